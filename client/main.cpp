@@ -1,0 +1,2 @@
+// parapm: the command-line tool (being written).
+int main() { return 0; }

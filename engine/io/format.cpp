@@ -1,0 +1,1 @@
+#include "io/mesh_io.h"

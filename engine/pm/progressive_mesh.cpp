@@ -1,0 +1,1 @@
+#include "pm/progressive_mesh.h"
