@@ -1,20 +1,34 @@
 // Validation and repair: turns what a reader produced into a mesh the engine can simplify,
 // and records what it changed so that a Progressive Mesh can still give back the input.
 //
-// Rules (each either an error or a counted repair; docs/ARCHITECTURE.md lists them):
-//  - NaN or infinite coordinates, NaN attributes: error naming the vertex.
-//  - face corners out of range: error (readers already check; repeated here for meshes
-//    that arrive by other paths, such as the network).
-//  - degenerate faces (a vertex repeated): removed, counted.
-//  - duplicate faces (same vertices, same orientation, any rotation): all but the first
-//    removed, counted. Faces with the same vertices but opposite orientation are kept.
-//  - unreferenced vertices: removed and counted, unless keep_unreferenced is set (then they
-//    stay as isolated vertices, which the simplifier never touches).
-//  - non-manifold edges (more than two faces, or two faces using the edge in the same
-//    direction) and non-manifold vertices (several fans): the mesh is cut along such edges
-//    and each extra fan of a vertex gets a copy of the vertex, so the engine sees a
-//    manifold; `copies` records which vertex each copy duplicates, so the full-resolution
-//    PM gives back the input's vertices once copies are merged.
+// Rules, applied in this order (each either an error or a counted repair; docs/ARCHITECTURE.md
+// lists them):
+//  1. Errors, Error(kInvalidInput) naming the vertex, wedge or face: NaN or infinite
+//     coordinates or attribute values; face corners out of range (readers already check;
+//     repeated here for meshes that arrive by other paths, such as the network); wedge arrays
+//     whose sizes disagree with the layout (all empty when the layout has no channel); a face
+//     corner whose wedge belongs to another vertex. Meshes with 2^32 - 1 vertices, wedges or
+//     more, or more than (2^32 - 2) / 3 faces: Error(kResourceExhausted).
+//  2. Degenerate faces (a vertex index repeated): removed, counted. Duplicate faces (same
+//     vertices in the same cyclic order, any rotation; wedges are not compared): all but the
+//     first removed, counted. Faces with the same vertices but opposite orientation are kept.
+//     Faces with distinct vertices but zero area (cross product exactly 0) are kept, counted.
+//  3. Unreferenced vertices (including those only removed faces used): removed with their
+//     wedges and counted, unless keep_unreferenced is set (then they stay as isolated
+//     vertices, which the simplifier never touches). Vertices and wedges keep their relative
+//     order. Wedges of kept vertices are kept even when no corner uses them.
+//  4. Non-manifold edges and vertices. An undirected edge is manifold when it has one face,
+//     or two faces that use it in opposite directions; the mesh is cut along every other edge
+//     (three or more faces, or two in the same direction): faces across it are not
+//     neighbours. The faces of each vertex are then grouped into fans, joined through the
+//     vertex's manifold edges; the fan holding the vertex's lowest face keeps the vertex, and
+//     each further fan gets a copy appended after all vertices (same position; copies ordered
+//     by original vertex, then by lowest face), with copies of the wedges its corners use
+//     (appended after all wedges). No face is changed other than by naming a copy, and no
+//     face is added: the result is an oriented 2-manifold with boundary (a halfedge structure
+//     can be built on it), and merging each copy into the vertex of input_vertex gives back
+//     the kept faces exactly.
+// Deterministic (no hashing, no threads) and O(F log(max valence)) time.
 #pragma once
 
 #include <cstdint>
@@ -33,13 +47,13 @@ struct RepairReport {
   uint64_t degenerate_faces_removed = 0;
   uint64_t duplicate_faces_removed = 0;
   uint64_t unreferenced_vertices_removed = 0;
-  uint64_t nonmanifold_edges = 0;      // edges the mesh was cut along
-  uint64_t nonmanifold_vertices = 0;   // vertices that received at least one copy
+  uint64_t nonmanifold_edges = 0;     // edges the mesh was cut along (after step 2)
+  uint64_t nonmanifold_vertices = 0;  // vertices that received at least one copy
   uint64_t vertex_copies_added = 0;
-  uint64_t zero_area_faces = 0;        // distinct vertices but zero area: kept, counted
+  uint64_t zero_area_faces = 0;  // distinct vertices but zero area: kept, counted
   bool changed() const {
-    return degenerate_faces_removed || duplicate_faces_removed ||
-           unreferenced_vertices_removed || vertex_copies_added;
+    return degenerate_faces_removed || duplicate_faces_removed || unreferenced_vertices_removed ||
+           vertex_copies_added;
   }
 };
 
@@ -48,8 +62,12 @@ struct RepairedMesh {
   // For each vertex of `mesh`: the vertex of the input it came from. Copies made to split a
   // non-manifold vertex map to the same input vertex as the original.
   std::vector<VertexId> input_vertex;
-  // For each face of `mesh`: its index among the input's faces (after fan triangulation).
+  // For each face of `mesh`: its index among the input's faces (after fan triangulation);
+  // increasing, since faces keep their order.
   std::vector<FaceId> input_face;
+  // For each wedge of `mesh`: the wedge of the input it came from (copies made with a vertex
+  // copy map to the wedge they copy). Empty when the mesh has no attributes.
+  std::vector<WedgeId> input_wedge;
   RepairReport report;
 };
 

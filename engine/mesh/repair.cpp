@@ -1,0 +1,481 @@
+// Validation and repair of an indexed triangle mesh; the rules are in repair.h.
+//
+// Method:
+//  - A. Guéziec, G. Taubin, F. Lazarus, W. Horn, "Cutting and Stitching: Converting Sets of
+//    Polygons to Manifold Surfaces", IEEE TVCG 7(2), 2001: the cutting half. Singular edges
+//    are cut, then each vertex is copied once per extra fan of faces around it. We do not
+//    stitch: stitching changes the input's connectivity, and the PM must give it back.
+//  - H. Hoppe, "Progressive Meshes", SIGGRAPH 96, section 3.1: wedges. A copied vertex takes
+//    copies of the wedges its corners use, so that every wedge still belongs to one vertex.
+//
+// Why cutting edges is enough (the "non-disk vertex" question). Around a vertex v each corner
+// has two edges at v: an outgoing one (v -> a) and an incoming one (b -> v). A manifold edge
+// has exactly one face in each direction, so it joins the outgoing edge of one corner to the
+// incoming edge of another, and each corner has at most one neighbour on each side. A fan is
+// therefore a simple chain or a simple cycle of corners, consistently oriented, and its edges
+// at v lead to distinct vertices (an indexed mesh has one edge {v, a}): a half-disk or a disk.
+// Two fans cannot be joined through a manifold edge, by definition of a fan.
+// The cut edges cannot break this either: a face that uses a cut edge v -> a has no
+// neighbour past its outgoing edge at v, so it is the clockwise end of its chain at v; a chain
+// has one such end, so two faces that use a cut edge in the same direction always end up in
+// different fans, at v and at a, hence on different copies. After the split each edge of the
+// output has at most one face per direction: manifold. A cut edge may remain an edge of the
+// output with two faces (say a tetrahedron with a fourth face on one of its edges: the
+// tetrahedron's two faces on that edge stay in one fan at both ends and keep their vertices,
+// only the extra face moves to copies); that closes the chain into a disk, which is fine.
+// mesh_checks.h verifies the result independently; the tests run it on every mesh.
+//
+// Cost: counting sorts by vertex, then sorts inside each vertex's bucket (its few faces or
+// edges): O(F log(max valence)) time; about 60 bytes per face of scratch memory. No hashing
+// and no threads, ties broken by index: the output depends only on the input.
+#include "mesh/repair.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <string>
+#include <tuple>
+
+#include "util/error.h"
+
+namespace parapm {
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// Messages.
+
+std::string number(double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+template <class T>
+std::string tuple_text(const T* values, int count) {
+  std::string out = "(";
+  for (int k = 0; k < count; ++k) {
+    if (k) out += ", ";
+    out += number(double(values[k]));
+  }
+  return out + ")";
+}
+
+// ---------------------------------------------------------------------------------------
+// Step 1: refuse what cannot be repaired.
+
+void check_finite_positions(const Mesh& mesh) {
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    const Vec3& p = mesh.positions[v];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      throw_invalid("vertex " + std::to_string(v) + " has a non-finite coordinate " +
+                    tuple_text(p.data(), 3));
+    }
+  }
+}
+
+void check_corners(const Mesh& mesh) {
+  const size_t n = mesh.vertex_count();
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      if (mesh.faces[f][i] >= n) {
+        throw_invalid("face " + std::to_string(f) + " corner " + std::to_string(i) +
+                      " refers to vertex " + std::to_string(mesh.faces[f][i]) +
+                      ", but the mesh has " + std::to_string(n) + " vertices");
+      }
+    }
+  }
+}
+
+void check_wedges(const Mesh& mesh) {
+  const size_t wedges = mesh.wedge_count();
+  if (!mesh.layout.any()) {
+    // No channel, no wedges: a reader that filled wedges without a layout has a bug that
+    // would otherwise surface far from here.
+    if (wedges || !mesh.wedge_values.empty() || !mesh.face_wedges.empty()) {
+      throw_invalid("mesh has no attribute channels but " + std::to_string(wedges) + " wedges, " +
+                    std::to_string(mesh.wedge_values.size()) + " wedge values and " +
+                    std::to_string(mesh.face_wedges.size()) + " face wedge triples");
+    }
+    return;
+  }
+  if (wedges >= kNoId) {
+    throw Error(ErrorCode::kResourceExhausted,
+                "mesh has too many wedges (" + std::to_string(wedges) + ")");
+  }
+  const int floats = mesh.layout.floats_per_wedge();
+  if (mesh.wedge_values.size() != wedges * size_t(floats)) {
+    throw_invalid("wedge_values has " + std::to_string(mesh.wedge_values.size()) +
+                  " floats, expected " + std::to_string(wedges) + " wedges x " +
+                  std::to_string(floats) + " floats");
+  }
+  if (mesh.face_wedges.size() != mesh.faces.size()) {
+    throw_invalid("face_wedges has " + std::to_string(mesh.face_wedges.size()) +
+                  " entries, expected one per face (" + std::to_string(mesh.faces.size()) + ")");
+  }
+  struct Channel {
+    bool present;
+    int offset, count;
+    const char* name;
+  };
+  const AttributeLayout& layout = mesh.layout;
+  const Channel channels[] = {{layout.normals, layout.normal_offset(), 3, "normal"},
+                              {layout.texcoords, layout.texcoord_offset(), 2, "texcoord"},
+                              {layout.colors, layout.color_offset(), 4, "color"}};
+  for (size_t w = 0; w < wedges; ++w) {
+    const VertexId v = mesh.wedge_vertex[w];
+    if (v >= mesh.vertex_count()) {
+      throw_invalid("wedge " + std::to_string(w) + " belongs to vertex " + std::to_string(v) +
+                    ", but the mesh has " + std::to_string(mesh.vertex_count()) + " vertices");
+    }
+    const float* values = mesh.wedge(WedgeId(w));
+    for (const Channel& channel : channels) {
+      if (!channel.present) continue;
+      for (int k = 0; k < channel.count; ++k) {
+        if (!std::isfinite(values[channel.offset + k])) {
+          throw_invalid("wedge " + std::to_string(w) + " (vertex " + std::to_string(v) +
+                        ") has a non-finite " + channel.name + " " +
+                        tuple_text(values + channel.offset, channel.count));
+        }
+      }
+    }
+  }
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      const WedgeId w = mesh.face_wedges[f][i];
+      const std::string corner = "face " + std::to_string(f) + " corner " + std::to_string(i);
+      if (w >= wedges) {
+        throw_invalid(corner + " uses wedge " + std::to_string(w) + ", but the mesh has " +
+                      std::to_string(wedges) + " wedges");
+      }
+      if (mesh.wedge_vertex[w] != mesh.faces[f][i]) {
+        throw_invalid(corner + " (vertex " + std::to_string(mesh.faces[f][i]) + ") uses wedge " +
+                      std::to_string(w) + ", which belongs to vertex " +
+                      std::to_string(mesh.wedge_vertex[w]));
+      }
+    }
+  }
+}
+
+void validate(const Mesh& mesh) {
+  // Ids must stay below kNoId, and corner ids (3 * face + corner) must fit in 32 bits.
+  if (mesh.vertex_count() >= kNoId) {
+    throw Error(ErrorCode::kResourceExhausted,
+                "mesh has too many vertices (" + std::to_string(mesh.vertex_count()) + ")");
+  }
+  if (mesh.face_count() > (size_t(kNoId) - 1) / 3) {
+    throw Error(ErrorCode::kResourceExhausted,
+                "mesh has too many faces (" + std::to_string(mesh.face_count()) + ")");
+  }
+  check_finite_positions(mesh);
+  check_corners(mesh);
+  check_wedges(mesh);
+}
+
+// ---------------------------------------------------------------------------------------
+// Counting sort by vertex, the building block of steps 2 and 4: for each item i whose
+// key_of(i) is not kNoId, value_of(i) is stored in bucket key_of(i), in increasing i inside a
+// bucket; bucket k is values[starts[k] .. starts[k + 1]). The values carry what the sort
+// inside a bucket compares, so that it does not go back to the faces.
+
+template <class Value, class KeyOf, class ValueOf>
+void bucket_by_vertex(size_t items, size_t vertices, KeyOf key_of, ValueOf value_of,
+                      std::vector<Value>* values, std::vector<uint32_t>* starts) {
+  starts->assign(vertices + 1, 0);
+  for (size_t i = 0; i < items; ++i) {
+    const VertexId k = key_of(i);
+    if (k != kNoId) ++(*starts)[k + 1];
+  }
+  for (size_t k = 0; k < vertices; ++k) (*starts)[k + 1] += (*starts)[k];
+  values->resize((*starts)[vertices]);
+  std::vector<uint32_t> next(starts->begin(), starts->end() - 1);
+  for (size_t i = 0; i < items; ++i) {
+    const VertexId k = key_of(i);
+    if (k != kNoId) (*values)[next[k]++] = value_of(i);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Step 2: degenerate and duplicate faces.
+
+struct FaceFilter {
+  std::vector<FaceId> kept;  // input face ids, increasing
+  uint64_t degenerate = 0;
+  uint64_t duplicate = 0;
+};
+
+FaceFilter filter_faces(const std::vector<Triangle>& faces, size_t vertices) {
+  // Rotate each face so that its lowest vertex comes first: two faces are duplicates exactly
+  // when their rotated triples are equal. Degenerate faces get kNoId, which keeps them out of
+  // the buckets.
+  std::vector<Triangle> rotated(faces.size());
+  FaceFilter filter;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const Triangle& t = faces[f];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      rotated[f] = {kNoId, kNoId, kNoId};
+      ++filter.degenerate;
+      continue;
+    }
+    const int first = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
+    rotated[f] = {t[first], t[(first + 1) % 3], t[(first + 2) % 3]};
+  }
+  // Bucket by the lowest vertex, holding (second vertex, third vertex, face). Inside a bucket
+  // equal triples become adjacent once sorted; the lowest face id of each run is kept.
+  std::vector<std::array<uint32_t, 3>> entries;
+  std::vector<uint32_t> starts;
+  bucket_by_vertex(
+      faces.size(), vertices, [&](size_t f) { return rotated[f][0]; },
+      [&](size_t f) {
+        return std::array<uint32_t, 3>{rotated[f][1], rotated[f][2], uint32_t(f)};
+      },
+      &entries, &starts);
+  std::vector<bool> removed(faces.size(), false);
+  for (size_t v = 0; v < vertices; ++v) {
+    const auto begin = entries.begin() + starts[v], end = entries.begin() + starts[v + 1];
+    if (end - begin < 2) continue;
+    std::sort(begin, end);
+    for (auto it = begin + 1; it != end; ++it) {
+      if ((*it)[0] == (*(it - 1))[0] && (*it)[1] == (*(it - 1))[1]) {
+        removed[(*it)[2]] = true;
+        ++filter.duplicate;
+      }
+    }
+  }
+  filter.kept.reserve(faces.size() - filter.degenerate - filter.duplicate);
+  for (size_t f = 0; f < faces.size(); ++f) {
+    if (rotated[f][0] != kNoId && !removed[f]) filter.kept.push_back(FaceId(f));
+  }
+  return filter;
+}
+
+bool has_zero_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const Vec3 w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  return u[1] * w[2] - u[2] * w[1] == 0 && u[2] * w[0] - u[0] * w[2] == 0 &&
+         u[0] * w[1] - u[1] * w[0] == 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Step 3: keep the kept faces' vertices (or all of them), renumbered in order, with their
+// wedges. Fills everything of `out` but the manifold split.
+
+void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOptions& options,
+             RepairedMesh* out) {
+  const size_t n = input.vertex_count();
+  std::vector<VertexId> new_vertex(n, kNoId);
+  for (FaceId f : kept) {
+    for (VertexId v : input.faces[f]) new_vertex[v] = 0;  // referenced
+  }
+  Mesh& mesh = out->mesh;
+  for (size_t v = 0; v < n; ++v) {
+    if (new_vertex[v] == kNoId && !options.keep_unreferenced) {
+      ++out->report.unreferenced_vertices_removed;
+      continue;
+    }
+    new_vertex[v] = VertexId(mesh.positions.size());
+    mesh.positions.push_back(input.positions[v]);
+    out->input_vertex.push_back(VertexId(v));
+  }
+
+  mesh.faces.reserve(kept.size());
+  for (FaceId f : kept) {
+    const Triangle& t = input.faces[f];
+    mesh.faces.push_back({new_vertex[t[0]], new_vertex[t[1]], new_vertex[t[2]]});
+  }
+  out->input_face = kept;
+
+  mesh.layout = input.layout;
+  mesh.positions_are_float = input.positions_are_float;
+  if (!input.layout.any()) return;
+  const size_t floats = size_t(input.layout.floats_per_wedge());
+  std::vector<WedgeId> new_wedge(input.wedge_count(), kNoId);
+  for (size_t w = 0; w < input.wedge_count(); ++w) {
+    const VertexId v = new_vertex[input.wedge_vertex[w]];
+    if (v == kNoId) continue;  // its vertex was removed
+    new_wedge[w] = WedgeId(mesh.wedge_vertex.size());
+    mesh.wedge_vertex.push_back(v);
+    const float* values = input.wedge(WedgeId(w));
+    mesh.wedge_values.insert(mesh.wedge_values.end(), values, values + floats);
+    out->input_wedge.push_back(WedgeId(w));
+  }
+  mesh.face_wedges.reserve(kept.size());
+  for (FaceId f : kept) {
+    const auto& fw = input.face_wedges[f];
+    mesh.face_wedges.push_back({new_wedge[fw[0]], new_wedge[fw[1]], new_wedge[fw[2]]});
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Step 4a: pair the faces across manifold edges. Halfedge h = 3 * face + corner goes from
+// that corner to the next; twin[h] is the halfedge of the other face of a manifold edge, or
+// kNoId on the boundary and along cut edges.
+
+VertexId tail(const std::vector<Triangle>& faces, uint32_t h) { return faces[h / 3][h % 3]; }
+VertexId head(const std::vector<Triangle>& faces, uint32_t h) {
+  return faces[h / 3][(h % 3 + 1) % 3];
+}
+
+std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vertices,
+                                 uint64_t* nonmanifold_edges) {
+  const size_t halfedges = 3 * faces.size();
+  // Group the halfedges of each undirected edge: bucket by the lower end, holding
+  // (higher end << 32 | halfedge), and sort each bucket (ties by halfedge id).
+  std::vector<uint64_t> entries;
+  std::vector<uint32_t> starts;
+  bucket_by_vertex(
+      halfedges, vertices,
+      [&](size_t h) { return std::min(tail(faces, uint32_t(h)), head(faces, uint32_t(h))); },
+      [&](size_t h) {
+        return uint64_t(std::max(tail(faces, uint32_t(h)), head(faces, uint32_t(h)))) << 32 | h;
+      },
+      &entries, &starts);
+
+  std::vector<uint32_t> twin(halfedges, kNoId);
+  for (size_t v = 0; v < vertices; ++v) {
+    const auto begin = entries.begin() + starts[v], end = entries.begin() + starts[v + 1];
+    std::sort(begin, end);
+    for (auto run = begin; run != end;) {
+      auto run_end = run + 1;
+      while (run_end != end && *run_end >> 32 == *run >> 32) ++run_end;
+      const uint32_t h0 = uint32_t(run[0]), h1 = uint32_t(run_end[-1]);
+      if (run_end - run == 2 && tail(faces, h0) == head(faces, h1)) {
+        twin[h0] = h1;
+        twin[h1] = h0;
+      } else if (run_end - run >= 2) {
+        ++*nonmanifold_edges;  // cut: its faces stay unpaired
+      }
+      run = run_end;
+    }
+  }
+  return twin;
+}
+
+// ---------------------------------------------------------------------------------------
+// Step 4b: group each vertex's corners into fans and give every fan but the first a copy of
+// the vertex. Corner c = 3 * face + i sits at faces[face][i]; its outgoing halfedge is c
+// itself and its incoming one is 3 * face + (i + 2) % 3.
+
+void split_fans(const std::vector<uint32_t>& twin, RepairedMesh* out) {
+  Mesh& mesh = out->mesh;
+  std::vector<Triangle>& faces = mesh.faces;
+  const size_t corners = 3 * faces.size();
+  const size_t n = mesh.vertex_count();
+
+  // Label the fans in increasing order of their lowest corner, so that a vertex meets its fan
+  // with the lowest face first. Crossing a corner's outgoing halfedge leads to the next corner
+  // clockwise around the vertex; crossing its incoming halfedge, counter-clockwise.
+  std::vector<uint32_t> fan_of(corners, kNoId);
+  std::vector<VertexId> fan_vertex;  // per fan: the vertex of the output it will use
+  std::vector<bool> vertex_has_fan(n, false);
+  std::vector<std::pair<VertexId, uint32_t>> extra_fans;  // (vertex, fan)
+  for (uint32_t c = 0; c < corners; ++c) {
+    if (fan_of[c] != kNoId) continue;
+    const uint32_t fan = uint32_t(fan_vertex.size());
+    auto label = [&](uint32_t corner) {
+      // Cannot happen with twins that pair opposite halfedges: the walk would loop.
+      if (fan_of[corner] != kNoId) throw_internal("repair: corner walked twice");
+      fan_of[corner] = fan;
+    };
+    label(c);
+    bool closed = false;
+    for (uint32_t x = c;;) {  // clockwise until the boundary or back to c
+      const uint32_t t = twin[x];
+      if (t == kNoId) break;
+      const uint32_t next = 3 * (t / 3) + (t % 3 + 1) % 3;
+      if (next == c) {
+        closed = true;
+        break;
+      }
+      label(next);
+      x = next;
+    }
+    for (uint32_t x = c; !closed;) {  // then counter-clockwise until the boundary
+      const uint32_t t = twin[3 * (x / 3) + (x % 3 + 2) % 3];
+      if (t == kNoId) break;
+      label(t);
+      x = t;
+    }
+    const VertexId v = faces[c / 3][c % 3];
+    if (!vertex_has_fan[v]) {
+      vertex_has_fan[v] = true;
+      fan_vertex.push_back(v);
+    } else {
+      fan_vertex.push_back(kNoId);
+      extra_fans.emplace_back(v, fan);
+    }
+  }
+
+  // Copies are numbered by original vertex, then by lowest face (the fan order above).
+  std::sort(extra_fans.begin(), extra_fans.end());
+  if (n + extra_fans.size() >= kNoId) {
+    throw Error(ErrorCode::kResourceExhausted, "repair: too many vertex copies");
+  }
+  for (size_t k = 0; k < extra_fans.size(); ++k) {
+    const auto [v, fan] = extra_fans[k];
+    fan_vertex[fan] = VertexId(n + k);
+    mesh.positions.push_back(mesh.positions[v]);
+    out->input_vertex.push_back(out->input_vertex[v]);
+    if (k == 0 || extra_fans[k - 1].first != v) ++out->report.nonmanifold_vertices;
+  }
+  out->report.vertex_copies_added = extra_fans.size();
+  if (extra_fans.empty()) return;
+
+  for (uint32_t c = 0; c < corners; ++c) faces[c / 3][c % 3] = fan_vertex[fan_of[c]];
+
+  // The corners now on a copy take copies of their wedges, one per (copy, wedge) pair.
+  if (!mesh.layout.any()) return;
+  std::vector<std::tuple<VertexId, WedgeId, uint32_t>> moved;  // (copy, old wedge, corner)
+  for (uint32_t c = 0; c < corners; ++c) {
+    if (faces[c / 3][c % 3] >= n)
+      moved.emplace_back(faces[c / 3][c % 3], mesh.face_wedges[c / 3][c % 3], c);
+  }
+  std::sort(moved.begin(), moved.end());
+  const size_t floats = size_t(mesh.layout.floats_per_wedge());
+  if (mesh.wedge_count() + moved.size() >= kNoId) {
+    throw Error(ErrorCode::kResourceExhausted, "repair: too many wedge copies");
+  }
+  WedgeId copy = kNoId;
+  for (size_t k = 0; k < moved.size(); ++k) {
+    const auto [vertex, wedge, c] = moved[k];
+    if (k == 0 || std::get<0>(moved[k - 1]) != vertex || std::get<1>(moved[k - 1]) != wedge) {
+      copy = WedgeId(mesh.wedge_count());
+      mesh.wedge_vertex.push_back(vertex);
+      float values[9];  // at most 3 + 2 + 4 floats; copied out before the vector grows
+      std::copy_n(mesh.wedge(wedge), floats, values);
+      mesh.wedge_values.insert(mesh.wedge_values.end(), values, values + floats);
+      out->input_wedge.push_back(out->input_wedge[wedge]);
+    }
+    mesh.face_wedges[c / 3][c % 3] = copy;
+  }
+}
+
+}  // namespace
+
+RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
+  // 1. Refuse what cannot be repaired: nothing below has to check a value or an index.
+  validate(input);
+
+  // 2. Faces that are not triangles of a surface (degenerate) or that repeat an earlier
+  // face go; zero-area faces stay (the simplifier removes them first) but are counted.
+  FaceFilter filter = filter_faces(input.faces, input.vertex_count());
+  RepairedMesh out;
+  out.report.degenerate_faces_removed = filter.degenerate;
+  out.report.duplicate_faces_removed = filter.duplicate;
+  for (FaceId f : filter.kept) {
+    const Triangle& t = input.faces[f];
+    if (has_zero_area(input.positions[t[0]], input.positions[t[1]], input.positions[t[2]])) {
+      ++out.report.zero_area_faces;
+    }
+  }
+
+  // 3. Vertices no face uses go (unless asked to keep them), with their wedges.
+  compact(input, filter.kept, options, &out);
+
+  // 4. Cut along the non-manifold edges, then copy each vertex once per extra fan.
+  const std::vector<uint32_t> twin =
+      pair_edges(out.mesh.faces, out.mesh.vertex_count(), &out.report.nonmanifold_edges);
+  split_fans(twin, &out);
+  return out;
+}
+
+}  // namespace parapm

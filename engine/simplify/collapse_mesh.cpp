@@ -1,0 +1,113 @@
+#include "simplify/collapse_mesh.h"
+
+#include <algorithm>
+
+#include "util/error.h"
+
+namespace parapm {
+
+CollapseMesh::CollapseMesh(const Mesh& mesh)
+    : positions_(mesh.positions),
+      faces_(mesh.faces),
+      corner_wedges_(mesh.face_wedges),
+      face_alive_(mesh.faces.size(), 1),
+      faces_of_(mesh.positions.size()),
+      boundary_(mesh.positions.size(), 0),
+      live_faces_(mesh.faces.size()) {
+  std::vector<uint32_t> valence(positions_.size(), 0);
+  for (const Triangle& t : faces_)
+    for (VertexId v : t) ++valence[v];
+  for (size_t v = 0; v < positions_.size(); ++v) faces_of_[v].reserve(valence[v]);
+  for (FaceId f = 0; f < faces_.size(); ++f)
+    for (VertexId v : faces_[f]) faces_of_[v].push_back(f);
+  for (VertexId v = 0; v < positions_.size(); ++v) {
+    if (faces_of_[v].empty()) continue;
+    ++live_vertices_;
+    boundary_[v] = compute_boundary(v);
+  }
+}
+
+EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
+  EdgeFaces result;
+  for (FaceId f : faces_of_[a]) {
+    const Triangle& t = faces_[f];
+    const int i = corner_of(t, a);
+    const VertexId next = t[(i + 1) % 3];
+    const VertexId prev = t[(i + 2) % 3];
+    if (next == b) {
+      result.left = f;
+      result.left_apex = prev;
+    } else if (prev == b) {
+      result.right = f;
+      result.right_apex = next;
+    }
+  }
+  return result;
+}
+
+void CollapseMesh::neighbors(VertexId v, std::vector<VertexId>& out) const {
+  out.clear();
+  for (FaceId f : faces_of_[v]) {
+    const Triangle& t = faces_[f];
+    const int i = corner_of(t, v);
+    out.push_back(t[(i + 1) % 3]);
+    out.push_back(t[(i + 2) % 3]);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+// A vertex is on the boundary when one of its edges has a face on one side only; on a
+// manifold every directed edge v->n appears once, so v is interior exactly when each
+// outgoing edge v->n is matched by an incoming n->v.
+bool CollapseMesh::compute_boundary(VertexId v) const {
+  for (FaceId f : faces_of_[v]) {
+    const Triangle& t = faces_[f];
+    const VertexId next = t[(corner_of(t, v) + 1) % 3];
+    bool matched = false;
+    for (FaceId g : faces_of_[v]) {
+      const Triangle& u = faces_[g];
+      if (u[(corner_of(u, v) + 2) % 3] == next) {
+        matched = true;
+        break;
+      }
+    }
+    if (!matched) return true;
+  }
+  return false;
+}
+
+void CollapseMesh::remove_face_from(VertexId v, FaceId f) {
+  auto& list = faces_of_[v];
+  auto it = std::find(list.begin(), list.end(), f);
+  if (it == list.end()) throw_internal("collapse: face missing from its vertex's list");
+  *it = list.back();
+  list.pop_back();
+}
+
+EdgeFaces CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position) {
+  const EdgeFaces removed = edge_faces(vs, vt);
+  for (FaceId f : {removed.left, removed.right}) {
+    if (f == kNoId) continue;
+    face_alive_[f] = 0;
+    --live_faces_;
+    for (VertexId v : faces_[f]) remove_face_from(v, f);
+  }
+  auto& moved = faces_of_[vt];
+  for (FaceId f : moved) {
+    Triangle& t = faces_[f];
+    t[corner_of(t, vt)] = vs;
+    faces_of_[vs].push_back(f);
+  }
+  moved.clear();
+  moved.shrink_to_fit();
+  --live_vertices_;
+  positions_[vs] = position;
+  boundary_[vt] = 0;
+  // A legal collapse changes the boundary status of vs and of the apexes only.
+  for (VertexId v : {vs, removed.left_apex, removed.right_apex})
+    if (v != kNoId) boundary_[v] = !faces_of_[v].empty() && compute_boundary(v);
+  return removed;
+}
+
+}  // namespace parapm

@@ -1,0 +1,73 @@
+// The working mesh of the simplifier: an indexed triangle mesh with vertex -> face
+// adjacency, on which edge collapses are performed in place (Hoppe 96, section 3).
+//
+// It is deliberately not a halfedge structure: the collapse engine needs only "the faces
+// around a vertex" and "the face holding a directed edge", both answered by scanning the
+// vertex's face list (valence ~6), and a flat list keeps a collapse cheap. Faces keep their
+// ids for the whole run; a collapsed face is marked dead.
+//
+// Preconditions: the mesh is an oriented 2-manifold with boundary (repair_mesh output).
+// Memory: about 60 bytes per vertex plus 32 bytes per face beyond the input mesh.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "mesh/mesh.h"
+
+namespace parapm {
+
+struct EdgeFaces {
+  FaceId left = kNoId;   // the face holding the directed edge a->b: (a, b, left_apex)
+  FaceId right = kNoId;  // the face holding b->a: (b, a, right_apex)
+  VertexId left_apex = kNoId;
+  VertexId right_apex = kNoId;
+};
+
+class CollapseMesh {
+ public:
+  explicit CollapseMesh(const Mesh& mesh);
+
+  size_t vertex_capacity() const { return positions_.size(); }
+  size_t face_capacity() const { return faces_.size(); }
+  size_t live_faces() const { return live_faces_; }
+  size_t live_vertices() const { return live_vertices_; }
+
+  bool vertex_alive(VertexId v) const { return !faces_of_[v].empty(); }
+  bool face_alive(FaceId f) const { return face_alive_[f]; }
+  const Triangle& face(FaceId f) const { return faces_[f]; }
+  const std::array<WedgeId, 3>& corner_wedges(FaceId f) const { return corner_wedges_[f]; }
+  bool has_wedges() const { return !corner_wedges_.empty(); }
+  const std::vector<FaceId>& faces_of(VertexId v) const { return faces_of_[v]; }
+  const Vec3& position(VertexId v) const { return positions_[v]; }
+  bool is_boundary(VertexId v) const { return boundary_[v]; }
+
+  EdgeFaces edge_faces(VertexId a, VertexId b) const;
+  // The distinct vertices sharing a face with v, sorted.
+  void neighbors(VertexId v, std::vector<VertexId>& out) const;
+
+  // Merges vt into vs, moves vs to `position`, removes the faces on the edge. The caller has
+  // checked legality. Returns the faces that were removed (left, right, kNoId if absent).
+  EdgeFaces collapse(VertexId vs, VertexId vt, const Vec3& position);
+
+ private:
+  void remove_face_from(VertexId v, FaceId f);
+  bool compute_boundary(VertexId v) const;
+
+  std::vector<Vec3> positions_;
+  std::vector<Triangle> faces_;
+  std::vector<std::array<WedgeId, 3>> corner_wedges_;
+  std::vector<uint8_t> face_alive_;
+  std::vector<std::vector<FaceId>> faces_of_;
+  std::vector<uint8_t> boundary_;
+  size_t live_faces_ = 0;
+  size_t live_vertices_ = 0;
+};
+
+// Index of vertex v among the corners of face t (0, 1, 2), or -1.
+inline int corner_of(const Triangle& t, VertexId v) {
+  return t[0] == v ? 0 : t[1] == v ? 1 : t[2] == v ? 2 : -1;
+}
+
+}  // namespace parapm

@@ -1,0 +1,163 @@
+// The standard constraint modules: topology (Hoppe 96 section 3; Dey et al. 1999 for the link
+// condition) and geometry (no flipped or degenerate faces).
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "simplify/modules.h"
+#include "simplify/vec_math.h"
+
+namespace parapm {
+namespace {
+
+class LockedVertices : public ConstraintModule {
+ public:
+  explicit LockedVertices(std::vector<uint8_t> locked) : locked_(std::move(locked)) {}
+  std::string name() const override { return "locked-vertices"; }
+  bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
+              const EdgeFaces&) const override {
+    if (locked_.empty()) return true;
+    if (locked_[c.vt]) return false;
+    return !locked_[c.vs] || c.position == mesh.position(c.vs);
+  }
+
+ private:
+  std::vector<uint8_t> locked_;
+};
+
+// Counts the live vertices of each connected component; components never merge or split
+// under legal collapses, so the counts only go down by one per collapse.
+class ComponentMinimum : public ConstraintModule {
+ public:
+  std::string name() const override { return "component-minimum"; }
+  void initialize(const CollapseMesh& mesh) override {
+    const size_t n = mesh.vertex_capacity();
+    std::vector<VertexId> parent(n);
+    for (VertexId v = 0; v < n; ++v) parent[v] = v;
+    auto find = [&](VertexId v) {
+      while (parent[v] != v) v = parent[v] = parent[parent[v]];
+      return v;
+    };
+    for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+      const Triangle& t = mesh.face(f);
+      for (int k = 1; k < 3; ++k) {
+        const VertexId a = find(t[0]), b = find(t[k]);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+    component_.assign(n, kNoId);
+    std::vector<uint32_t> index_of_root(n, kNoId);
+    for (VertexId v = 0; v < n; ++v) {
+      if (!mesh.vertex_alive(v)) continue;
+      const VertexId root = find(v);
+      if (index_of_root[root] == kNoId) {
+        index_of_root[root] = uint32_t(count_.size());
+        count_.push_back(0);
+        closed_.push_back(1);
+      }
+      const uint32_t c = index_of_root[root];
+      component_[v] = c;
+      ++count_[c];
+      if (mesh.is_boundary(v)) closed_[c] = 0;
+    }
+  }
+  bool allows(const CollapseMesh&, const CollapseCandidate& c, const EdgeFaces&) const override {
+    const uint32_t comp = component_[c.vs];
+    return count_[comp] > (closed_[comp] ? 4u : 3u);
+  }
+  void collapsed(const CollapseMesh&, const CollapseCandidate& c) override {
+    --count_[component_[c.vs]];
+  }
+
+ private:
+  std::vector<uint32_t> component_;
+  std::vector<uint32_t> count_;
+  std::vector<uint8_t> closed_;
+};
+
+class BoundaryRule : public ConstraintModule {
+ public:
+  std::string name() const override { return "boundary"; }
+  bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
+              const EdgeFaces& edge) const override {
+    if (edge.left == kNoId && edge.right == kNoId) return false;  // not an edge any more
+    const bool boundary_edge = edge.left == kNoId || edge.right == kNoId;
+    return boundary_edge || !(mesh.is_boundary(c.vs) && mesh.is_boundary(c.vt));
+  }
+};
+
+class LinkCondition : public ConstraintModule {
+ public:
+  std::string name() const override { return "link-condition"; }
+  bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
+              const EdgeFaces& edge) const override {
+    thread_local std::vector<VertexId> ring_s, ring_t;
+    mesh.neighbors(c.vs, ring_s);
+    mesh.neighbors(c.vt, ring_t);
+    size_t i = 0, j = 0;
+    while (i < ring_s.size() && j < ring_t.size()) {
+      if (ring_s[i] < ring_t[j]) {
+        ++i;
+      } else if (ring_t[j] < ring_s[i]) {
+        ++j;
+      } else {
+        const VertexId common = ring_s[i];
+        if (common != edge.left_apex && common != edge.right_apex) return false;
+        ++i, ++j;
+      }
+    }
+    return true;
+  }
+};
+
+// Rejects a collapse after which a face around vs or vt turns by more than 90 degrees or
+// loses (almost) all its area: both make folds that later collapses cannot undo.
+class FaceGeometry : public ConstraintModule {
+  // |n| is twice the area; a sliver's height is below ~1e-6 of its longest side.
+  static bool is_sliver(const Vec3& n, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const double longest_sq = std::max(
+        {dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
+    return dot(n, n) <= 1e-12 * longest_sq * longest_sq;
+  }
+
+ public:
+  std::string name() const override { return "face-geometry"; }
+  bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
+              const EdgeFaces& edge) const override {
+    for (VertexId moved : {c.vs, c.vt}) {
+      for (FaceId f : mesh.faces_of(moved)) {
+        if (f == edge.left || f == edge.right) continue;
+        const Triangle& t = mesh.face(f);
+        const Vec3& p0 = mesh.position(t[0]);
+        const Vec3& p1 = mesh.position(t[1]);
+        const Vec3& p2 = mesh.position(t[2]);
+        const Vec3 before = triangle_normal(p0, p1, p2);
+        const int k = corner_of(t, moved);
+        const Vec3& q0 = k == 0 ? c.position : p0;
+        const Vec3& q1 = k == 1 ? c.position : p1;
+        const Vec3& q2 = k == 2 ? c.position : p2;
+        // A face that is already degenerate (zero-area input) has no normal to keep; it is
+        // left to be collapsed away rather than blocking every collapse around it.
+        if (is_sliver(before, p0, p1, p2)) continue;
+        const Vec3 after = triangle_normal(q0, q1, q2);
+        if (dot(before, after) <= 0 || is_sliver(after, q0, q1, q2)) return false;
+      }
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
+std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
+    const std::vector<uint8_t>& locked) {
+  std::vector<std::unique_ptr<ConstraintModule>> modules;
+  modules.push_back(std::make_unique<LockedVertices>(locked));
+  modules.push_back(std::make_unique<ComponentMinimum>());
+  modules.push_back(std::make_unique<BoundaryRule>());
+  modules.push_back(std::make_unique<LinkCondition>());
+  modules.push_back(std::make_unique<FaceGeometry>());
+  return modules;
+}
+
+}  // namespace parapm

@@ -1,0 +1,57 @@
+// The collapse engine's plug-in points, after OpenMesh's Decimater: constraint modules veto
+// a collapse, one priority module costs it and places the surviving vertex. A module's
+// per-vertex state (quadrics, sample points) belongs to the module.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "simplify/collapse_mesh.h"
+
+namespace parapm {
+
+// The collapse of edge (vs, vt): vt is merged into vs, which moves to `position`.
+struct CollapseCandidate {
+  VertexId vs = kNoId;
+  VertexId vt = kNoId;
+  Vec3 position{};
+  double cost = 0;   // priority: smaller collapses first; units are the module's own
+  double error = 0;  // geometric error of the collapse in model units (for cutting a PM)
+};
+
+class PriorityModule {
+ public:
+  virtual ~PriorityModule() = default;
+  virtual std::string name() const = 0;
+  virtual void initialize(const CollapseMesh& mesh) = 0;
+  // Costs the collapse of edge {a, b}, choosing which end survives and where. Returns false
+  // when the collapse cannot be placed (the edge is then left alone).
+  virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
+                        CollapseCandidate& out) const = 0;
+  // Called after the mesh performed `done`, to update the module's state.
+  virtual void collapsed(const CollapseMesh& mesh, const CollapseCandidate& done) = 0;
+};
+
+class ConstraintModule {
+ public:
+  virtual ~ConstraintModule() = default;
+  virtual std::string name() const = 0;
+  virtual void initialize(const CollapseMesh&) {}
+  // `edge` holds the faces on the edge (vs, vt) as CollapseMesh::edge_faces(vs, vt).
+  virtual bool allows(const CollapseMesh& mesh, const CollapseCandidate& candidate,
+                      const EdgeFaces& edge) const = 0;
+  virtual void collapsed(const CollapseMesh&, const CollapseCandidate&) {}
+};
+
+// The legality rules every collapse obeys (Hoppe 96 section 3, and METHOD.md section 1), in
+// the order they are checked, cheapest first:
+//   locked vertices: a vertex the repair step duplicated is never removed nor moved;
+//   minimum size: a closed component keeps more than 4 vertices, an open one more than 3;
+//   boundary: an edge between two boundary vertices must itself be a boundary edge;
+//   link condition: vs and vt share no neighbour other than the apexes of the edge's faces;
+//   geometry: no remaining face around vs or vt flips its normal or becomes degenerate.
+std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
+    const std::vector<uint8_t>& locked);
+
+}  // namespace parapm

@@ -1,0 +1,26 @@
+// Turns the simplifier's collapse records and the mesh they leave into a Progressive Mesh:
+// the surviving mesh becomes the base mesh, the records reversed become the vertex splits,
+// and every id is renumbered to the PM's streaming order (progressive_mesh.h).
+#pragma once
+
+#include <vector>
+
+#include "mesh/repair.h"
+#include "pm/progressive_mesh.h"
+#include "simplify/collapse_mesh.h"
+#include "simplify/simplifier.h"
+
+namespace parapm {
+
+struct PmBuildOptions {
+  bool keep_order = false;  // store the input's vertex and face order (--keep-order)
+};
+
+// `repaired` is the mesh the simplifier started from; `final_mesh` the CollapseMesh after
+// `records` were performed on it, in order.
+ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
+                                        const CollapseMesh& final_mesh,
+                                        const std::vector<CollapseRecord>& records,
+                                        const PmBuildOptions& options);
+
+}  // namespace parapm

@@ -1,0 +1,57 @@
+#include "simplify/quadric.h"
+
+#include <cmath>
+
+namespace parapm {
+
+Quadric Quadric::from_plane(const Vec3& n, double d, double weight) {
+  Quadric q;
+  q.a00 = weight * n[0] * n[0];
+  q.a01 = weight * n[0] * n[1];
+  q.a02 = weight * n[0] * n[2];
+  q.a11 = weight * n[1] * n[1];
+  q.a12 = weight * n[1] * n[2];
+  q.a22 = weight * n[2] * n[2];
+  q.b0 = weight * n[0] * d;
+  q.b1 = weight * n[1] * d;
+  q.b2 = weight * n[2] * d;
+  q.c = weight * d * d;
+  q.weight = weight;
+  return q;
+}
+
+Quadric& Quadric::operator+=(const Quadric& q) {
+  a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
+  b0 += q.b0, b1 += q.b1, b2 += q.b2;
+  c += q.c;
+  weight += q.weight;
+  return *this;
+}
+
+double Quadric::evaluate(const Vec3& p) const {
+  const double x = p[0], y = p[1], z = p[2];
+  return a00 * x * x + 2 * a01 * x * y + 2 * a02 * x * z + a11 * y * y + 2 * a12 * y * z +
+         a22 * z * z + 2 * (b0 * x + b1 * y + b2 * z) + c;
+}
+
+bool Quadric::minimizer(Vec3& out) const {
+  // Cofactors of the symmetric A; A p = -b.
+  const double c00 = a11 * a22 - a12 * a12;
+  const double c01 = a02 * a12 - a01 * a22;
+  const double c02 = a01 * a12 - a02 * a11;
+  const double det = a00 * c00 + a01 * c01 + a02 * c02;
+  const double scale = a00 + a11 + a22;
+  // A nearly singular A (flat or cylindrical neighbourhood) has no reliable minimiser: the
+  // relative threshold keeps the test independent of the model's units.
+  if (!(std::fabs(det) > 1e-9 * scale * scale * scale)) return false;
+  const double c11 = a00 * a22 - a02 * a02;
+  const double c12 = a01 * a02 - a00 * a12;
+  const double c22 = a00 * a11 - a01 * a01;
+  const double inv = 1.0 / det;
+  out[0] = -(c00 * b0 + c01 * b1 + c02 * b2) * inv;
+  out[1] = -(c01 * b0 + c11 * b1 + c12 * b2) * inv;
+  out[2] = -(c02 * b0 + c12 * b1 + c22 * b2) * inv;
+  return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
+}
+
+}  // namespace parapm

@@ -1,0 +1,91 @@
+// Quadric error metric priority (Garland & Heckbert, SIGGRAPH 97), with the boundary planes of
+// their section 6.1 and the placement fallback of Hoppe 99 (best of the two ends and the
+// midpoint when the optimum is ill-conditioned or lands far from the edge).
+#include "simplify/quadric_priority.h"
+
+#include <cmath>
+
+#include "simplify/vec_math.h"
+
+namespace parapm {
+
+void QuadricPriority::initialize(const CollapseMesh& mesh) {
+  quadrics_.assign(mesh.vertex_capacity(), Quadric{});
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    const Vec3& p0 = mesh.position(t[0]);
+    const Vec3 n2 = triangle_normal(p0, mesh.position(t[1]), mesh.position(t[2]));
+    const double len = length(n2);
+    if (len == 0) continue;  // a zero-area face has no plane
+    const Vec3 n = scale(n2, 1.0 / len);
+    const Quadric q = Quadric::from_plane(n, -dot(n, p0), 0.5 * len);
+    for (VertexId v : t) quadrics_[v] += q;
+    // Boundary edges: the plane through the edge perpendicular to the face keeps the border
+    // from shrinking inwards.
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3];
+      if (!mesh.is_boundary(a) || !mesh.is_boundary(b)) continue;
+      if (mesh.edge_faces(b, a).left != kNoId) continue;  // b->a has a face: interior edge
+      const Vec3 e = sub(mesh.position(b), mesh.position(a));
+      const Vec3 side = cross(e, n);
+      const double side_len = length(side);
+      if (side_len == 0) continue;
+      const Vec3 m = scale(side, 1.0 / side_len);
+      const Quadric qb = Quadric::from_plane(m, -dot(m, mesh.position(a)),
+                                             options_.boundary_weight * dot(e, e));
+      quadrics_[a] += qb;
+      quadrics_[b] += qb;
+    }
+  }
+}
+
+bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
+                               CollapseCandidate& out) const {
+  const bool locked_a = !locked_.empty() && locked_[a];
+  const bool locked_b = !locked_.empty() && locked_[b];
+  if (locked_a && locked_b) return false;
+  Quadric q = quadrics_[a];
+  q += quadrics_[b];
+  const Vec3& pa = mesh.position(a);
+  const Vec3& pb = mesh.position(b);
+  out.vs = (locked_b || (!locked_a && b < a)) ? b : a;
+  out.vt = out.vs == a ? b : a;
+  if (locked_a || locked_b) {
+    out.position = mesh.position(out.vs);
+  } else {
+    const Vec3 mid = scale(add(pa, pb), 0.5);
+    const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
+    Vec3 best;
+    bool placed = q.minimizer(best);
+    if (placed) {
+      // An optimum far from the edge comes from a nearly flat quadric; it folds the mesh.
+      const Vec3 d = sub(best, mid);
+      placed = dot(d, d) <= 4.0 * edge_sq;
+    }
+    if (placed && options_.round_to_float) {
+      for (double& c : best) c = static_cast<double>(static_cast<float>(c));
+    }
+    if (!placed) {
+      best = pa;
+      double best_cost = q.evaluate(pa);
+      Vec3 mid_placed = mid;
+      if (options_.round_to_float)
+        for (double& c : mid_placed) c = static_cast<double>(static_cast<float>(c));
+      for (const Vec3& p : {pb, mid_placed}) {
+        const double cost = q.evaluate(p);
+        if (cost < best_cost) best_cost = cost, best = p;
+      }
+    }
+    out.position = best;
+  }
+  out.cost = std::max(0.0, q.evaluate(out.position));
+  out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
+  return std::isfinite(out.cost);
+}
+
+void QuadricPriority::collapsed(const CollapseMesh&, const CollapseCandidate& done) {
+  quadrics_[done.vs] += quadrics_[done.vt];
+}
+
+}  // namespace parapm

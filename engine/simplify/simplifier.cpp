@@ -1,0 +1,148 @@
+#include "simplify/simplifier.h"
+
+#include <algorithm>
+
+namespace parapm {
+
+Simplifier::Simplifier(CollapseMesh& mesh, PriorityModule& priority,
+                       std::vector<std::unique_ptr<ConstraintModule>> constraints)
+    : mesh_(mesh), priority_(priority), constraints_(std::move(constraints)) {}
+
+void Simplifier::push_edge(VertexId a, VertexId b) {
+  if (a > b) std::swap(a, b);
+  CollapseCandidate candidate;
+  if (!priority_.evaluate(mesh_, a, b, candidate)) return;
+  heap_.push_back({candidate.cost, a, b, version_[a], version_[b]});
+  std::push_heap(heap_.begin(), heap_.end(), Later{});
+}
+
+bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const {
+  for (const auto& module : constraints_)
+    if (!module->allows(mesh_, candidate, edge)) return false;
+  return true;
+}
+
+CollapseRecord Simplifier::perform(const CollapseCandidate& c, const EdgeFaces& edge) {
+  CollapseRecord r;
+  r.vs = c.vs;
+  r.vt = c.vt;
+  r.vl = edge.left_apex;
+  r.vr = edge.right_apex;
+  r.fl = edge.left;
+  r.fr = edge.right;
+  r.vs_position = mesh_.position(c.vs);
+  r.vt_position = mesh_.position(c.vt);
+  r.position = c.position;
+  r.cost = c.cost;
+  r.error = static_cast<float>(c.error);
+  if (mesh_.has_wedges()) {
+    // Corner order of the vertex split: fl = (vs, vt, vl), fr = (vt, vs, vr).
+    auto corners = [&](FaceId f, VertexId first, int slot) {
+      if (f == kNoId) return;
+      const int k = corner_of(mesh_.face(f), first);
+      const auto& w = mesh_.corner_wedges(f);
+      for (int i = 0; i < 3; ++i) r.corner_wedges[slot + i] = w[(k + i) % 3];
+    };
+    corners(edge.left, c.vs, 0);
+    corners(edge.right, c.vt, 3);
+  }
+  mesh_.collapse(c.vs, c.vt, c.position);
+  priority_.collapsed(mesh_, c);
+  for (const auto& module : constraints_) module->collapsed(mesh_, c);
+  return r;
+}
+
+std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
+                                            const ProgressCallback& progress,
+                                            const CancelToken* cancel) {
+  priority_.initialize(mesh_);
+  for (const auto& module : constraints_) module->initialize(mesh_);
+  version_.assign(mesh_.vertex_capacity(), 0);
+  rejected_.assign(mesh_.vertex_capacity(), {});
+
+  // Every undirected edge once, in a deterministic order.
+  std::vector<std::pair<VertexId, VertexId>> edges;
+  edges.reserve(mesh_.face_capacity() * 3);
+  for (FaceId f = 0; f < mesh_.face_capacity(); ++f) {
+    if (!mesh_.face_alive(f)) continue;
+    const Triangle& t = mesh_.face(f);
+    for (int k = 0; k < 3; ++k)
+      edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  heap_.clear();
+  heap_.reserve(edges.size() * 2);
+  for (const auto& [a, b] : edges) {
+    CollapseCandidate candidate;
+    if (priority_.evaluate(mesh_, a, b, candidate))
+      heap_.push_back({candidate.cost, a, b, version_[a], version_[b]});
+  }
+  std::make_heap(heap_.begin(), heap_.end(), Later{});
+  edges = {};
+
+  const size_t start_faces = mesh_.live_faces();
+  const uint64_t total = start_faces > limits.target_faces ? start_faces - limits.target_faces : 0;
+  std::vector<CollapseRecord> records;
+  records.reserve(mesh_.live_vertices());
+  std::vector<VertexId> ring;
+  stats_ = {};
+  stats_.stop_reason = "no legal collapse left";
+
+  while (!heap_.empty()) {
+    if (mesh_.live_faces() <= limits.target_faces) {
+      stats_.stop_reason = "target face count reached";
+      break;
+    }
+    std::pop_heap(heap_.begin(), heap_.end(), Later{});
+    const Entry entry = heap_.back();
+    heap_.pop_back();
+    if (!mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
+        version_[entry.a] != entry.version_a || version_[entry.b] != entry.version_b) {
+      ++stats_.stale;
+      continue;
+    }
+    // The entry is current, so the cost and placement are those of the present mesh; only
+    // legality depends on the neighbourhood and is checked now (Decimater: re-check on pop).
+    CollapseCandidate candidate;
+    if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate)) continue;
+    const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
+    if (edge.left == kNoId && edge.right == kNoId) {  // a re-costed edge that is gone
+      ++stats_.stale;
+      continue;
+    }
+    if (!legal(candidate, edge)) {
+      ++stats_.rejected;
+      rejected_[entry.a].push_back(entry.b);
+      rejected_[entry.b].push_back(entry.a);
+      continue;
+    }
+    records.push_back(perform(candidate, edge));
+    const VertexId vs = candidate.vs;
+    ++version_[vs];
+    mesh_.neighbors(vs, ring);
+    for (VertexId n : ring) push_edge(vs, n);
+    // Edges vetoed earlier around the changed star may be legal now: cost them again.
+    rejected_[candidate.vt].clear();
+    rejected_[vs].clear();
+    for (VertexId n : ring) {
+      auto& list = rejected_[n];
+      for (VertexId other : list) {
+        if (other == vs || !mesh_.vertex_alive(other)) continue;
+        ++stats_.reevaluated;
+        push_edge(n, other);
+      }
+      list.clear();
+    }
+
+    if ((records.size() & 1023) == 0) {
+      if (cancel) cancel->check();
+      if (progress) progress(start_faces - mesh_.live_faces(), total);
+    }
+  }
+  stats_.collapses = records.size();
+  if (progress) progress(start_faces - mesh_.live_faces(), total);
+  return records;
+}
+
+}  // namespace parapm

@@ -1,0 +1,86 @@
+// The collapse driver (Hoppe 96 section 4; Garland & Heckbert 97 section 4): every edge in a
+// priority queue by cost; pop the cheapest, re-check its legality, collapse it, re-cost the
+// edges around the surviving vertex. Produces the ordered collapse records from which the
+// Progressive Mesh is built, and which a worker streams back to the coordinator.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "simplify/collapse_mesh.h"
+#include "simplify/modules.h"
+#include "util/progress.h"
+
+namespace parapm {
+
+// One performed collapse, in the ids of the simplifier's mesh. Its inverse is the vertex split
+// of the PM: fl = (vs, vt, vl) and fr = (vt, vs, vr) come back.
+struct CollapseRecord {
+  VertexId vs = kNoId;
+  VertexId vt = kNoId;
+  VertexId vl = kNoId;  // apex of fl, or kNoId on a boundary edge
+  VertexId vr = kNoId;  // apex of fr, or kNoId
+  FaceId fl = kNoId;
+  FaceId fr = kNoId;
+  Vec3 vs_position{};  // before the collapse
+  Vec3 vt_position{};
+  Vec3 position{};     // of vs after the collapse
+  std::array<WedgeId, 6> corner_wedges{kNoId, kNoId, kNoId, kNoId, kNoId, kNoId};
+  double cost = 0;
+  float error = 0;     // the priority module's geometric error, model units
+};
+
+struct SimplifierLimits {
+  size_t target_faces = 0;  // stop once the live face count is <= this (0: go as far as legal)
+};
+
+struct SimplifierStats {
+  uint64_t collapses = 0;
+  uint64_t rejected = 0;          // pops vetoed by a constraint
+  uint64_t stale = 0;             // pops of outdated queue entries
+  uint64_t reevaluated = 0;       // rejected edges costed again after their star changed
+  std::string stop_reason;        // why the loop ended
+};
+
+class Simplifier {
+ public:
+  Simplifier(CollapseMesh& mesh, PriorityModule& priority,
+             std::vector<std::unique_ptr<ConstraintModule>> constraints);
+
+  // Runs until the target is reached or no legal collapse is left. Calls progress every few
+  // hundred collapses and polls `cancel` (may be null); on cancellation throws and leaves the
+  // mesh in a consistent state.
+  std::vector<CollapseRecord> run(const SimplifierLimits& limits, const ProgressCallback& progress,
+                                  const CancelToken* cancel);
+  const SimplifierStats& stats() const { return stats_; }
+
+ private:
+  struct Entry {
+    double cost;
+    VertexId a, b;
+    uint32_t version_a, version_b;
+  };
+  struct Later {  // min-heap order, ties broken by the edge's ids for determinism
+    bool operator()(const Entry& x, const Entry& y) const {
+      if (x.cost != y.cost) return x.cost > y.cost;
+      if (x.a != y.a) return x.a > y.a;
+      return x.b > y.b;
+    }
+  };
+
+  void push_edge(VertexId a, VertexId b);
+  bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const;
+  CollapseRecord perform(const CollapseCandidate& candidate, const EdgeFaces& edge);
+
+  CollapseMesh& mesh_;
+  PriorityModule& priority_;
+  std::vector<std::unique_ptr<ConstraintModule>> constraints_;
+  std::vector<Entry> heap_;
+  std::vector<uint32_t> version_;
+  std::vector<std::vector<VertexId>> rejected_;  // per vertex: edges vetoed since its last change
+  SimplifierStats stats_;
+};
+
+}  // namespace parapm

@@ -1,0 +1,40 @@
+// The engine's entry point for building a Progressive Mesh in-process: repaired mesh in,
+// PM out. The CLI, the tests and (later) the worker daemon all call this.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "mesh/repair.h"
+#include "pm/progressive_mesh.h"
+#include "util/progress.h"
+
+namespace parapm {
+
+struct SimplifyOptions {
+  // Target size of the base mesh: target_faces when non-zero, else target_ratio of the input
+  // faces when non-zero, else as far as collapses stay legal.
+  uint64_t target_faces = 0;
+  double target_ratio = 0;
+  std::string metric = "quadric";  // "quadric" (the energy metric comes with its own issue)
+  uint64_t seed = 1;               // randomised steps only; the quadric metric has none
+  bool keep_order = false;         // store the input's vertex and face order in the PM
+};
+
+struct SimplifyStats {
+  uint64_t collapses = 0;
+  uint64_t rejected = 0;
+  std::string stop_reason;
+  double seconds = 0;  // simplification and PM assembly, not reading or repair
+};
+
+// Throws Error(kInvalidInput) for unknown options, Error(kCancelled / kDeadlineExceeded) when
+// `cancel` fires.
+ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const SimplifyOptions& options,
+                                       SimplifyStats* stats = nullptr,
+                                       const ProgressCallback& progress = {},
+                                       const CancelToken* cancel = nullptr);
+
+uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options);
+
+}  // namespace parapm

@@ -1,0 +1,77 @@
+// What every repair must satisfy, whatever the input: the output is an oriented manifold with
+// consistent wedges, and merging the copies back (input_vertex, input_wedge) gives back the
+// input's faces, positions and attributes, minus exactly the removed faces.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+#include "mesh/mesh_checks.h"
+#include "mesh/repair.h"
+
+namespace parapm::testing {
+
+inline void expect_faithful_repair(const Mesh& input, const RepairedMesh& repaired) {
+  const Mesh& mesh = repaired.mesh;
+  const RepairReport& report = repaired.report;
+  std::string why;
+  EXPECT_TRUE(is_oriented_manifold(mesh, &why)) << why;
+  EXPECT_TRUE(wedges_are_consistent(mesh, &why)) << why;
+  EXPECT_EQ(mesh.layout, input.layout);
+  EXPECT_EQ(mesh.positions_are_float, input.positions_are_float);
+
+  // Faces: the input's, in order, minus the removed ones, up to merging copies.
+  ASSERT_EQ(repaired.input_face.size(), mesh.face_count());
+  EXPECT_EQ(mesh.face_count() + report.degenerate_faces_removed + report.duplicate_faces_removed,
+            input.face_count());
+  ASSERT_EQ(repaired.input_vertex.size(), mesh.vertex_count());
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    const FaceId from = repaired.input_face[f];
+    ASSERT_LT(from, input.face_count());
+    if (f) {
+      ASSERT_LT(repaired.input_face[f - 1], from) << "face " << f;
+    }
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_EQ(repaired.input_vertex[mesh.faces[f][i]], input.faces[from][i])
+          << "face " << f << " corner " << i;
+    }
+  }
+
+  // Vertices: the originals keep their order and come first; copies follow.
+  const size_t originals = mesh.vertex_count() - report.vertex_copies_added;
+  EXPECT_EQ(originals + report.unreferenced_vertices_removed, input.vertex_count());
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    const VertexId from = repaired.input_vertex[v];
+    ASSERT_LT(from, input.vertex_count());
+    if (v && v < originals) {
+      ASSERT_LT(repaired.input_vertex[v - 1], from);
+    }
+    ASSERT_EQ(mesh.positions[v], input.positions[from]) << "vertex " << v;
+  }
+
+  // Wedges: same values, of the same input vertex, used by the same corners.
+  if (!input.layout.any()) {
+    EXPECT_TRUE(repaired.input_wedge.empty());
+    return;
+  }
+  ASSERT_EQ(repaired.input_wedge.size(), mesh.wedge_count());
+  const size_t floats = size_t(input.layout.floats_per_wedge());
+  for (size_t w = 0; w < mesh.wedge_count(); ++w) {
+    const WedgeId from = repaired.input_wedge[w];
+    ASSERT_LT(from, input.wedge_count());
+    ASSERT_EQ(repaired.input_vertex[mesh.wedge_vertex[w]], input.wedge_vertex[from]);
+    ASSERT_EQ(std::memcmp(mesh.wedge(WedgeId(w)), input.wedge(from), floats * sizeof(float)), 0)
+        << "wedge " << w;
+  }
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_EQ(repaired.input_wedge[mesh.face_wedges[f][i]],
+                input.face_wedges[repaired.input_face[f]][i])
+          << "face " << f << " corner " << i;
+    }
+  }
+}
+
+}  // namespace parapm::testing

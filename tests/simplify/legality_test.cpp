@@ -1,0 +1,108 @@
+// Legality rules of the collapse engine, one tiny drawn mesh per rule.
+#include <gtest/gtest.h>
+
+#include "simplify/collapse_mesh.h"
+#include "simplify/modules.h"
+
+namespace parapm {
+namespace {
+
+Mesh make_mesh(std::vector<Vec3> positions, std::vector<Triangle> faces) {
+  Mesh m;
+  m.positions = std::move(positions);
+  m.faces = std::move(faces);
+  return m;
+}
+
+// Which standard constraint (by name) vetoes collapsing vt into vs at vs's position; "" if none.
+std::string veto(const Mesh& mesh, VertexId vs, VertexId vt, std::vector<uint8_t> locked = {}) {
+  CollapseMesh cm(mesh);
+  auto modules = standard_constraints(locked);
+  for (auto& m : modules) m->initialize(cm);
+  CollapseCandidate c;
+  c.vs = vs;
+  c.vt = vt;
+  c.position = cm.position(vs);
+  const EdgeFaces edge = cm.edge_faces(vs, vt);
+  for (auto& m : modules)
+    if (!m->allows(cm, c, edge)) return m->name();
+  return "";
+}
+
+Mesh tetrahedron() {
+  return make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                   {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}});
+}
+
+Mesh octahedron() {
+  return make_mesh({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+                   {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                    {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+}
+
+TEST(Legality, TetrahedronCannotCollapse) {
+  EXPECT_EQ(veto(tetrahedron(), 0, 1), "component-minimum");
+}
+
+TEST(Legality, OctahedronEdgeCollapses) { EXPECT_EQ(veto(octahedron(), 0, 2), ""); }
+
+//   c
+//  / \      the triangle (a, b, c) is a hole, not a face; d lies below a-b.
+// a---b     a and b share the neighbour c, which is not an apex of edge a-b's only face
+//  \ /      (b, a, d): collapsing a-b would glue the hole shut into a non-manifold edge.
+//   d
+// The outer ring e, f, g closes the fan around c so that a-c and b-c are boundary edges
+// of the hole only.
+TEST(Legality, LinkConditionForbidsClosingAHole) {
+  const Mesh m = make_mesh({{0, 0, 0}, {2, 0, 0}, {1, 2, 0}, {1, -1, 0},
+                            {-1, 3, 0}, {3, 3, 0}},
+                           {{1, 0, 3}, {0, 2, 4}, {2, 1, 5}, {4, 2, 5}});
+  EXPECT_EQ(veto(m, 0, 1), "link-condition");
+}
+
+//  a---c
+//  | / |    edge b-c is interior (two faces), but b and c are both boundary vertices:
+//  b---d    collapsing it would pinch the strip into two sheets joined at one vertex.
+TEST(Legality, InteriorEdgeBetweenBoundaryVertices) {
+  const Mesh m = make_mesh({{0, 1, 0}, {0, 0, 0}, {1, 1, 0}, {1, 0, 0}},
+                           {{0, 1, 2}, {1, 3, 2}});
+  EXPECT_EQ(veto(m, 1, 2), "boundary");
+  EXPECT_EQ(veto(m, 0, 1), "");  // a boundary edge between boundary vertices is fine
+}
+
+TEST(Legality, LockedVertexIsNeverRemoved) {
+  std::vector<uint8_t> locked(6, 0);
+  locked[2] = 1;
+  EXPECT_EQ(veto(octahedron(), 0, 2, locked), "locked-vertices");
+  EXPECT_EQ(veto(octahedron(), 2, 0, locked), "");
+}
+
+//     c           Moving b onto a' (far left of a) flips face (b, d, c)... here we collapse
+//    /|\          d into a, which drags the fan around d across the edge b-c.
+//   a-b-d  flat strip below: faces (a,b,c), (b,d,c), (a,e,b), (b,e,d)
+//    \|/
+//     e
+TEST(Legality, CollapseThatFlipsAFaceIsVetoed) {
+  const Mesh m = make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {1, -1, 0}},
+                           {{0, 1, 2}, {1, 3, 2}, {0, 4, 1}, {1, 4, 3}});
+  // Collapsing b (interior) into d at d's position is fine: the fan just shrinks.
+  EXPECT_EQ(veto(m, 3, 1), "");
+  CollapseMesh cm(m);
+  auto modules = standard_constraints({});
+  for (auto& mod : modules) mod->initialize(cm);
+  CollapseCandidate c;
+  c.vs = 1;  // b stays, d goes, but b is placed beyond a: faces around b fold over
+  c.vt = 3;
+  c.position = {-1, 0.2, 0};
+  const EdgeFaces edge = cm.edge_faces(1, 3);
+  std::string vetoed;
+  for (auto& mod : modules)
+    if (!mod->allows(cm, c, edge)) {
+      vetoed = mod->name();
+      break;
+    }
+  EXPECT_EQ(vetoed, "face-geometry");
+}
+
+}  // namespace
+}  // namespace parapm

@@ -1,0 +1,115 @@
+// The collapse driver on drawn meshes: where it stops, determinism, the records it keeps.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "simplify/quadric_priority.h"
+#include "simplify/simplifier.h"
+
+namespace parapm {
+namespace {
+
+// A UV sphere: closed, genus 0, rings x segments.
+Mesh uv_sphere(int rings, int segments) {
+  Mesh m;
+  m.positions.push_back({0, 0, 1});
+  for (int r = 1; r < rings; ++r) {
+    const double theta = M_PI * r / rings;
+    for (int s = 0; s < segments; ++s) {
+      const double phi = 2 * M_PI * s / segments;
+      m.positions.push_back({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                             std::cos(theta)});
+    }
+  }
+  m.positions.push_back({0, 0, -1});
+  const VertexId south = VertexId(m.positions.size() - 1);
+  auto ring = [&](int r, int s) { return VertexId(1 + (r - 1) * segments + (s % segments)); };
+  for (int s = 0; s < segments; ++s) m.faces.push_back({0, ring(1, s), ring(1, s + 1)});
+  for (int r = 1; r + 1 < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      m.faces.push_back({ring(r, s), ring(r + 1, s), ring(r + 1, s + 1)});
+      m.faces.push_back({ring(r, s), ring(r + 1, s + 1), ring(r, s + 1)});
+    }
+  for (int s = 0; s < segments; ++s) m.faces.push_back({south, ring(rings - 1, s + 1), ring(rings - 1, s)});
+  return m;
+}
+
+std::vector<CollapseRecord> simplify(const Mesh& mesh, size_t target_faces, CollapseMesh& cm) {
+  std::vector<uint8_t> locked;
+  QuadricPriority priority(locked, {});
+  Simplifier simplifier(cm, priority, standard_constraints(locked));
+  return simplifier.run({target_faces}, {}, nullptr);
+}
+
+TEST(Simplifier, ClosedSphereGoesDownToATetrahedron) {
+  const Mesh sphere = uv_sphere(12, 16);
+  CollapseMesh cm(sphere);
+  const auto records = simplify(sphere, 0, cm);
+  EXPECT_EQ(cm.live_faces(), 4u);
+  EXPECT_EQ(cm.live_vertices(), 4u);
+  EXPECT_EQ(records.size(), sphere.vertex_count() - 4);
+}
+
+TEST(Simplifier, StopsAtTheTargetFaceCount) {
+  const Mesh sphere = uv_sphere(12, 16);
+  CollapseMesh cm(sphere);
+  simplify(sphere, 100, cm);
+  EXPECT_LE(cm.live_faces(), 100u);
+  EXPECT_GE(cm.live_faces(), 98u);  // a closed mesh loses two faces per collapse
+}
+
+TEST(Simplifier, SameInputSameRecords) {
+  const Mesh sphere = uv_sphere(10, 14);
+  CollapseMesh a(sphere), b(sphere);
+  const auto ra = simplify(sphere, 20, a);
+  const auto rb = simplify(sphere, 20, b);
+  ASSERT_EQ(ra.size(), rb.size());
+  for (size_t i = 0; i < ra.size(); ++i) {
+    EXPECT_EQ(ra[i].vs, rb[i].vs);
+    EXPECT_EQ(ra[i].vt, rb[i].vt);
+    EXPECT_EQ(ra[i].position, rb[i].position);
+  }
+}
+
+TEST(Simplifier, CancellationStopsTheRun) {
+  const Mesh sphere = uv_sphere(60, 80);
+  CollapseMesh cm(sphere);
+  std::vector<uint8_t> locked;
+  QuadricPriority priority(locked, {});
+  Simplifier simplifier(cm, priority, standard_constraints(locked));
+  CancelToken token;
+  uint64_t calls = 0;
+  auto progress = [&](uint64_t, uint64_t) {
+    if (++calls == 2) token.cancel();
+  };
+  try {
+    simplifier.run({0}, progress, &token);
+    FAIL() << "expected cancellation";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kCancelled);
+  }
+  EXPECT_GT(cm.live_faces(), 4u);
+}
+
+TEST(Simplifier, RecordsNameTheApexesOfTheRemovedFaces) {
+  const Mesh sphere = uv_sphere(8, 10);
+  CollapseMesh cm(sphere);
+  const Mesh copy = sphere;
+  const auto records = simplify(sphere, 0, cm);
+  ASSERT_FALSE(records.empty());
+  const CollapseRecord& first = records.front();
+  // The first collapse happens on the input mesh: its faces are the input's faces.
+  EXPECT_NE(first.fl, kNoId);
+  EXPECT_NE(first.fr, kNoId);
+  const Triangle& fl = copy.faces[first.fl];
+  const int k = corner_of(fl, first.vs);
+  EXPECT_EQ(fl[(k + 1) % 3], first.vt);
+  EXPECT_EQ(fl[(k + 2) % 3], first.vl);
+  const Triangle& fr = copy.faces[first.fr];
+  const int j = corner_of(fr, first.vt);
+  EXPECT_EQ(fr[(j + 1) % 3], first.vs);
+  EXPECT_EQ(fr[(j + 2) % 3], first.vr);
+}
+
+}  // namespace
+}  // namespace parapm
