@@ -27,7 +27,7 @@ Box bounding_box(const Mesh& mesh) {
 bool all_positions_are_float(const std::vector<Vec3>& positions) {
   for (const Vec3& p : positions)
     for (double c : p)
-      if (static_cast<double>(static_cast<float>(c)) != c) return false;
+      if (round_to_float(c) != c) return false;
   return true;
 }
 

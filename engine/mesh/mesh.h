@@ -70,6 +70,15 @@ struct Box {
 };
 Box bounding_box(const Mesh& mesh);
 
+// x rounded to the nearest float32, as a double. The empty asm keeps GCC 12 at -O2/-O3 from
+// folding the (double)(float)x pair away when it vectorises (seen here: the rounding of the
+// first two coordinates of a std::array<double, 3> vanished).
+inline double round_to_float(double x) {
+  float f = static_cast<float>(x);
+  asm("" : "+x"(f));
+  return f;
+}
+
 // Recomputes positions_are_float from the coordinates.
 bool all_positions_are_float(const std::vector<Vec3>& positions);
 

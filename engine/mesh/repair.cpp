@@ -459,6 +459,8 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   // face go; zero-area faces stay (the simplifier removes them first) but are counted.
   FaceFilter filter = filter_faces(input.faces, input.vertex_count());
   RepairedMesh out;
+  out.input_vertex_count = input.vertex_count();
+  out.input_face_count = input.face_count();
   out.report.degenerate_faces_removed = filter.degenerate;
   out.report.duplicate_faces_removed = filter.duplicate;
   for (FaceId f : filter.kept) {

@@ -68,6 +68,8 @@ struct RepairedMesh {
   // For each wedge of `mesh`: the wedge of the input it came from (copies made with a vertex
   // copy map to the wedge they copy). Empty when the mesh has no attributes.
   std::vector<WedgeId> input_wedge;
+  uint64_t input_vertex_count = 0;  // of the mesh given to repair_mesh
+  uint64_t input_face_count = 0;
   RepairReport report;
 };
 

@@ -12,7 +12,7 @@
 //   may be absent on a boundary (vl or vr == kNoId), never both. The faces of vs that move
 //   to vt are the fan that starts at the face holding the directed edge vs->vr and turns
 //   counter-clockwise around vs up to the face holding vl->vs; where vt was a boundary
-//   vertex the fan is cut by the boundary and is walked from both ends (see pm_cursor.cpp).
+//   vertex the fan is cut by the boundary and is walked from both ends (see fan_mesh.cpp).
 //   Their corners at vs become corners at vt; corner wedges do not change.
 #pragma once
 
@@ -58,7 +58,8 @@ struct PmInfo {
   std::string metric;             // "quadric", "energy"
   uint64_t input_vertices = 0;    // of the input as read, before repairs
   uint64_t input_faces = 0;       // triangles of the input as read (polygons fan-split)
-  double seconds = 0;             // construction time, informational
+  double seconds = 0;             // construction time; in memory only (not in the .pm, whose
+                                  // bytes depend only on the input and the options)
 };
 
 struct ProgressiveMesh {

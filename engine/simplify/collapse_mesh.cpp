@@ -57,24 +57,19 @@ void CollapseMesh::neighbors(VertexId v, std::vector<VertexId>& out) const {
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
-// A vertex is on the boundary when one of its edges has a face on one side only; on a
-// manifold every directed edge v->n appears once, so v is interior exactly when each
-// outgoing edge v->n is matched by an incoming n->v.
+// A vertex is on the boundary when one of its edges has a face on one side only. On a
+// manifold the faces (v, a, b) around v form a fan: closed, every "next" corner a is also the
+// "previous" corner b of the face before it, so the two id sums agree; open (a chain from
+// a_first to a_last != a_first), they differ by a_first - a_last. O(valence).
 bool CollapseMesh::compute_boundary(VertexId v) const {
+  uint64_t next_sum = 0, prev_sum = 0;
   for (FaceId f : faces_of_[v]) {
     const Triangle& t = faces_[f];
-    const VertexId next = t[(corner_of(t, v) + 1) % 3];
-    bool matched = false;
-    for (FaceId g : faces_of_[v]) {
-      const Triangle& u = faces_[g];
-      if (u[(corner_of(u, v) + 2) % 3] == next) {
-        matched = true;
-        break;
-      }
-    }
-    if (!matched) return true;
+    const int i = corner_of(t, v);
+    next_sum += t[(i + 1) % 3];
+    prev_sum += t[(i + 2) % 3];
   }
-  return false;
+  return next_sum != prev_sum;
 }
 
 void CollapseMesh::remove_face_from(VertexId v, FaceId f) {

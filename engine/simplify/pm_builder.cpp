@@ -50,6 +50,8 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
                                         const PmBuildOptions& options) {
   const Mesh& mesh = repaired.mesh;
   ProgressiveMesh pm;
+  pm.info.input_vertices = repaired.input_vertex_count;
+  pm.info.input_faces = repaired.input_face_count;
   pm.base.layout = mesh.layout;
   pm.base.positions_are_float = mesh.positions_are_float;
 

@@ -64,14 +64,14 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       placed = dot(d, d) <= 4.0 * edge_sq;
     }
     if (placed && options_.round_to_float) {
-      for (double& c : best) c = static_cast<double>(static_cast<float>(c));
+      for (double& c : best) c = round_to_float(c);
     }
     if (!placed) {
       best = pa;
       double best_cost = q.evaluate(pa);
       Vec3 mid_placed = mid;
       if (options_.round_to_float)
-        for (double& c : mid_placed) c = static_cast<double>(static_cast<float>(c));
+        for (double& c : mid_placed) c = round_to_float(c);
       for (const Vec3& p : {pb, mid_placed}) {
         const double cost = q.evaluate(p);
         if (cost < best_cost) best_cost = cost, best = p;

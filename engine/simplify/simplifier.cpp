@@ -16,6 +16,12 @@ void Simplifier::push_edge(VertexId a, VertexId b) {
   std::push_heap(heap_.begin(), heap_.end(), Later{});
 }
 
+// Each side lists a vetoed edge at most once, so the lists stay as short as the valence.
+void Simplifier::remember_rejected(VertexId v, VertexId other) {
+  auto& list = rejected_[v];
+  if (std::find(list.begin(), list.end(), other) == list.end()) list.push_back(other);
+}
+
 bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const {
   for (const auto& module : constraints_)
     if (!module->allows(mesh_, candidate, edge)) return false;
@@ -113,8 +119,8 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     }
     if (!legal(candidate, edge)) {
       ++stats_.rejected;
-      rejected_[entry.a].push_back(entry.b);
-      rejected_[entry.b].push_back(entry.a);
+      remember_rejected(entry.a, entry.b);
+      remember_rejected(entry.b, entry.a);
       continue;
     }
     records.push_back(perform(candidate, edge));
@@ -129,6 +135,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       auto& list = rejected_[n];
       for (VertexId other : list) {
         if (other == vs || !mesh_.vertex_alive(other)) continue;
+        // The edge is pushed once, from this side: forget it on the other side too.
+        auto& mirror = rejected_[other];
+        mirror.erase(std::remove(mirror.begin(), mirror.end(), n), mirror.end());
         ++stats_.reevaluated;
         push_edge(n, other);
       }

@@ -71,6 +71,7 @@ class Simplifier {
   };
 
   void push_edge(VertexId a, VertexId b);
+  void remember_rejected(VertexId v, VertexId other);
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const;
   CollapseRecord perform(const CollapseCandidate& candidate, const EdgeFaces& edge);
 

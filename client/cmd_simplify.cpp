@@ -1,0 +1,115 @@
+// parapm simplify IN -o OUT.pm: read, repair, build the Progressive Mesh, write it.
+#include <chrono>
+#include <cstdio>
+
+#include <spdlog/spdlog.h>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "pm/pm_file.h"
+#include "simplify/simplify.h"
+#include "util/memory.h"
+
+namespace parapm::cli {
+namespace {
+
+struct SimplifyArgs {
+  std::string input;
+  std::string output;
+  uint64_t faces = 0;
+  double ratio = 0;
+  std::string metric = "quadric";
+  uint64_t seed = 1;
+  bool keep_order = false;
+  bool json = false;
+};
+
+int run_simplify(const SimplifyArgs& args) {
+  RepairOptions repair_options;
+  repair_options.keep_unreferenced = args.keep_order;  // the input's numbering needs them
+  LoadedMesh loaded = load_and_repair(args.input, repair_options);
+
+  SimplifyOptions options;
+  options.target_faces = args.faces;
+  options.target_ratio = args.ratio;
+  options.metric = args.metric;
+  options.seed = args.seed;
+  options.keep_order = args.keep_order;
+  SimplifyStats stats;
+  ProgressBar bar("simplify");
+  ProgressiveMesh pm =
+      build_progressive_mesh(loaded.repaired, options, &stats, bar.callback(), nullptr);
+  bar.finish();
+
+  const auto write_start = std::chrono::steady_clock::now();
+  write_pm_file(pm, args.output);
+  const double write_seconds = seconds_since(write_start);
+  const uint64_t pm_bytes = pm_encoded_size(pm);
+  const uint64_t ply_bytes = binary_ply_size(loaded.repaired.mesh);
+  const uint64_t peak = peak_memory_bytes();
+  spdlog::info("simplified {}: {} -> {} faces, {} vertex splits, {:.3f} s ({}); wrote {}",
+               args.input, loaded.repaired.mesh.face_count(), pm.base.face_count(),
+               pm.splits.size(), stats.seconds, stats.stop_reason, args.output);
+
+  if (args.json) {
+    print_json({{"input", args.input},
+                {"output", args.output},
+                {"in_vertices", loaded.input_vertices},
+                {"in_faces", loaded.input_faces},
+                {"repaired_vertices", loaded.repaired.mesh.vertex_count()},
+                {"repaired_faces", loaded.repaired.mesh.face_count()},
+                {"base_vertices", pm.base.vertex_count()},
+                {"base_faces", pm.base.face_count()},
+                {"vsplits", pm.splits.size()},
+                {"seconds", stats.seconds},
+                {"read_seconds", loaded.read_seconds},
+                {"repair_seconds", loaded.repair_seconds},
+                {"write_seconds", write_seconds},
+                {"metric", pm.info.metric},
+                {"stop_reason", stats.stop_reason},
+                {"pm_bytes", pm_bytes},
+                {"binary_ply_bytes", ply_bytes},
+                {"peak_memory_bytes", peak},
+                {"repairs", repair_report_json(loaded.repaired.report)}});
+  } else {
+    std::printf("input      %s: %llu vertices, %llu faces\n", args.input.c_str(),
+                (unsigned long long)loaded.input_vertices, (unsigned long long)loaded.input_faces);
+    std::printf("base mesh  %zu vertices, %zu faces\n", pm.base.vertex_count(),
+                pm.base.face_count());
+    std::printf("vsplits    %zu (%s)\n", pm.splits.size(), stats.stop_reason.c_str());
+    std::printf("time       %.3f s simplification, %.3f s read, %.3f s repair\n", stats.seconds,
+                loaded.read_seconds, loaded.repair_seconds);
+    std::printf("size       %llu bytes .pm, %llu bytes binary PLY (%.2fx)\n",
+                (unsigned long long)pm_bytes, (unsigned long long)ply_bytes,
+                ply_bytes ? double(pm_bytes) / double(ply_bytes) : 0.0);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_simplify_command(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<SimplifyArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "simplify", "Build a Progressive Mesh from a mesh file (OBJ, PLY, OFF, STL, optionally .gz)");
+  cmd->add_option("input", args->input, "Input mesh")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "Output .pm file")->required();
+  auto* faces = cmd->add_option("--faces", args->faces,
+                                "Base mesh size in faces (default: simplify as far as "
+                                "collapses stay legal)");
+  cmd->add_option("--ratio", args->ratio, "Base mesh size as a fraction of the input faces")
+      ->check(CLI::Range(0.0, 1.0))
+      ->excludes(faces);
+  cmd->add_option("--metric", args->metric, "Priority metric")
+      ->check(CLI::IsMember({"quadric"}))
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed,
+                  "Seed of randomised steps (the quadric metric has none: same input, same .pm)")
+      ->capture_default_str();
+  cmd->add_flag("--keep-order", args->keep_order,
+                "Store the input's vertex and face order, and keep unreferenced vertices");
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->callback([args, &exit_code] { exit_code = run_simplify(*args); });
+}
+
+}  // namespace parapm::cli

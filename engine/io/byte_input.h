@@ -1,0 +1,24 @@
+// Getting the bytes of a mesh file into memory: the whole file at once, then gzip inflated when
+// it is gzip. Readers then parse the buffer with pointers, never with streams.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace parapm::io {
+
+// Reads the whole file. kNotFound when it does not exist, kIo when it cannot be read (or is a
+// directory), kResourceExhausted when it is larger than max_bytes.
+std::string read_file_bytes(const std::string& path, uint64_t max_bytes);
+
+// True when the bytes start with the gzip magic (1f 8b).
+bool is_gzip(std::string_view bytes);
+
+// Inflates gzip data, concatenated members too (as `cat a.gz b.gz` or pigz produce). The
+// output never grows beyond max_bytes + 1 bytes: passing max_bytes is kResourceExhausted as
+// soon as it happens, so a gzip bomb costs at most the limit. Corrupt or truncated data is
+// kInvalidInput naming `name` and the compressed byte offset.
+std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes);
+
+}  // namespace parapm::io

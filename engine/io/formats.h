@@ -1,0 +1,31 @@
+// The per-format entry points behind read_mesh() and write_mesh(). Internal to engine/io: each
+// reader takes the whole decompressed file and fills the report; each writer returns the file's
+// bytes (uncompressed).
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "io/mesh_io.h"
+#include "io/read_context.h"
+
+namespace parapm::io {
+
+Mesh read_obj(const ReadContext& ctx);  // obj_reader.cpp
+Mesh read_ply(const ReadContext& ctx);  // ply_reader.cpp
+Mesh read_off(const ReadContext& ctx);  // off_reader.cpp
+Mesh read_stl(const ReadContext& ctx);  // stl_reader.cpp
+
+// The format of a file from its first bytes, kUnknown when none fits (format.cpp).
+MeshFormat detect_format(std::string_view bytes);
+// Whether a token is an OFF header keyword: [ST][C][N][4][n]OFF (off_reader.cpp).
+bool is_off_keyword(std::string_view token);
+// Whether the size is exactly 84 + 50 * (the count at byte 80): a binary STL (stl_reader.cpp).
+bool stl_binary_size_matches(std::string_view bytes);
+
+// Throws kInvalidInput unless faces, wedges and attribute arrays are consistent (mesh_io.cpp).
+void check_writable(const Mesh& mesh);
+std::string write_obj(const Mesh& mesh);              // obj_writer.cpp
+std::string write_ply(const Mesh& mesh, bool ascii);  // ply_writer.cpp
+
+}  // namespace parapm::io

@@ -1,0 +1,620 @@
+// PLY reader. Accepts ascii, binary_little_endian and binary_big_endian files with any
+// property types (see ply_format.h), and from them:
+//   element vertex      x y z (any numeric type) -> positions;
+//                       nx ny nz -> normals; red green blue [alpha] -> colours (uchar / 255,
+//                       ushort / 65535, float and double as they are); s t, u v, texture_u
+//                       texture_v or texture_s texture_t -> texcoords. Other vertex
+//                       properties are skipped and listed in ReadReport::ignored.
+//   element face        list vertex_indices (or vertex_index), any count and index types;
+//                       polygons are fan-split; other face properties skipped and listed.
+//   element tristrips   list vertex_indices: -1 ends a strip; inside a strip, triangle j is
+//                       (s[j], s[j+1], s[j+2]) for even j and (s[j+1], s[j], s[j+2]) for odd j
+//                       (orientation alternates); triangles with a repeated index (the
+//                       degenerate joints) are not faces (counted in strip_degenerates).
+//   other elements      skipped (lists included) and listed.
+// Attributes are per vertex: wedge i is vertex i, face_wedges == faces.
+//
+// Untrusted input: the header's counts are checked against the limits (kResourceExhausted)
+// and then against the bytes after the header (each record needs a minimum number of bytes)
+// before anything is allocated; each list length is checked against the bytes left before it
+// is read; each index against the declared vertex count. Errors name the line (ascii) or the
+// byte offset (binary).
+#include <array>
+#include <bit>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "io/formats.h"
+#include "io/ply_format.h"
+#include "io/text_scanner.h"
+
+namespace parapm::io {
+namespace {
+
+std::string record_name(const PlyElement& e, uint64_t index) {
+  return e.name + " " + std::to_string(index);
+}
+
+// ---- Value sources: the same element readers run over ascii text and binary data. ----
+
+class AsciiSource {
+ public:
+  AsciiSource(const ReadContext& ctx, const PlyHeader& header)
+      : ctx_(ctx),
+        s_(ctx.bytes.data() + header.body_offset, ctx.bytes.data() + ctx.bytes.size(),
+           header.body_line) {}
+
+  void begin_record(const PlyElement& e, uint64_t index) {
+    element_ = &e;
+    index_ = index;
+  }
+
+  double scalar(PlyType type) {
+    s_.skip_space();
+    if (type == PlyType::kFloat32) {
+      float f;
+      if (!s_.read(f)) bad_value();
+      return f;
+    }
+    if (type == PlyType::kFloat64) {
+      double d;
+      if (!s_.read(d)) bad_value();
+      return d;
+    }
+    return double(integer(type));
+  }
+
+  int64_t integer(PlyType type) {
+    s_.skip_space();
+    int64_t v;
+    if (!s_.read(v)) bad_value();
+    if (!fits(type, v))
+      fail_here(record_name(*element_, index_) + ": value " + std::to_string(v) +
+                " does not fit its type " + ply_type_name(type));
+    return v;
+  }
+
+  void skip(PlyType) {
+    s_.skip_space();
+    if (s_.token().empty()) bad_value();
+  }
+
+  uint64_t list_count(const PlyProperty& p) {
+    const int64_t n = integer(p.count_type);
+    if (n < 0)
+      fail_here(record_name(*element_, index_) + ": list '" + p.name + "' has negative length " +
+                std::to_string(n));
+    // Each item needs a separator and a digit.
+    if (uint64_t(n) > (s_.remaining() + 1) / 2)
+      fail_here(record_name(*element_, index_) + ": list '" + p.name + "' declares " +
+                std::to_string(n) + " values but only " + std::to_string(s_.remaining()) +
+                " bytes remain");
+    return uint64_t(n);
+  }
+
+  // Ascii positions are lines; mark() is where the next value starts.
+  uint64_t mark() {
+    s_.skip_space();
+    return s_.line();
+  }
+  [[noreturn]] void fail_at(uint64_t line, const std::string& what) {
+    fail_at_line(ctx_, line, what);
+  }
+  [[noreturn]] void fail_here(const std::string& what) { fail_at_line(ctx_, s_.line(), what); }
+
+  // Skips `count` records of a list-free element.
+  void skip_records(const PlyElement& e, uint64_t count) {
+    for (uint64_t i = 0; i < count; ++i) {
+      begin_record(e, i);
+      for (const PlyProperty& p : e.properties) skip(p.type);
+    }
+  }
+
+  void finish() {
+    s_.skip_space();
+    if (!s_.at_end())
+      note_ignored(ctx_,
+                   "ply data after the last element (line " + std::to_string(s_.line()) + ")");
+  }
+
+  uint64_t remaining() const { return s_.remaining(); }
+
+ private:
+  static bool fits(PlyType type, int64_t v) {
+    switch (type) {
+      case PlyType::kInt8:
+        return v >= -128 && v <= 127;
+      case PlyType::kUint8:
+        return v >= 0 && v <= 255;
+      case PlyType::kInt16:
+        return v >= -32768 && v <= 32767;
+      case PlyType::kUint16:
+        return v >= 0 && v <= 65535;
+      case PlyType::kInt32:
+        return v >= INT32_MIN && v <= INT32_MAX;
+      case PlyType::kUint32:
+        return v >= 0 && v <= int64_t(UINT32_MAX);
+      default:
+        return true;
+    }
+  }
+
+  [[noreturn]] void bad_value() {
+    s_.skip_space();
+    if (s_.at_end())
+      fail_here("the file ends inside " + record_name(*element_, index_) +
+                " (the header declares " + std::to_string(element_->count) + ")");
+    const std::string_view found = s_.token();
+    fail_here(record_name(*element_, index_) + ": expected a number, found " + quote(found));
+  }
+
+  const ReadContext& ctx_;
+  TextScanner s_;
+  const PlyElement* element_ = nullptr;
+  uint64_t index_ = 0;
+};
+
+template <bool kSwap>
+class BinarySource {
+ public:
+  BinarySource(const ReadContext& ctx, const PlyHeader& header)
+      : ctx_(ctx),
+        base_(ctx.bytes.data()),
+        p_(base_ + header.body_offset),
+        end_(base_ + ctx.bytes.size()) {}
+
+  void begin_record(const PlyElement& e, uint64_t index) {
+    element_ = &e;
+    index_ = index;
+  }
+
+  double scalar(PlyType type) {
+    need(ply_type_size(type));
+    switch (type) {
+      case PlyType::kInt8:
+        return double(int8_t(load<uint8_t>()));
+      case PlyType::kUint8:
+        return double(load<uint8_t>());
+      case PlyType::kInt16:
+        return double(int16_t(load<uint16_t>()));
+      case PlyType::kUint16:
+        return double(load<uint16_t>());
+      case PlyType::kInt32:
+        return double(int32_t(load<uint32_t>()));
+      case PlyType::kUint32:
+        return double(load<uint32_t>());
+      case PlyType::kFloat32:
+        return double(std::bit_cast<float>(load<uint32_t>()));
+      case PlyType::kFloat64:
+        return std::bit_cast<double>(load<uint64_t>());
+    }
+    return 0;
+  }
+
+  // Only called for integer types (list counts and indices; the header checks them).
+  int64_t integer(PlyType type) {
+    need(ply_type_size(type));
+    switch (type) {
+      case PlyType::kInt8:
+        return int8_t(load<uint8_t>());
+      case PlyType::kUint8:
+        return load<uint8_t>();
+      case PlyType::kInt16:
+        return int16_t(load<uint16_t>());
+      case PlyType::kUint16:
+        return load<uint16_t>();
+      case PlyType::kInt32:
+        return int32_t(load<uint32_t>());
+      case PlyType::kUint32:
+        return load<uint32_t>();
+      default:
+        fail_here("internal: integer read of a float property");
+    }
+  }
+
+  void skip(PlyType type) {
+    need(ply_type_size(type));
+    p_ += ply_type_size(type);
+  }
+
+  uint64_t list_count(const PlyProperty& p) {
+    const uint64_t at = offset();
+    const int64_t n = integer(p.count_type);
+    if (n < 0)
+      fail_at(at, record_name(*element_, index_) + ": list '" + p.name + "' has negative length " +
+                      std::to_string(n));
+    if (uint64_t(n) > remaining() / uint64_t(ply_type_size(p.type)))
+      fail_at(at, record_name(*element_, index_) + ": list '" + p.name + "' declares " +
+                      std::to_string(n) + " values of " + std::to_string(ply_type_size(p.type)) +
+                      " bytes but only " + std::to_string(remaining()) + " bytes remain");
+    return uint64_t(n);
+  }
+
+  uint64_t mark() const { return offset(); }
+  [[noreturn]] void fail_at(uint64_t byte, const std::string& what) {
+    fail_at_byte(ctx_, byte, what);
+  }
+  [[noreturn]] void fail_here(const std::string& what) { fail_at_byte(ctx_, offset(), what); }
+
+  void skip_records(const PlyElement& e, uint64_t count) {
+    const uint64_t size = e.fixed_record_bytes();
+    if (size != 0 && count > remaining() / size) {
+      begin_record(e, remaining() / size);
+      p_ += remaining() / size * size;
+      truncated();
+    }
+    p_ += size * count;
+  }
+
+  void finish() {
+    if (p_ != end_)
+      note_ignored(ctx_,
+                   "ply data after the last element (" + std::to_string(end_ - p_) + " bytes)");
+  }
+
+  uint64_t remaining() const { return uint64_t(end_ - p_); }
+
+ private:
+  uint64_t offset() const { return uint64_t(p_ - base_); }
+
+  void need(int bytes) {
+    if (end_ - p_ < bytes) truncated();
+  }
+  [[noreturn]] void truncated() {
+    fail_here("the file ends inside " + record_name(*element_, index_) + " (the header declares " +
+              std::to_string(element_->count) + ")");
+  }
+
+  template <class U>
+  U load() {
+    U v;
+    std::memcpy(&v, p_, sizeof v);
+    p_ += sizeof v;
+    if constexpr (kSwap && sizeof(U) == 2) v = U(__builtin_bswap16(v));
+    if constexpr (kSwap && sizeof(U) == 4) v = U(__builtin_bswap32(v));
+    if constexpr (kSwap && sizeof(U) == 8) v = U(__builtin_bswap64(v));
+    return v;
+  }
+
+  const ReadContext& ctx_;
+  const char* base_;
+  const char* p_;
+  const char* end_;
+  const PlyElement* element_ = nullptr;
+  uint64_t index_ = 0;
+};
+
+// ---- What each vertex property is for. ----
+
+enum VertexSlot : int { kX, kY, kZ, kNx, kNy, kNz, kS, kT, kRed, kGreen, kBlue, kAlpha, kSlots };
+constexpr int kSkip = -1;
+
+struct VertexPlan {
+  std::vector<int> slot;        // per property: a VertexSlot or kSkip
+  std::vector<double> divisor;  // per property: colour normalisation (255 for uchar), else 1
+  AttributeLayout layout;
+};
+
+int find_property(const PlyElement& e, std::string_view name) {
+  for (size_t i = 0; i < e.properties.size(); ++i)
+    if (e.properties[i].name == name && !e.properties[i].is_list) return int(i);
+  return -1;
+}
+
+VertexPlan plan_vertices(const ReadContext& ctx, const PlyElement& e) {
+  VertexPlan plan;
+  plan.slot.assign(e.properties.size(), kSkip);
+  plan.divisor.assign(e.properties.size(), 1.0);
+  auto assign = [&](std::initializer_list<std::pair<std::string_view, int>> group) {
+    std::vector<int> found;
+    for (const auto& [name, slot] : group) {
+      const int i = find_property(e, name);
+      if (i < 0 || plan.slot[size_t(i)] != kSkip) return false;
+      found.push_back(i);
+    }
+    size_t k = 0;
+    for (const auto& entry : group) plan.slot[size_t(found[k++])] = entry.second;
+    return true;
+  };
+  for (const char* axis : {"x", "y", "z"})
+    if (find_property(e, axis) < 0)
+      fail_at_line(ctx, e.line,
+                   std::string("the vertex element has no scalar '") + axis + "' property");
+  assign({{"x", kX}, {"y", kY}, {"z", kZ}});
+  plan.layout.normals = assign({{"nx", kNx}, {"ny", kNy}, {"nz", kNz}});
+  plan.layout.texcoords = assign({{"s", kS}, {"t", kT}}) || assign({{"u", kS}, {"v", kT}}) ||
+                          assign({{"texture_u", kS}, {"texture_v", kT}}) ||
+                          assign({{"texture_s", kS}, {"texture_t", kT}});
+  // Colours: integer channels are normalised by their type's maximum.
+  auto color_divisor = [](PlyType t) {
+    switch (t) {
+      case PlyType::kUint8:
+        return 255.0;
+      case PlyType::kUint16:
+        return 65535.0;
+      case PlyType::kFloat32:
+      case PlyType::kFloat64:
+        return 1.0;
+      default:
+        return 0.0;  // signed or 32-bit integer colours: meaning unclear
+    }
+  };
+  const int r = find_property(e, "red"), g = find_property(e, "green"),
+            b = find_property(e, "blue"), a = find_property(e, "alpha");
+  if (r >= 0 && g >= 0 && b >= 0) {
+    bool usable = true;
+    for (int i : {r, g, b, a})
+      if (i >= 0 && color_divisor(e.properties[size_t(i)].type) == 0.0) usable = false;
+    if (usable) {
+      plan.layout.colors = true;
+      const std::pair<int, int> channels[] = {{r, kRed}, {g, kGreen}, {b, kBlue}, {a, kAlpha}};
+      for (const auto& [i, slot] : channels) {
+        if (i < 0) continue;
+        plan.slot[size_t(i)] = slot;
+        plan.divisor[size_t(i)] = color_divisor(e.properties[size_t(i)].type);
+      }
+    }
+  }
+  for (size_t i = 0; i < e.properties.size(); ++i)
+    if (plan.slot[i] == kSkip)
+      note_ignored(ctx, "ply vertex property '" + e.properties[i].name + "'");
+  return plan;
+}
+
+// Finds the list of vertex indices of a face or tristrips element.
+int index_list(const ReadContext& ctx, const PlyElement& e) {
+  int found = -1;
+  for (size_t i = 0; i < e.properties.size(); ++i) {
+    const PlyProperty& p = e.properties[i];
+    if (found < 0 && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+      if (!ply_type_is_integer(p.type))
+        fail_at_line(ctx, e.line,
+                     "the " + e.name + " element's '" + p.name + "' list has non-integer type " +
+                         ply_type_name(p.type));
+      found = int(i);
+    } else {
+      note_ignored(ctx, "ply " + e.name + " property '" + p.name + "'");
+    }
+  }
+  if (found < 0) fail_at_line(ctx, e.line, "the " + e.name + " element has no vertex_indices list");
+  return found;
+}
+
+// ---- The body. ----
+
+template <class Source>
+class PlyBody {
+ public:
+  PlyBody(const ReadContext& ctx, const PlyHeader& header, Source& src, uint64_t vertex_count)
+      : ctx_(ctx), header_(header), src_(src), vertex_count_(vertex_count) {}
+
+  Mesh read() {
+    bool have_vertices = false;
+    for (const PlyElement& e : header_.elements) {
+      if (e.name == "vertex") {
+        if (have_vertices) fail_at_line(ctx_, e.line, "a second vertex element");
+        have_vertices = true;
+        read_vertices(e);
+      } else if (e.name == "face") {
+        read_faces(e);
+      } else if (e.name == "tristrips") {
+        read_strips(e);
+      } else {
+        note_ignored(ctx_, "ply element '" + e.name + "'");
+        skip_element(e);
+      }
+    }
+    src_.finish();
+    if (mesh_.layout.any()) {
+      mesh_.wedge_vertex.resize(mesh_.positions.size());
+      for (size_t v = 0; v < mesh_.wedge_vertex.size(); ++v) mesh_.wedge_vertex[v] = VertexId(v);
+      mesh_.face_wedges.assign(mesh_.faces.begin(), mesh_.faces.end());
+    }
+    finish_mesh(mesh_);
+    return std::move(mesh_);
+  }
+
+ private:
+  void read_vertices(const PlyElement& e) {
+    const VertexPlan plan = plan_vertices(ctx_, e);
+    mesh_.layout = plan.layout;
+    const AttributeLayout& layout = plan.layout;
+    const int stride = layout.floats_per_wedge();
+    mesh_.positions.reserve(size_t(e.count));
+    mesh_.wedge_values.reserve(size_t(e.count) * size_t(stride));
+    for (uint64_t i = 0; i < e.count; ++i) {
+      src_.begin_record(e, i);
+      double v[kSlots] = {};
+      v[kAlpha] = 1.0;
+      for (size_t k = 0; k < e.properties.size(); ++k) {
+        const PlyProperty& p = e.properties[k];
+        if (p.is_list) {
+          const uint64_t n = src_.list_count(p);
+          for (uint64_t j = 0; j < n; ++j) src_.skip(p.type);
+        } else if (plan.slot[k] == kSkip) {
+          src_.skip(p.type);
+        } else {
+          v[plan.slot[k]] = src_.scalar(p.type) / plan.divisor[k];
+        }
+      }
+      mesh_.positions.push_back({v[kX], v[kY], v[kZ]});
+      if (layout.normals)
+        for (int c : {kNx, kNy, kNz}) mesh_.wedge_values.push_back(float(v[c]));
+      if (layout.texcoords)
+        for (int c : {kS, kT}) mesh_.wedge_values.push_back(float(v[c]));
+      if (layout.colors)
+        for (int c : {kRed, kGreen, kBlue, kAlpha}) mesh_.wedge_values.push_back(float(v[c]));
+    }
+  }
+
+  // Reads one index of `record` and checks it; -1 is allowed when `allow_restart`.
+  int64_t read_index(const PlyProperty& p, const PlyElement& e, uint64_t record,
+                     bool allow_restart) {
+    const uint64_t at = src_.mark();
+    const int64_t index = src_.integer(p.type);
+    if (index >= 0 && uint64_t(index) < vertex_count_) return index;
+    if (index == -1 && allow_restart) return index;
+    src_.fail_at(at, record_name(e, record) + " has vertex index " + std::to_string(index) +
+                         " but the file has " + std::to_string(vertex_count_) + " vertices");
+  }
+
+  void add_triangle(VertexId a, VertexId b, VertexId c) {
+    if (mesh_.faces.size() >= ctx_.max_faces())
+      fail_limit(ctx_, "more than the limit of " + std::to_string(ctx_.max_faces()) + " faces");
+    mesh_.faces.push_back({a, b, c});
+  }
+
+  void read_faces(const PlyElement& e) {
+    const int list = index_list(ctx_, e);
+    mesh_.faces.reserve(mesh_.faces.size() + size_t(e.count));
+    ReadReport& report = *ctx_.report;
+    for (uint64_t i = 0; i < e.count; ++i) {
+      src_.begin_record(e, i);
+      for (size_t k = 0; k < e.properties.size(); ++k) {
+        const PlyProperty& p = e.properties[k];
+        if (int(k) != list) {
+          skip_property(p);
+          continue;
+        }
+        const uint64_t at = src_.mark();
+        const uint64_t n = src_.list_count(p);
+        if (n < 3)
+          src_.fail_at(
+              at, record_name(e, i) + " has " + std::to_string(n) + " vertices, at least 3 needed");
+        const VertexId first = VertexId(read_index(p, e, i, false));
+        VertexId previous = VertexId(read_index(p, e, i, false));
+        for (uint64_t j = 2; j < n; ++j) {
+          const VertexId current = VertexId(read_index(p, e, i, false));
+          add_triangle(first, previous, current);
+          previous = current;
+        }
+        ++report.polygons;
+        if (n > 3) ++report.triangulated_polygons;
+      }
+    }
+  }
+
+  void read_strips(const PlyElement& e) {
+    const int list = index_list(ctx_, e);
+    ReadReport& report = *ctx_.report;
+    for (uint64_t i = 0; i < e.count; ++i) {
+      src_.begin_record(e, i);
+      for (size_t k = 0; k < e.properties.size(); ++k) {
+        const PlyProperty& p = e.properties[k];
+        if (int(k) != list) {
+          skip_property(p);
+          continue;
+        }
+        const uint64_t n = src_.list_count(p);
+        // The last two indices of the current strip and the number of indices in it so far.
+        VertexId a = 0, b = 0;
+        uint64_t in_strip = 0;
+        for (uint64_t j = 0; j < n; ++j) {
+          const int64_t index = read_index(p, e, i, true);
+          if (index < 0) {
+            in_strip = 0;
+            continue;
+          }
+          const VertexId c = VertexId(index);
+          if (in_strip >= 2) {
+            const bool odd = (in_strip - 2) % 2 == 1;
+            if (a == b || b == c || a == c) {
+              ++report.strip_degenerates;
+            } else {
+              if (odd)
+                add_triangle(b, a, c);
+              else
+                add_triangle(a, b, c);
+              ++report.strip_triangles;
+            }
+          }
+          a = b;
+          b = c;
+          ++in_strip;
+        }
+      }
+    }
+  }
+
+  void skip_property(const PlyProperty& p) {
+    if (!p.is_list) return src_.skip(p.type);
+    const uint64_t n = src_.list_count(p);
+    for (uint64_t j = 0; j < n; ++j) src_.skip(p.type);
+  }
+
+  void skip_element(const PlyElement& e) {
+    if (e.fixed_record_bytes() != 0) return src_.skip_records(e, e.count);
+    if (e.properties.empty()) return;
+    for (uint64_t i = 0; i < e.count; ++i) {
+      src_.begin_record(e, i);
+      for (const PlyProperty& p : e.properties) skip_property(p);
+    }
+  }
+
+  const ReadContext& ctx_;
+  const PlyHeader& header_;
+  Source& src_;
+  const uint64_t vertex_count_;
+  Mesh mesh_;
+};
+
+// Refuses, before anything is allocated, counts above the limits and then counts the bytes
+// after the header cannot hold.
+void check_declared_counts(const ReadContext& ctx, const PlyHeader& header) {
+  for (const PlyElement& e : header.elements) {
+    if (e.name == "vertex")
+      check_vertex_limit(ctx, e.count,
+                         "the header declares " + std::to_string(e.count) + " vertices");
+    if (e.name == "face")
+      check_face_limit(ctx, e.count, "the header declares " + std::to_string(e.count) + " faces");
+  }
+  const bool binary = header.encoding != PlyEncoding::kAscii;
+  const uint64_t available = ctx.bytes.size() - header.body_offset;
+  // Ascii: the last value needs no separator after it.
+  uint64_t budget = binary ? available : available + 1;
+  for (const PlyElement& e : header.elements) {
+    const uint64_t per_record = e.min_record_bytes(binary);
+    if (per_record == 0 || e.count == 0) continue;
+    if (e.count > budget / per_record)
+      fail_at_line(ctx, e.line,
+                   "the header declares " + std::to_string(e.count) + " " + e.name +
+                       " elements of at least " + std::to_string(per_record) +
+                       " bytes each, but only " + std::to_string(available) +
+                       " bytes follow the header");
+    budget -= e.count * per_record;
+  }
+}
+
+template <class Source>
+Mesh read_body(const ReadContext& ctx, const PlyHeader& header) {
+  uint64_t vertex_count = 0;
+  for (const PlyElement& e : header.elements)
+    if (e.name == "vertex") vertex_count = e.count;
+  Source src(ctx, header);
+  return PlyBody<Source>(ctx, header, src, vertex_count).read();
+}
+
+}  // namespace
+
+Mesh read_ply(const ReadContext& ctx) {
+  ReadReport& report = *ctx.report;
+  report.format = MeshFormat::kPly;
+  const PlyHeader header = parse_ply_header(ctx);
+  check_declared_counts(ctx, header);
+  constexpr bool kLittleHost = std::endian::native == std::endian::little;
+  switch (header.encoding) {
+    case PlyEncoding::kAscii:
+      report.encoding = "ascii";
+      return read_body<AsciiSource>(ctx, header);
+    case PlyEncoding::kBinaryLittleEndian:
+      report.encoding = "binary_little_endian";
+      return read_body<BinarySource<!kLittleHost>>(ctx, header);
+    case PlyEncoding::kBinaryBigEndian:
+      report.encoding = "binary_big_endian";
+      return read_body<BinarySource<kLittleHost>>(ctx, header);
+  }
+  fail(ctx, "unknown PLY encoding");
+}
+
+}  // namespace parapm::io
