@@ -1,6 +1,7 @@
 // parapm simplify IN -o OUT.pm: read, repair, build the Progressive Mesh, write it.
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include <spdlog/spdlog.h>
 
@@ -44,7 +45,7 @@ int run_simplify(const SimplifyArgs& args) {
   const auto write_start = std::chrono::steady_clock::now();
   write_pm_file(pm, args.output);
   const double write_seconds = seconds_since(write_start);
-  const uint64_t pm_bytes = pm_encoded_size(pm);
+  const uint64_t pm_bytes = std::filesystem::file_size(args.output);
   const uint64_t ply_bytes = binary_ply_size(loaded.repaired.mesh);
   const uint64_t peak = peak_memory_bytes();
   spdlog::info("simplified {}: {} -> {} faces, {} vertex splits, {:.3f} s ({}); wrote {}",

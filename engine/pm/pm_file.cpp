@@ -64,8 +64,8 @@ void write_position_delta(ByteWriter& out, const Vec3& after, const Vec3& before
   }
 }
 
+// The caller has validated `pm` (validate_pm): the encoding relies on its invariants.
 void write_all(const ProgressiveMesh& pm, ByteWriter& out) {
-  validate_pm(pm);
   const Mesh& base = pm.base;
   const bool float32 = base.positions_are_float;
   const bool attributes = base.layout.any();
@@ -157,11 +157,13 @@ void write_all(const ProgressiveMesh& pm, ByteWriter& out) {
 }  // namespace
 
 void write_pm(const ProgressiveMesh& pm, std::ostream& out) {
+  validate_pm(pm);
   ByteWriter writer(&out);
   write_all(pm, writer);
 }
 
 size_t pm_encoded_size(const ProgressiveMesh& pm) {
+  validate_pm(pm);
   ByteWriter counter(nullptr);
   write_all(pm, counter);
   return size_t(counter.offset());
@@ -172,7 +174,8 @@ void write_pm_file(const ProgressiveMesh& pm, const std::string& path) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(ErrorCode::kIo, "cannot open " + path + " for writing");
   try {
-    write_pm(pm, out);
+    ByteWriter writer(&out);
+    write_all(pm, writer);
     out.close();
     if (!out) throw Error(ErrorCode::kIo, "writing " + path + " failed");
   } catch (const Error& e) {

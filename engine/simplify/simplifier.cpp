@@ -12,7 +12,7 @@ void Simplifier::push_edge(VertexId a, VertexId b) {
   if (a > b) std::swap(a, b);
   CollapseCandidate candidate;
   if (!priority_.evaluate(mesh_, a, b, candidate)) return;
-  heap_.push_back({candidate.cost, a, b, version_[a], version_[b]});
+  heap_.push_back({static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]});
   std::push_heap(heap_.begin(), heap_.end(), Later{});
 }
 
@@ -66,26 +66,22 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   version_.assign(mesh_.vertex_capacity(), 0);
   rejected_.assign(mesh_.vertex_capacity(), {});
 
-  // Every undirected edge once, in a deterministic order.
-  std::vector<std::pair<VertexId, VertexId>> edges;
-  edges.reserve(mesh_.face_capacity() * 3);
+  // Every undirected edge once: from the face holding a->b with a < b, or from the only face
+  // of a boundary edge. The heap's order does not depend on the order of insertion.
+  heap_.clear();
+  heap_.reserve(mesh_.face_capacity() * 3);
   for (FaceId f = 0; f < mesh_.face_capacity(); ++f) {
     if (!mesh_.face_alive(f)) continue;
     const Triangle& t = mesh_.face(f);
-    for (int k = 0; k < 3; ++k)
-      edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
-  }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  heap_.clear();
-  heap_.reserve(edges.size() * 2);
-  for (const auto& [a, b] : edges) {
-    CollapseCandidate candidate;
-    if (priority_.evaluate(mesh_, a, b, candidate))
-      heap_.push_back({candidate.cost, a, b, version_[a], version_[b]});
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3];
+      if (a > b && mesh_.edge_faces(b, a).left != kNoId) continue;  // counted from b->a
+      CollapseCandidate candidate;
+      if (priority_.evaluate(mesh_, std::min(a, b), std::max(a, b), candidate))
+        heap_.push_back({static_cast<float>(candidate.cost), std::min(a, b), std::max(a, b), 0});
+    }
   }
   std::make_heap(heap_.begin(), heap_.end(), Later{});
-  edges = {};
 
   const size_t start_faces = mesh_.live_faces();
   const uint64_t total = start_faces > limits.target_faces ? start_faces - limits.target_faces : 0;
@@ -104,7 +100,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     const Entry entry = heap_.back();
     heap_.pop_back();
     if (!mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
-        version_[entry.a] != entry.version_a || version_[entry.b] != entry.version_b) {
+        version_[entry.a] + version_[entry.b] != entry.stamp) {
       ++stats_.stale;
       continue;
     }

@@ -57,10 +57,13 @@ class Simplifier {
   const SimplifierStats& stats() const { return stats_; }
 
  private:
+  // 16 bytes, so that more of the heap stays in cache. The stamp is the sum of the two
+  // vertices' versions when the entry was pushed: versions only grow, so the sum is unchanged
+  // exactly when neither end has changed since.
   struct Entry {
-    double cost;
+    float cost;
     VertexId a, b;
-    uint32_t version_a, version_b;
+    uint32_t stamp;
   };
   struct Later {  // min-heap order, ties broken by the edge's ids for determinism
     bool operator()(const Entry& x, const Entry& y) const {
