@@ -49,9 +49,10 @@ int run_check(const CheckArgs& args) {
 void add_check_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<CheckArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "check", "Exit 0 iff the PM rebuilds the original mesh exactly (positions bit for bit, "
-               "attributes, faces and their orientation; up to vertex renumbering unless the "
-               "PM was built with --keep-order); exit 1 and name the first difference otherwise");
+      "check",
+      "Exit 0 iff the PM rebuilds the original mesh exactly (positions bit for bit, "
+      "attributes, faces and their orientation; up to vertex renumbering unless the "
+      "PM was built with --keep-order); exit 1 and name the first difference otherwise");
   cmd->add_option("input", args->input, "The .pm")->required()->check(CLI::ExistingFile);
   cmd->add_option("--against", args->original, "The original mesh file")
       ->required()

@@ -41,6 +41,7 @@ int run_lod(const LodArgs& args) {
                 {"faces", mesh.face_count()},
                 {"vertices", mesh.vertex_count()},
                 {"error_bound", error},
+                {"bbox_diagonal", pm_bounding_box(pm).diagonal()},
                 {"seconds", seconds}});
   }
   return 0;
@@ -51,8 +52,9 @@ int run_lod(const LodArgs& args) {
 void add_lod_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<LodArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "lod", "Write one level of detail of a .pm: the largest with at most N faces, or the "
-             "smallest whose error bound is at most E");
+      "lod",
+      "Write one level of detail of a .pm: the largest with at most N faces, or the "
+      "smallest whose error bound is at most E");
   cmd->add_option("input", args->input, "Input .pm")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->output, "Output mesh (.obj or .ply, optionally .gz)")
       ->required();
@@ -64,8 +66,7 @@ void add_lod_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--ascii", args->ascii, "Write ascii PLY instead of binary");
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args, &exit_code, faces, error] {
-    if (faces->count() == 0 && error->count() == 0)
-      throw CLI::RequiredError("--faces or --error");
+    if (faces->count() == 0 && error->count() == 0) throw CLI::RequiredError("--faces or --error");
     exit_code = run_lod(*args);
   });
 }

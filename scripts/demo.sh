@@ -8,7 +8,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 mesh="${1:-$root/tests/data/pymeshlab-bunny-textured-10k.obj}"
 out="${PARAPM_OUT:-$root/out}"
-"$root/scripts/bootstrap.sh" 2> >(grep -v '^\[' >&2 || true)
+"$root/scripts/bootstrap.sh" 2> >(grep -vE '^\[|^ninja: no work' >&2 || true)
 bin="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
 mkdir -p "$out"
 name="$(basename "$mesh")"; name="${name%.gz}"; name="${name%.*}"
@@ -26,24 +26,26 @@ for dir in "${PEERS_BUILD:-}" "$root/.peers-build"; do
 done
 
 printf '\nParaPM demo: %s\n' "$mesh"
-printf 'Progressive Mesh %s: %s vertex splits over a %s-face base mesh, built in %s s; lossless: %s\n' \
+printf 'Progressive Mesh %s: %s vertex splits over a %s-face base mesh, built in %.3f s; lossless: %s\n' \
   "$pm" "$(jget "$summary" vsplits)" "$(jget "$summary" base_faces)" "$(jget "$summary" seconds)" "$lossless"
 printf '.pm %s bytes, binary PLY %s bytes\n\n' "$(jget "$summary" pm_bytes)" "$(jget "$summary" binary_ply_bytes)"
 header="%-8s %10s %10s %12s %14s"
 [[ -n "$metro" ]] && header+=" %14s %14s"
-printf "$header\n" level faces_in faces_out seconds error_bound ${metro:+rms/diag hausdorff/diag}
+printf "$header\n" level faces_in faces_out seconds bound/diag ${metro:+rms/diag hausdorff/diag}
 for pct in 50 10 2; do
   faces=$(( in_faces * pct / 100 ))
   lod="$out/$name.lod$pct.obj"
   info="$("$bin" --log-level warn lod "$pm" --faces "$faces" -o "$lod" --json)"
-  row=("$pct%" "$in_faces" "$(jget "$info" faces)" "$(printf '%.3f' "$(jget "$info" seconds)")" "$(jget "$info" error_bound)")
+  bound_rel="$(awk -v e="$(jget "$info" error_bound)" -v d="$(jget "$info" bbox_diagonal)" 'BEGIN { printf "%.3g", (d > 0 ? e / d : 0) }')"
+  row=("$pct%" "$in_faces" "$(jget "$info" faces)" "$(printf '%.3f' "$(jget "$info" seconds)")" "$bound_rel")
   if [[ -n "$metro" ]]; then
     m="$("$metro" "$mesh" "$lod" 2>/dev/null || true)"
     row+=("$(jget "$m" rms_rel)" "$(jget "$m" hausdorff_rel)")
   fi
   printf "$header\n" "${row[@]}"
 done
-printf '\nseconds: time to read the .pm, cut the level and write it; error_bound: the PM'"'"'s own\n'
-printf 'bound for that level (RMS distance to the collapsed planes, model units).\n'
+printf '\nseconds: time to read the .pm, cut the level and write it. bound/diag: the PM'"'"'s own\n'
+printf 'error bound for that level (RMS distance to the collapsed planes) over the bounding-box\n'
+printf 'diagonal. rms/diag, hausdorff/diag: measured by metro, the independent judge of ../shared/tools.\n'
 [[ -z "$metro" ]] && printf 'For measured errors, build the judge: ../shared/tools/build.sh .peers-build\n'
 printf 'Levels of detail written to %s/%s.lod{50,10,2}.obj\n' "$out" "$name"

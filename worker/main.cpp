@@ -6,8 +6,11 @@
 #include "parapm.grpc.pb.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"parapm-worker: not implemented yet (the service issue builds it); use 'parapm simplify' in-process"};
+  CLI::App app{
+      "parapm-worker: not implemented yet (the service issue builds it); use 'parapm simplify' "
+      "in-process"};
   CLI11_PARSE(app, argc, argv);
-  std::fprintf(stderr, "parapm-worker: the gRPC service is not implemented yet; use 'parapm simplify'\n");
+  std::fprintf(stderr,
+               "parapm-worker: the gRPC service is not implemented yet; use 'parapm simplify'\n");
   return 2;
 }

@@ -41,13 +41,13 @@ struct AttributeLayout {
 };
 
 struct Mesh {
-  std::vector<Vec3> positions;   // per vertex, in model units
-  std::vector<Triangle> faces;   // vertex ids, counter-clockwise
+  std::vector<Vec3> positions;  // per vertex, in model units
+  std::vector<Triangle> faces;  // vertex ids, counter-clockwise
 
   // Attributes (all empty when layout.any() is false).
   AttributeLayout layout;
-  std::vector<VertexId> wedge_vertex;             // wedge -> the vertex it belongs to
-  std::vector<float> wedge_values;                // layout.floats_per_wedge() per wedge
+  std::vector<VertexId> wedge_vertex;               // wedge -> the vertex it belongs to
+  std::vector<float> wedge_values;                  // layout.floats_per_wedge() per wedge
   std::vector<std::array<WedgeId, 3>> face_wedges;  // per face, the wedge of each corner
 
   // True when every coordinate is exactly a float32: the PM then stores float32 positions and

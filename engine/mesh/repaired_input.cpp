@@ -27,9 +27,8 @@ Mesh repaired_input(const RepairedMesh& repaired) {
 
   std::vector<FaceId> order(mesh.face_count());
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](FaceId a, FaceId b) {
-    return repaired.input_face[a] < repaired.input_face[b];
-  });
+  std::sort(order.begin(), order.end(),
+            [&](FaceId a, FaceId b) { return repaired.input_face[a] < repaired.input_face[b]; });
   out.faces.reserve(order.size());
   for (FaceId f : order) {
     const Triangle& t = mesh.faces[f];
@@ -39,7 +38,8 @@ Mesh repaired_input(const RepairedMesh& repaired) {
   if (mesh.layout.any()) {
     out.wedge_values = mesh.wedge_values;
     out.wedge_vertex.resize(mesh.wedge_count());
-    for (WedgeId w = 0; w < mesh.wedge_count(); ++w) out.wedge_vertex[w] = merged[mesh.wedge_vertex[w]];
+    for (WedgeId w = 0; w < mesh.wedge_count(); ++w)
+      out.wedge_vertex[w] = merged[mesh.wedge_vertex[w]];
   }
   return out;
 }

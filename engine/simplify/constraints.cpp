@@ -115,8 +115,8 @@ class LinkCondition : public ConstraintModule {
 class FaceGeometry : public ConstraintModule {
   // |n| is twice the area; a sliver's height is below ~1e-6 of its longest side.
   static bool is_sliver(const Vec3& n, const Vec3& a, const Vec3& b, const Vec3& c) {
-    const double longest_sq = std::max(
-        {dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
+    const double longest_sq =
+        std::max({dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
     return dot(n, n) <= 1e-12 * longest_sq * longest_sq;
   }
 

@@ -11,7 +11,9 @@ namespace {
 class WedgeNumbering {
  public:
   WedgeNumbering(const Mesh& mesh, ProgressiveMesh& pm)
-      : mesh_(mesh), pm_(pm), pm_id_(mesh.wedge_count(), kNoId),
+      : mesh_(mesh),
+        pm_(pm),
+        pm_id_(mesh.wedge_count(), kNoId),
         floats_(mesh.layout.floats_per_wedge()) {}
 
   WedgeId base(WedgeId w) {

@@ -32,8 +32,8 @@ void QuadricPriority::initialize(const CollapseMesh& mesh) {
       const double side_len = length(side);
       if (side_len == 0) continue;
       const Vec3 m = scale(side, 1.0 / side_len);
-      const Quadric qb = Quadric::from_plane(m, -dot(m, mesh.position(a)),
-                                             options_.boundary_weight * dot(e, e));
+      const Quadric qb =
+          Quadric::from_plane(m, -dot(m, mesh.position(a)), options_.boundary_weight * dot(e, e));
       quadrics_[a] += qb;
       quadrics_[b] += qb;
     }

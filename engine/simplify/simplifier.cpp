@@ -12,8 +12,22 @@ void Simplifier::push_edge(VertexId a, VertexId b) {
   if (a > b) std::swap(a, b);
   CollapseCandidate candidate;
   if (!priority_.evaluate(mesh_, a, b, candidate)) return;
-  heap_.push_back({static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]});
-  std::push_heap(heap_.begin(), heap_.end(), Later{});
+  heap_.push({static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]});
+}
+
+bool Simplifier::is_stale(const Entry& entry) const {
+  return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
+         version_[entry.a] + version_[entry.b] != entry.stamp;
+}
+
+void Simplifier::compact_heap() {
+  auto& items = heap_.items();
+  const size_t before = items.size();
+  items.erase(
+      std::remove_if(items.begin(), items.end(), [this](const Entry& e) { return is_stale(e); }),
+      items.end());
+  heap_.rebuild();
+  stats_.stale += before - items.size();
 }
 
 // Each side lists a vetoed edge at most once, so the lists stay as short as the valence.
@@ -78,10 +92,11 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       if (a > b && mesh_.edge_faces(b, a).left != kNoId) continue;  // counted from b->a
       CollapseCandidate candidate;
       if (priority_.evaluate(mesh_, std::min(a, b), std::max(a, b), candidate))
-        heap_.push_back({static_cast<float>(candidate.cost), std::min(a, b), std::max(a, b), 0});
+        heap_.items().push_back(
+            {static_cast<float>(candidate.cost), std::min(a, b), std::max(a, b), 0});
     }
   }
-  std::make_heap(heap_.begin(), heap_.end(), Later{});
+  heap_.rebuild();
 
   const size_t start_faces = mesh_.live_faces();
   const uint64_t total = start_faces > limits.target_faces ? start_faces - limits.target_faces : 0;
@@ -96,11 +111,13 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       stats_.stop_reason = "target face count reached";
       break;
     }
-    std::pop_heap(heap_.begin(), heap_.end(), Later{});
-    const Entry entry = heap_.back();
-    heap_.pop_back();
-    if (!mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
-        version_[entry.a] + version_[entry.b] != entry.stamp) {
+    // Lazy deletion leaves stale entries behind (about seven per collapse). Once the queue
+    // holds more than two entries per live face (live edges are ~1.5 per face) they are
+    // dropped in one sequential pass, far cheaper than popping each through the
+    // cache-missing heap; amortised, each entry is compacted away at most once.
+    if (heap_.size() > 2 * mesh_.live_faces() + 1024) compact_heap();
+    const Entry entry = heap_.pop();
+    if (is_stale(entry)) {
       ++stats_.stale;
       continue;
     }

@@ -11,6 +11,7 @@
 
 #include "simplify/collapse_mesh.h"
 #include "simplify/modules.h"
+#include "simplify/quad_heap.h"
 #include "util/progress.h"
 
 namespace parapm {
@@ -26,10 +27,10 @@ struct CollapseRecord {
   FaceId fr = kNoId;
   Vec3 vs_position{};  // before the collapse
   Vec3 vt_position{};
-  Vec3 position{};     // of vs after the collapse
+  Vec3 position{};  // of vs after the collapse
   std::array<WedgeId, 6> corner_wedges{kNoId, kNoId, kNoId, kNoId, kNoId, kNoId};
   double cost = 0;
-  float error = 0;     // the priority module's geometric error, model units
+  float error = 0;  // the priority module's geometric error, model units
 };
 
 struct SimplifierLimits {
@@ -38,10 +39,10 @@ struct SimplifierLimits {
 
 struct SimplifierStats {
   uint64_t collapses = 0;
-  uint64_t rejected = 0;          // pops vetoed by a constraint
-  uint64_t stale = 0;             // pops of outdated queue entries
-  uint64_t reevaluated = 0;       // rejected edges costed again after their star changed
-  std::string stop_reason;        // why the loop ended
+  uint64_t rejected = 0;     // pops vetoed by a constraint
+  uint64_t stale = 0;        // pops of outdated queue entries
+  uint64_t reevaluated = 0;  // rejected edges costed again after their star changed
+  std::string stop_reason;   // why the loop ended
 };
 
 class Simplifier {
@@ -65,23 +66,25 @@ class Simplifier {
     VertexId a, b;
     uint32_t stamp;
   };
-  struct Later {  // min-heap order, ties broken by the edge's ids for determinism
+  struct Before {  // cheapest first, ties broken by the edge's ids for determinism
     bool operator()(const Entry& x, const Entry& y) const {
-      if (x.cost != y.cost) return x.cost > y.cost;
-      if (x.a != y.a) return x.a > y.a;
-      return x.b > y.b;
+      if (x.cost != y.cost) return x.cost < y.cost;
+      if (x.a != y.a) return x.a < y.a;
+      return x.b < y.b;
     }
   };
 
   void push_edge(VertexId a, VertexId b);
   void remember_rejected(VertexId v, VertexId other);
+  bool is_stale(const Entry& entry) const;
+  void compact_heap();
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const;
   CollapseRecord perform(const CollapseCandidate& candidate, const EdgeFaces& edge);
 
   CollapseMesh& mesh_;
   PriorityModule& priority_;
   std::vector<std::unique_ptr<ConstraintModule>> constraints_;
-  std::vector<Entry> heap_;
+  QuadHeap<Entry, Before> heap_;
   std::vector<uint32_t> version_;
   std::vector<std::vector<VertexId>> rejected_;  // per vertex: edges vetoed since its last change
   SimplifierStats stats_;

@@ -24,10 +24,10 @@ struct CliRun {
 CliRun parapm(const std::string& args) {
   static int counter = 0;
   const fs::path err_file =
-      fs::temp_directory_path() / ("parapm-cli-test-" + std::to_string(::getpid()) + "-" +
-                                   std::to_string(counter++) + ".err");
-  const std::string command = std::string(PARAPM_BINARY_DIR) + "/parapm " + args + " 2>" +
-                              err_file.string();
+      fs::temp_directory_path() /
+      ("parapm-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".err");
+  const std::string command =
+      std::string(PARAPM_BINARY_DIR) + "/parapm " + args + " 2>" + err_file.string();
   CliRun run;
   FILE* pipe = popen(command.c_str(), "r");
   std::array<char, 4096> buffer;
@@ -81,7 +81,8 @@ TEST_F(Cli, CheckFailsAgainstAnotherMesh) {
   const std::string pm = path("strat.pm");
   ASSERT_EQ(parapm("simplify " + testing::test_data("stratocaster-9k.ply") + " -o " + pm).status,
             0);
-  const CliRun r = parapm("check " + pm + " --against " + testing::test_data("cad-featuretype-3k.stl"));
+  const CliRun r =
+      parapm("check " + pm + " --against " + testing::test_data("cad-featuretype-3k.stl"));
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("DIFFERENT"), std::string::npos) << r.out;
 }

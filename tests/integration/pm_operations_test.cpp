@@ -72,9 +72,9 @@ TEST(PmOperations, SelectiveRefinementOfOneHalf) {
       pm, [&](VertexId vs, const Vec3& p) { return vs < coarse || p[0] > middle; });
   EXPECT_GT(half.applied, 0u);
   EXPECT_GT(half.skipped_by_predicate + half.skipped_absent, 0u);
-  EXPECT_EQ(half.applied + half.skipped_absent + half.skipped_by_predicate +
-                half.skipped_inapplicable,
-            pm.splits.size());
+  EXPECT_EQ(
+      half.applied + half.skipped_absent + half.skipped_by_predicate + half.skipped_inapplicable,
+      pm.splits.size());
   EXPECT_GT(half.mesh.face_count(), pm.base.face_count());
   EXPECT_LT(half.mesh.face_count(), pm.full_face_count());
   for (const Triangle& t : half.mesh.faces)

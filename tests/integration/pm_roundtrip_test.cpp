@@ -55,9 +55,12 @@ void expect_lossless(const std::string& path, const SimplifyOptions& options) {
               rt.pm.base.face_count(), rt.pm.splits.size(), rt.bytes.size(), seconds);
 }
 
-const char* kCommitted[] = {"pymeshlab-bunny-textured-10k.obj", "pymeshlab-colored-airplane-11k.ply",
-                            "cad-featuretype-3k.stl", "stratocaster-9k.ply",
-                            "cad-cycloidal-43k.ply", "gmsh-aneurysm-20k.stl.gz"};
+const char* kCommitted[] = {"pymeshlab-bunny-textured-10k.obj",
+                            "pymeshlab-colored-airplane-11k.ply",
+                            "cad-featuretype-3k.stl",
+                            "stratocaster-9k.ply",
+                            "cad-cycloidal-43k.ply",
+                            "gmsh-aneurysm-20k.stl.gz"};
 
 TEST(PmRoundTrip, CommittedMeshesAreLossless) {
   for (const char* name : kCommitted) expect_lossless(testing::test_data(name), {});

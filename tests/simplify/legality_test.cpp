@@ -35,9 +35,9 @@ Mesh tetrahedron() {
 }
 
 Mesh octahedron() {
-  return make_mesh({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
-                   {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
-                    {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+  return make_mesh(
+      {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
 }
 
 TEST(Legality, TetrahedronCannotCollapse) {
@@ -54,8 +54,7 @@ TEST(Legality, OctahedronEdgeCollapses) { EXPECT_EQ(veto(octahedron(), 0, 2), ""
 // The outer ring e, f, g closes the fan around c so that a-c and b-c are boundary edges
 // of the hole only.
 TEST(Legality, LinkConditionForbidsClosingAHole) {
-  const Mesh m = make_mesh({{0, 0, 0}, {2, 0, 0}, {1, 2, 0}, {1, -1, 0},
-                            {-1, 3, 0}, {3, 3, 0}},
+  const Mesh m = make_mesh({{0, 0, 0}, {2, 0, 0}, {1, 2, 0}, {1, -1, 0}, {-1, 3, 0}, {3, 3, 0}},
                            {{1, 0, 3}, {0, 2, 4}, {2, 1, 5}, {4, 2, 5}});
   EXPECT_EQ(veto(m, 0, 1), "link-condition");
 }
@@ -64,8 +63,7 @@ TEST(Legality, LinkConditionForbidsClosingAHole) {
 //  | / |    edge b-c is interior (two faces), but b and c are both boundary vertices:
 //  b---d    collapsing it would pinch the strip into two sheets joined at one vertex.
 TEST(Legality, InteriorEdgeBetweenBoundaryVertices) {
-  const Mesh m = make_mesh({{0, 1, 0}, {0, 0, 0}, {1, 1, 0}, {1, 0, 0}},
-                           {{0, 1, 2}, {1, 3, 2}});
+  const Mesh m = make_mesh({{0, 1, 0}, {0, 0, 0}, {1, 1, 0}, {1, 0, 0}}, {{0, 1, 2}, {1, 3, 2}});
   EXPECT_EQ(veto(m, 1, 2), "boundary");
   EXPECT_EQ(veto(m, 0, 1), "");  // a boundary edge between boundary vertices is fine
 }

@@ -17,8 +17,8 @@ Mesh uv_sphere(int rings, int segments) {
     const double theta = M_PI * r / rings;
     for (int s = 0; s < segments; ++s) {
       const double phi = 2 * M_PI * s / segments;
-      m.positions.push_back({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                             std::cos(theta)});
+      m.positions.push_back(
+          {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)});
     }
   }
   m.positions.push_back({0, 0, -1});
@@ -30,7 +30,8 @@ Mesh uv_sphere(int rings, int segments) {
       m.faces.push_back({ring(r, s), ring(r + 1, s), ring(r + 1, s + 1)});
       m.faces.push_back({ring(r, s), ring(r + 1, s + 1), ring(r, s + 1)});
     }
-  for (int s = 0; s < segments; ++s) m.faces.push_back({south, ring(rings - 1, s + 1), ring(rings - 1, s)});
+  for (int s = 0; s < segments; ++s)
+    m.faces.push_back({south, ring(rings - 1, s + 1), ring(rings - 1, s)});
   return m;
 }
 

@@ -1,0 +1,67 @@
+// A 4-ary min-heap. The collapse queue is large (millions of entries on big meshes) and
+// memory-bound: with four 16-byte children per node a sift visits half the levels of a
+// binary heap and reads one cache line per level. `Before(x, y)` is true when x must come out
+// before y; with a total order the output sequence does not depend on the heap's shape.
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+namespace parapm {
+
+template <typename T, typename Before>
+class QuadHeap {
+ public:
+  bool empty() const { return items_.empty(); }
+  size_t size() const { return items_.size(); }
+  void reserve(size_t n) { items_.reserve(n); }
+  void clear() { items_.clear(); }
+  std::vector<T>& items() { return items_; }  // edit freely, then call rebuild()
+
+  void push(const T& item) {
+    size_t i = items_.size();
+    items_.push_back(item);
+    while (i > 0) {
+      const size_t parent = (i - 1) / 4;
+      if (!before_(item, items_[parent])) break;
+      items_[i] = items_[parent];
+      i = parent;
+    }
+    items_[i] = item;
+  }
+
+  T pop() {
+    const T top = items_.front();
+    const T last = items_.back();
+    items_.pop_back();
+    if (!items_.empty()) sift_down(0, last);
+    return top;
+  }
+
+  void rebuild() {
+    if (items_.size() < 2) return;
+    for (size_t i = (items_.size() - 2) / 4 + 1; i-- > 0;) sift_down(i, items_[i]);
+  }
+
+ private:
+  void sift_down(size_t i, const T item) {
+    const size_t n = items_.size();
+    for (;;) {
+      const size_t first = 4 * i + 1;
+      if (first >= n) break;
+      size_t best = first;
+      const size_t end = std::min(first + 4, n);
+      for (size_t c = first + 1; c < end; ++c)
+        if (before_(items_[c], items_[best])) best = c;
+      if (!before_(items_[best], item)) break;
+      items_[i] = items_[best];
+      i = best;
+    }
+    items_[i] = item;
+  }
+
+  std::vector<T> items_;
+  Before before_;
+};
+
+}  // namespace parapm
