@@ -13,7 +13,8 @@ CollapseMesh::CollapseMesh(const Mesh& mesh)
       face_alive_(mesh.faces.size(), 1),
       faces_of_(mesh.positions.size()),
       boundary_(mesh.positions.size(), 0),
-      live_faces_(mesh.faces.size()) {
+      live_faces_(mesh.faces.size()),
+      mark_(mesh.positions.size(), 0) {
   std::vector<uint32_t> valence(positions_.size(), 0);
   for (const Triangle& t : faces_)
     for (VertexId v : t) ++valence[v];
@@ -45,16 +46,24 @@ EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
   return result;
 }
 
+uint32_t CollapseMesh::next_stamp() const {
+  if (++stamp_ == 0) {  // wrapped: old marks could collide with new stamps
+    std::fill(mark_.begin(), mark_.end(), 0);
+    stamp_ = 1;
+  }
+  return stamp_;
+}
+
 void CollapseMesh::neighbors(VertexId v, std::vector<VertexId>& out) const {
   out.clear();
-  for (FaceId f : faces_of_[v]) {
-    const Triangle& t = faces_[f];
-    const int i = corner_of(t, v);
-    out.push_back(t[(i + 1) % 3]);
-    out.push_back(t[(i + 2) % 3]);
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  const uint32_t seen = next_stamp();
+  mark_[v] = seen;
+  for (FaceId f : faces_of_[v])
+    for (VertexId n : faces_[f])
+      if (mark_[n] != seen) {
+        mark_[n] = seen;
+        out.push_back(n);
+      }
 }
 
 // A vertex is on the boundary when one of its edges has a face on one side only. On a

@@ -44,8 +44,22 @@ class CollapseMesh {
   bool is_boundary(VertexId v) const { return boundary_[v]; }
 
   EdgeFaces edge_faces(VertexId a, VertexId b) const;
-  // The distinct vertices sharing a face with v, sorted.
+  // The distinct vertices sharing a face with v, in no particular order.
   void neighbors(VertexId v, std::vector<VertexId>& out) const;
+  // Calls visit(n) once for every vertex n adjacent to both a and b.
+  template <typename Visit>
+  void for_each_common_neighbor(VertexId a, VertexId b, Visit visit) const {
+    const uint32_t seen = next_stamp();
+    for (FaceId f : faces_of_[a])
+      for (VertexId n : faces_[f]) mark_[n] = seen;
+    const uint32_t done = next_stamp();
+    for (FaceId f : faces_of_[b])
+      for (VertexId n : faces_[f])
+        if (n != a && n != b && mark_[n] == seen) {
+          mark_[n] = done;
+          visit(n);
+        }
+  }
 
   // Merges vt into vs, moves vs to `position`, removes the faces on the edge. The caller has
   // checked legality. Returns the faces that were removed (left, right, kNoId if absent).
@@ -53,6 +67,7 @@ class CollapseMesh {
 
  private:
   void remove_face_from(VertexId v, FaceId f);
+  uint32_t next_stamp() const;
   bool compute_boundary(VertexId v) const;
 
   std::vector<Vec3> positions_;
@@ -63,6 +78,10 @@ class CollapseMesh {
   std::vector<uint8_t> boundary_;
   size_t live_faces_ = 0;
   size_t live_vertices_ = 0;
+  // Scratch marks for neighbourhood queries (instead of sorting): a vertex is marked when
+  // mark_[v] equals the current stamp. Queries are const but not thread-safe.
+  mutable std::vector<uint32_t> mark_;
+  mutable uint32_t stamp_ = 0;
 };
 
 // Index of vertex v among the corners of face t (0, 1, 2), or -1.

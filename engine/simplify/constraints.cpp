@@ -91,22 +91,11 @@ class LinkCondition : public ConstraintModule {
   std::string name() const override { return "link-condition"; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces& edge) const override {
-    thread_local std::vector<VertexId> ring_s, ring_t;
-    mesh.neighbors(c.vs, ring_s);
-    mesh.neighbors(c.vt, ring_t);
-    size_t i = 0, j = 0;
-    while (i < ring_s.size() && j < ring_t.size()) {
-      if (ring_s[i] < ring_t[j]) {
-        ++i;
-      } else if (ring_t[j] < ring_s[i]) {
-        ++j;
-      } else {
-        const VertexId common = ring_s[i];
-        if (common != edge.left_apex && common != edge.right_apex) return false;
-        ++i, ++j;
-      }
-    }
-    return true;
+    bool ok = true;
+    mesh.for_each_common_neighbor(c.vs, c.vt, [&](VertexId common) {
+      if (common != edge.left_apex && common != edge.right_apex) ok = false;
+    });
+    return ok;
   }
 };
 
