@@ -17,7 +17,7 @@ struct InfoArgs {
 
 int run_info(const InfoArgs& args) {
   const ProgressiveMesh pm = read_pm_file(args.input);
-  const Box box = bounding_box(pm.base);
+  const Box box = pm_bounding_box(pm);  // of every position at every level
   const uint64_t pm_bytes = std::filesystem::file_size(args.input);
   const uint64_t ply_bytes = binary_ply_size(restore_input(pm));
   const double coarsest_error = pm.splits.empty() ? 0.0 : pm.splits.front().error;
@@ -43,8 +43,8 @@ int run_info(const InfoArgs& args) {
       {"keeps_input_order", !pm.input_vertex_order.empty()},
       {"input_vertices", pm.info.input_vertices},
       {"input_faces", pm.info.input_faces},
-      {"build_seconds", pm.info.seconds},
       {"base_error_bound", coarsest_error},
+      {"bbox_diagonal", box.diagonal()},
       {"bbox_min", {box.min[0], box.min[1], box.min[2]}},
       {"bbox_max", {box.max[0], box.max[1], box.max[2]}},
       {"pm_bytes", pm_bytes},

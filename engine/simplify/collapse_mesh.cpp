@@ -11,6 +11,7 @@ CollapseMesh::CollapseMesh(const Mesh& mesh)
       faces_(mesh.faces),
       corner_wedges_(mesh.face_wedges),
       face_alive_(mesh.faces.size(), 1),
+      vertex_alive_(mesh.positions.size(), 0),
       faces_of_(mesh.positions.size()),
       boundary_(mesh.positions.size(), 0),
       live_faces_(mesh.faces.size()),
@@ -23,6 +24,7 @@ CollapseMesh::CollapseMesh(const Mesh& mesh)
     for (VertexId v : faces_[f]) faces_of_[v].push_back(f);
   for (VertexId v = 0; v < positions_.size(); ++v) {
     if (faces_of_[v].empty()) continue;
+    vertex_alive_[v] = 1;
     ++live_vertices_;
     boundary_[v] = compute_boundary(v);
   }
@@ -105,7 +107,15 @@ EdgeFaces CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position)
   }
   moved.clear();
   moved.shrink_to_fit();
+  vertex_alive_[vt] = 0;
   --live_vertices_;
+  // An apex whose only face was removed is gone too (legal collapses never do this: the
+  // component minimum keeps a lone triangle; kept for the invariant alive == has faces).
+  for (VertexId apex : {removed.left_apex, removed.right_apex})
+    if (apex != kNoId && vertex_alive_[apex] && faces_of_[apex].empty()) {
+      vertex_alive_[apex] = 0;
+      --live_vertices_;
+    }
   positions_[vs] = position;
   boundary_[vt] = 0;
   // A legal collapse changes the boundary status of vs and of the apexes only.

@@ -34,7 +34,7 @@ class CollapseMesh {
   size_t live_faces() const { return live_faces_; }
   size_t live_vertices() const { return live_vertices_; }
 
-  bool vertex_alive(VertexId v) const { return !faces_of_[v].empty(); }
+  bool vertex_alive(VertexId v) const { return vertex_alive_[v]; }  // has faces
   bool face_alive(FaceId f) const { return face_alive_[f]; }
   const Triangle& face(FaceId f) const { return faces_[f]; }
   const std::array<WedgeId, 3>& corner_wedges(FaceId f) const { return corner_wedges_[f]; }
@@ -74,6 +74,7 @@ class CollapseMesh {
   std::vector<Triangle> faces_;
   std::vector<std::array<WedgeId, 3>> corner_wedges_;
   std::vector<uint8_t> face_alive_;
+  std::vector<uint8_t> vertex_alive_;  // a byte per vertex: the queue checks it on every pop
   std::vector<std::vector<FaceId>> faces_of_;
   std::vector<uint8_t> boundary_;
   size_t live_faces_ = 0;
