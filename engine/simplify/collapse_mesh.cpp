@@ -91,8 +91,8 @@ void CollapseMesh::remove_face_from(VertexId v, FaceId f) {
   list.pop_back();
 }
 
-EdgeFaces CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position) {
-  const EdgeFaces removed = edge_faces(vs, vt);
+void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
+                            const EdgeFaces& removed) {
   for (FaceId f : {removed.left, removed.right}) {
     if (f == kNoId) continue;
     face_alive_[f] = 0;
@@ -121,7 +121,6 @@ EdgeFaces CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position)
   // A legal collapse changes the boundary status of vs and of the apexes only.
   for (VertexId v : {vs, removed.left_apex, removed.right_apex})
     if (v != kNoId) boundary_[v] = !faces_of_[v].empty() && compute_boundary(v);
-  return removed;
 }
 
 }  // namespace parapm

@@ -61,9 +61,9 @@ class CollapseMesh {
         }
   }
 
-  // Merges vt into vs, moves vs to `position`, removes the faces on the edge. The caller has
-  // checked legality. Returns the faces that were removed (left, right, kNoId if absent).
-  EdgeFaces collapse(VertexId vs, VertexId vt, const Vec3& position);
+  // Merges vt into vs, moves vs to `position`, removes the faces on the edge: `edge` must be
+  // edge_faces(vs, vt) of the present mesh (the caller computed it to check legality).
+  void collapse(VertexId vs, VertexId vt, const Vec3& position, const EdgeFaces& edge);
 
  private:
   void remove_face_from(VertexId v, FaceId f);

@@ -66,7 +66,7 @@ CollapseRecord Simplifier::perform(const CollapseCandidate& c, const EdgeFaces& 
     corners(edge.left, c.vs, 0);
     corners(edge.right, c.vt, 3);
   }
-  mesh_.collapse(c.vs, c.vt, c.position);
+  mesh_.collapse(c.vs, c.vt, c.position, edge);
   priority_.collapsed(mesh_, c);
   for (const auto& module : constraints_) module->collapsed(mesh_, c);
   return r;
