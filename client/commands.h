@@ -10,5 +10,6 @@ void add_simplify_command(CLI::App& app, int& exit_code);
 void add_lod_command(CLI::App& app, int& exit_code);
 void add_info_command(CLI::App& app, int& exit_code);
 void add_check_command(CLI::App& app, int& exit_code);
+void add_partition_command(CLI::App& app, int& exit_code);
 
 }  // namespace parapm::cli

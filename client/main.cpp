@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   parapm::cli::add_lod_command(app, exit_code);
   parapm::cli::add_info_command(app, exit_code);
   parapm::cli::add_check_command(app, exit_code);
+  parapm::cli::add_partition_command(app, exit_code);
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
 
   try {

@@ -106,10 +106,24 @@ TEST_F(Cli, BadInputGivesOneClearLine) {
   EXPECT_EQ(r.status, 2) << "--faces or --error is required";
 }
 
+TEST_F(Cli, PartitionReportsTheThesisMetrics) {
+  const std::string mesh = testing::test_data("cad-cycloidal-43k.ply");
+  CliRun r = parapm("partition " + mesh + " -p 4 --json -o " + path("parts.ply"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* field : {"\"p\":4", "\"algo\":\"greedy\"", "\"subset_faces\":",
+                            "\"stddev_faces\":", "\"biggest_faces\":", "\"ideal_faces\":",
+                            "\"cut_faces\":", "\"cut_edges\":", "\"components\":"})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << " in " << r.out;
+  EXPECT_TRUE(fs::exists(path("parts.ply")));
+  r = parapm("partition " + mesh + " -p 3 --weights 1,2");
+  EXPECT_EQ(r.status, 2) << "three subsets need three weights";
+  EXPECT_FALSE(r.err.empty());
+}
+
 TEST_F(Cli, HelpTellsTheCommands) {
   const CliRun r = parapm("--help");
   EXPECT_EQ(r.status, 0);
-  for (const char* command : {"simplify", "lod", "info", "check"})
+  for (const char* command : {"simplify", "lod", "info", "check", "partition"})
     EXPECT_NE(r.out.find(command), std::string::npos) << command;
 }
 

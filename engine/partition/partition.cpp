@@ -1,0 +1,229 @@
+// The parts shared by the partitioning algorithms, and partition_mesh(), which checks the
+// arguments, computes the targets, runs the chosen algorithm and assigns the faces.
+#include "partition/partition.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "partition/partition_internal.h"
+#include "util/error.h"
+
+namespace parapm {
+namespace partition_detail {
+
+uint32_t VertexGraph::max_degree() const {
+  uint32_t result = 0;
+  for (uint32_t v = 0; v < vertex_count(); ++v) result = std::max(result, degree(v));
+  return result;
+}
+
+VertexGraph build_vertex_graph(const Mesh& mesh) {
+  const size_t n = mesh.vertex_count();
+  VertexGraph graph;
+  graph.offsets.assign(n + 1, 0);
+  // Each corner gives its vertex two (possibly repeated) neighbours: count, fill, then drop
+  // repeats row by row with a per-vertex stamp. Linear, no sorting or hashing.
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    for (VertexId v : mesh.faces[f]) {
+      if (v >= n) {
+        throw_invalid("face " + std::to_string(f) + " has vertex " + std::to_string(v) +
+                      " but the mesh has " + std::to_string(n) + " vertices");
+      }
+      graph.offsets[v + 1] += 2;
+    }
+  }
+  for (size_t v = 0; v < n; ++v) graph.offsets[v + 1] += graph.offsets[v];
+  std::vector<uint32_t> neighbours(graph.offsets[n]);
+  std::vector<size_t> fill(graph.offsets.begin(), graph.offsets.end() - 1);
+  for (const Triangle& face : mesh.faces) {
+    for (int c = 0; c < 3; ++c) {
+      const VertexId v = face[c];
+      neighbours[fill[v]++] = face[(c + 1) % 3];
+      neighbours[fill[v]++] = face[(c + 2) % 3];
+    }
+  }
+  std::vector<uint32_t> stamp(n, kNoId);
+  graph.neighbours.reserve(neighbours.size() / 2 + 16);  // closed manifolds: each edge twice
+  size_t out = 0;
+  for (size_t v = 0; v < n; ++v) {
+    const size_t begin = graph.offsets[v], end = graph.offsets[v + 1];
+    graph.offsets[v] = out;
+    for (size_t i = begin; i < end; ++i) {
+      const uint32_t u = neighbours[i];
+      if (u == v || stamp[u] == v) continue;  // a repeated corner, or already listed
+      stamp[u] = uint32_t(v);
+      graph.neighbours.push_back(u);
+      ++out;
+    }
+  }
+  graph.offsets[n] = out;
+  return graph;
+}
+
+BucketQueue::BucketQueue(uint32_t items, uint32_t max_key)
+    : head_(size_t(max_key) + 1, kNoId),
+      tail_(size_t(max_key) + 1, kNoId),
+      next_(items, kNoId),
+      prev_(items, kNoId),
+      key_(items, kNoId),
+      min_key_(max_key + 1) {}
+
+void BucketQueue::insert(uint32_t item, uint32_t key) {
+  key_[item] = key;
+  next_[item] = kNoId;
+  prev_[item] = tail_[key];
+  if (tail_[key] != kNoId) {
+    next_[tail_[key]] = item;
+  } else {
+    head_[key] = item;
+  }
+  tail_[key] = item;
+  min_key_ = std::min(min_key_, key);
+  ++size_;
+}
+
+void BucketQueue::remove(uint32_t item) {
+  const uint32_t key = key_[item];
+  if (prev_[item] != kNoId) {
+    next_[prev_[item]] = next_[item];
+  } else {
+    head_[key] = next_[item];
+  }
+  if (next_[item] != kNoId) {
+    prev_[next_[item]] = prev_[item];
+  } else {
+    tail_[key] = prev_[item];
+  }
+  key_[item] = kNoId;
+  --size_;
+}
+
+uint32_t BucketQueue::min() {
+  if (size_ == 0) return kNoId;
+  while (head_[min_key_] == kNoId) ++min_key_;  // terminates: some bucket is occupied
+  return head_[min_key_];
+}
+
+uint32_t BucketQueue::pop_min() {
+  const uint32_t item = min();
+  if (item != kNoId) remove(item);
+  return item;
+}
+
+std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph) {
+  // Counting sort; degree 0 is given the key past the maximum so that it sorts last.
+  const uint32_t n = graph.vertex_count(), max_degree = graph.max_degree();
+  auto key = [&](uint32_t v) {
+    const uint32_t d = graph.degree(v);
+    return d == 0 ? max_degree + 1 : d;
+  };
+  std::vector<size_t> start(size_t(max_degree) + 3, 0);
+  for (uint32_t v = 0; v < n; ++v) ++start[key(v) + 1];
+  for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+  std::vector<uint32_t> order(n);
+  for (uint32_t v = 0; v < n; ++v) order[start[key(v)]++] = v;
+  return order;
+}
+
+uint32_t first_start_vertex(const VertexGraph& graph, const std::vector<uint32_t>& by_degree,
+                            uint64_t seed) {
+  const uint32_t min_degree = graph.degree(by_degree.front());
+  size_t count = 0;
+  while (count < by_degree.size() && graph.degree(by_degree[count]) == min_degree) ++count;
+  return by_degree[seed % count];
+}
+
+void assign_faces(const Mesh& mesh, Partition& partition) {
+  // Each face is simplified by exactly one worker. Giving it to the subset that owns the
+  // majority of its vertices keeps it with the worker that holds most of its edges (two of
+  // its three edges lie inside that subset), so fewer faces wait for the border pass. When
+  // the three vertices are in three subsets there is no majority: the smallest subset id
+  // wins, which does not depend on which corner happens to be listed first.
+  const auto& vs = partition.vertex_subset;
+  partition.face_subset.resize(mesh.faces.size());
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    const uint32_t a = vs[mesh.faces[f][0]], b = vs[mesh.faces[f][1]], c = vs[mesh.faces[f][2]];
+    uint32_t owner;
+    if (a == b || a == c) {
+      owner = a;
+    } else if (b == c) {
+      owner = b;
+    } else {
+      owner = std::min({a, b, c});
+    }
+    partition.face_subset[f] = owner;
+  }
+}
+
+}  // namespace partition_detail
+
+std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
+                                        const std::vector<double>& weights) {
+  if (p < 1 || p > kMaxPartitionSubsets) {
+    throw_invalid("partition: p must be from 1 to " + std::to_string(kMaxPartitionSubsets) +
+                  ", got " + std::to_string(p));
+  }
+  if (!weights.empty() && weights.size() != p) {
+    throw_invalid("partition: " + std::to_string(weights.size()) +
+                  " weights given for p = " + std::to_string(p) + " subsets");
+  }
+  double sum = 0;
+  for (size_t i = 0; i < weights.size(); ++i) {
+    if (!std::isfinite(weights[i]) || !(weights[i] > 0)) {
+      throw_invalid("partition: weight " + std::to_string(i) + " is " + std::to_string(weights[i]) +
+                    ", weights must be positive and finite");
+    }
+    sum += weights[i];
+  }
+  if (!std::isfinite(sum)) throw_invalid("partition: the weights' sum is not finite");
+  // Largest remainder: floor of each exact share, then one more vertex to the subsets with
+  // the largest fractional parts (ties to the lower subset) until the sizes sum to `vertices`.
+  std::vector<uint32_t> targets(p);
+  std::vector<double> remainder(p);
+  uint64_t given = 0;
+  for (uint32_t i = 0; i < p; ++i) {
+    const double share = weights.empty() ? double(vertices) / p : vertices * (weights[i] / sum);
+    const double whole = std::min(std::floor(share), double(vertices));
+    targets[i] = uint32_t(whole);
+    remainder[i] = share - whole;
+    given += targets[i];
+  }
+  std::vector<uint32_t> order(p);
+  for (uint32_t i = 0; i < p; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t x, uint32_t y) { return remainder[x] > remainder[y]; });
+  // Rounding can leave `given` a little off either way; correct one vertex at a time.
+  for (size_t k = 0; given < vertices; k = (k + 1) % p, ++given) ++targets[order[k]];
+  for (size_t k = p; given > vertices;) {
+    k = (k + p - 1) % p;  // take back from the smallest remainders first
+    if (targets[order[k]] > 0) {
+      --targets[order[k]];
+      --given;
+    }
+  }
+  return targets;
+}
+
+Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& options) {
+  using namespace partition_detail;
+  if (mesh.vertex_count() >= kNoId) throw_invalid("partition: too many vertices");
+  const uint32_t n = uint32_t(mesh.vertex_count());
+  const std::vector<uint32_t> targets = partition_targets(n, p, options.weights);
+  if (p > n) {
+    throw_invalid("partition: p = " + std::to_string(p) + " subsets but the mesh has only " +
+                  std::to_string(n) + " vertices");
+  }
+  if (options.algorithm != "greedy" && options.algorithm != "bfs") {
+    throw_invalid("partition: unknown algorithm '" + options.algorithm +
+                  "' (expected greedy or bfs)");
+  }
+  const VertexGraph graph = build_vertex_graph(mesh);
+  Partition partition = options.algorithm == "greedy"
+                            ? greedy_partition(graph, targets, options.seed)
+                            : bfs_partition(graph, targets, options.seed);
+  assign_faces(mesh, partition);
+  return partition;
+}
+
+}  // namespace parapm

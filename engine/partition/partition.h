@@ -1,0 +1,55 @@
+// Mesh partitioning: splits the vertices of a mesh into p subsets of prescribed relative sizes
+// with few cut edges, so that p workers can each simplify one subset (METHOD.md section 3).
+// Every face is given to exactly one subset (see face_subset below).
+//
+// Algorithms (PartitionOptions::algorithm):
+//  - "greedy": Ciarlet & Lamour's greedy algorithm G (greedy_partition.cpp), O(|E|).
+//  - "bfs":    the intuitive baseline: p spread-out seeds grown round-robin by breadth-first
+//              search (bfs_partition.cpp), O(p |V| + |E|) (seeding dominates for large p).
+// Both are deterministic for a given mesh, p, weights and seed (no hashing, no threads), and
+// handle meshes with boundaries, several connected components and isolated vertices.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mesh/mesh.h"
+
+namespace parapm {
+
+inline constexpr uint32_t kMaxPartitionSubsets = 256;
+
+struct PartitionOptions {
+  std::string algorithm = "greedy";  // "greedy" or "bfs"
+  // Relative size of each subset (worker capacity): empty means equal, otherwise exactly p
+  // positive finite values. Only ratios matter.
+  std::vector<double> weights;
+  // Picks the start vertex among the vertices of minimal degree: the (seed mod count)-th of
+  // them in id order. Different seeds give different, equally valid partitions.
+  uint64_t seed = 1;
+};
+
+struct Partition {
+  std::vector<uint32_t> vertex_subset;  // per vertex, its subset in [0, subsets)
+  // Per face, the subset that simplifies it: the subset owning the majority (2 or 3) of its
+  // vertices; a face whose three vertices are in three subsets goes to the smallest of them.
+  std::vector<uint32_t> face_subset;
+  uint32_t subsets = 0;  // p
+};
+
+// The number of vertices each subset gets: proportional to the weights (equal when empty),
+// rounded by largest remainder (ties to the lower subset) so that they sum to `vertices`.
+// Throws Error(kInvalidInput) for p outside [1, 256] or bad weights (as partition_mesh).
+std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
+                                        const std::vector<double>& weights);
+
+// Partitions `mesh` (any mesh whose faces index existing vertices; a repaired one in practice)
+// into p subsets. Subset i gets exactly partition_targets(...)[i] vertices.
+// Errors, Error(kInvalidInput): p outside [1, 256]; p larger than the vertex count (every
+// subset must be able to hold a vertex; with unequal weights a subset whose share rounds to
+// 0 vertices is allowed and stays empty); weights neither empty nor p positive finite
+// values; an unknown algorithm; a face corner out of range.
+Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& options = {});
+
+}  // namespace parapm

@@ -1,0 +1,75 @@
+// Shared by the partitioning algorithms (not part of the public interface): the vertex graph,
+// a bucket queue keyed by small integers (degrees), and the face rule.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mesh/mesh.h"
+#include "partition/partition.h"
+
+namespace parapm::partition_detail {
+
+// The mesh's edge graph in compressed rows: the neighbours of v are
+// neighbours[offsets[v] .. offsets[v + 1]), each once, in order of first appearance in the
+// faces. Isolated vertices have none. 8 bytes per vertex + 4 bytes per directed edge.
+struct VertexGraph {
+  std::vector<size_t> offsets;  // vertex_count + 1
+  std::vector<uint32_t> neighbours;
+
+  uint32_t vertex_count() const { return uint32_t(offsets.size() - 1); }
+  uint32_t degree(uint32_t v) const { return uint32_t(offsets[v + 1] - offsets[v]); }
+  std::span<const uint32_t> neighbours_of(uint32_t v) const {
+    return {neighbours.data() + offsets[v], neighbours.data() + offsets[v + 1]};
+  }
+  uint32_t max_degree() const;
+};
+
+// O(F + V). Error(kInvalidInput) when a face corner is out of range; repeated corners are
+// ignored (no self loops).
+VertexGraph build_vertex_graph(const Mesh& mesh);
+
+// Items 0..n-1 with integer keys 0..max_key, each in at most once. Insert, remove and changing
+// a key are O(1); pop_min scans up from the lowest key that may be occupied. Equal keys pop in
+// insertion order (a key change counts as a new insertion), so the order is deterministic.
+class BucketQueue {
+ public:
+  BucketQueue(uint32_t items, uint32_t max_key);
+  bool empty() const { return size_ == 0; }
+  bool contains(uint32_t item) const { return key_[item] != kNoId; }
+  void insert(uint32_t item, uint32_t key);
+  void remove(uint32_t item);
+  void set_key(uint32_t item, uint32_t key) {
+    remove(item);
+    insert(item, key);
+  }
+  uint32_t min();  // the item pop_min would return; kNoId when empty
+  uint32_t pop_min();
+
+ private:
+  std::vector<uint32_t> head_, tail_;        // per key
+  std::vector<uint32_t> next_, prev_, key_;  // per item; key_ kNoId when absent
+  uint32_t min_key_ = 0;                     // no occupied key is below it
+  size_t size_ = 0;
+};
+
+// Vertices sorted by degree (stable: ties by id), vertices of degree 0 last: isolated vertices
+// are never chosen to start a subset while a vertex with edges is free.
+std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph);
+
+// The start vertex of the first subset: among the vertices of minimal (non-zero) degree, the
+// (seed mod count)-th in id order.
+uint32_t first_start_vertex(const VertexGraph& graph, const std::vector<uint32_t>& by_degree,
+                            uint64_t seed);
+
+// Fills partition.face_subset from partition.vertex_subset (the rule in partition.h).
+void assign_faces(const Mesh& mesh, Partition& partition);
+
+Partition greedy_partition(const VertexGraph& graph, const std::vector<uint32_t>& targets,
+                           uint64_t seed);
+Partition bfs_partition(const VertexGraph& graph, const std::vector<uint32_t>& targets,
+                        uint64_t seed);
+
+}  // namespace parapm::partition_detail

@@ -1,0 +1,252 @@
+// partition_mesh() on tiny meshes drawn below, with exact expectations, and its argument
+// checks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "mesh/mesh.h"
+#include "partition/partition.h"
+#include "partition/partition_metrics.h"
+#include "util/error.h"
+
+namespace parapm {
+namespace {
+
+using Subsets = std::vector<uint32_t>;
+
+PartitionOptions options(const char* algorithm, uint64_t seed = 1,
+                         std::vector<double> weights = {}) {
+  PartitionOptions result;
+  result.algorithm = algorithm;
+  result.seed = seed;
+  result.weights = std::move(weights);
+  return result;
+}
+
+Mesh make_mesh(uint32_t vertices, std::vector<Triangle> faces) {
+  Mesh mesh;
+  for (uint32_t v = 0; v < vertices; ++v) mesh.positions.push_back({double(v), 0, 0});
+  mesh.faces = std::move(faces);
+  return mesh;
+}
+
+// A strip of 8 faces:
+//   0---1---2---3---4
+//   | \ | \ | \ | \ |
+//   5---6---7---8---9
+Mesh strip() {
+  std::vector<Triangle> faces;
+  for (uint32_t i = 0; i < 4; ++i) {
+    faces.push_back({i, i + 5, i + 6});
+    faces.push_back({i, i + 6, i + 1});
+  }
+  return make_mesh(10, faces);
+}
+
+// Two triangles that share nothing, and (with_isolated) a vertex that no face uses.
+//   0       3
+//   | \     | \        6
+//   1---2   4---5
+Mesh two_triangles(bool with_isolated) {
+  return make_mesh(with_isolated ? 7 : 6, {{0, 1, 2}, {3, 4, 5}});
+}
+
+// An n x n grid of vertices (id = row * n + column), each square split by its diagonal from
+// the top-left corner: 2 (n-1)^2 faces.
+Mesh grid(uint32_t n) {
+  std::vector<Triangle> faces;
+  for (uint32_t r = 0; r + 1 < n; ++r) {
+    for (uint32_t c = 0; c + 1 < n; ++c) {
+      const uint32_t v = r * n + c;
+      faces.push_back({v, v + n, v + n + 1});
+      faces.push_back({v, v + n + 1, v + 1});
+    }
+  }
+  return make_mesh(n * n, faces);
+}
+
+void expect_valid(const Mesh& mesh, const Partition& partition, uint32_t p,
+                  const std::vector<double>& weights = {}) {
+  ASSERT_EQ(partition.subsets, p);
+  ASSERT_EQ(partition.vertex_subset.size(), mesh.vertex_count());
+  ASSERT_EQ(partition.face_subset.size(), mesh.face_count());
+  std::vector<uint32_t> sizes(p, 0);
+  for (uint32_t s : partition.vertex_subset) {
+    ASSERT_LT(s, p);
+    ++sizes[s];
+  }
+  EXPECT_EQ(sizes, partition_targets(uint32_t(mesh.vertex_count()), p, weights));
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    // The face rule: the majority subset of its vertices, else the smallest.
+    const auto& face = mesh.faces[f];
+    const uint32_t a = partition.vertex_subset[face[0]], b = partition.vertex_subset[face[1]],
+                   c = partition.vertex_subset[face[2]];
+    const uint32_t expected = (a == b || a == c) ? a : b == c ? b : std::min({a, b, c});
+    EXPECT_EQ(partition.face_subset[f], expected) << "face " << f;
+  }
+}
+
+TEST(PartitionTargets, EqualWeightsSplitTheRemainderToTheLowerSubsets) {
+  EXPECT_EQ(partition_targets(10, 3, {}), (Subsets{4, 3, 3}));
+  EXPECT_EQ(partition_targets(10, 1, {}), (Subsets{10}));
+  EXPECT_EQ(partition_targets(7, 2, {}), (Subsets{4, 3}));
+}
+
+TEST(PartitionTargets, WeightsGiveProportionalShares) {
+  EXPECT_EQ(partition_targets(10, 4, {1, 2, 3, 4}), (Subsets{1, 2, 3, 4}));
+  EXPECT_EQ(partition_targets(100, 4, {1, 2, 3, 4}), (Subsets{10, 20, 30, 40}));
+  // 11 * (1/6, 2/6, 3/6) = 1.83, 3.67, 5.5: floors 1, 3, 5, remainders .83, .67, .5.
+  EXPECT_EQ(partition_targets(11, 3, {1, 2, 3}), (Subsets{2, 4, 5}));
+  // A share that rounds to no vertex leaves its subset empty.
+  EXPECT_EQ(partition_targets(4, 2, {1, 1000}), (Subsets{0, 4}));
+}
+
+TEST(PartitionTargets, RejectsBadArguments) {
+  EXPECT_THROW(partition_targets(10, 0, {}), Error);
+  EXPECT_THROW(partition_targets(1000, 257, {}), Error);
+  EXPECT_THROW(partition_targets(10, 2, {1}), Error);
+  EXPECT_THROW(partition_targets(10, 2, {1, 0}), Error);
+  EXPECT_THROW(partition_targets(10, 2, {1, -1}), Error);
+  EXPECT_THROW(partition_targets(10, 2, {1, std::nan("")}), Error);
+  EXPECT_THROW(partition_targets(10, 2, {1, std::numeric_limits<double>::infinity()}), Error);
+  EXPECT_NO_THROW(partition_targets(1000, 256, {}));
+}
+
+TEST(PartitionMesh, RejectsBadArguments) {
+  const Mesh mesh = strip();
+  try {
+    partition_mesh(mesh, 11, {});
+    FAIL() << "p larger than the vertex count was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
+    EXPECT_NE(std::string(e.what()).find("only 10 vertices"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(partition_mesh(mesh, 0, {}), Error);
+  EXPECT_THROW(partition_mesh(mesh, 2, options("metis")), Error);
+  EXPECT_THROW(partition_mesh(mesh, 2, options("greedy", 1, {1, 2, 3})), Error);
+  Mesh broken = mesh;
+  broken.faces[3][1] = 10;
+  EXPECT_THROW(partition_mesh(broken, 2, {}), Error);
+  EXPECT_THROW(partition_mesh(Mesh{}, 1, {}), Error);
+}
+
+TEST(PartitionMesh, PIsOneGivesEverythingToSubsetZero) {
+  for (const char* algorithm : {"greedy", "bfs"}) {
+    const Mesh mesh = grid(4);
+    const Partition partition = partition_mesh(mesh, 1, options(algorithm));
+    expect_valid(mesh, partition, 1);
+    EXPECT_EQ(partition.vertex_subset, Subsets(16, 0));
+    EXPECT_EQ(partition.face_subset, Subsets(18, 0));
+  }
+}
+
+TEST(PartitionMesh, PEqualToTheVertexCountGivesOneVertexEach) {
+  for (const char* algorithm : {"greedy", "bfs"}) {
+    const Mesh mesh = strip();
+    const Partition partition = partition_mesh(mesh, 10, options(algorithm));
+    expect_valid(mesh, partition, 10);
+  }
+}
+
+TEST(GreedyPartition, StripSplitsIntoLeftAndRightHalves) {
+  // Minimal degree 2: vertices 4 and 5; seed 1 picks the second, 5. Fronts from 5: {5},
+  // {0, 6}, {1, 7} -> 5 vertices, the target. The last subset takes the rest.
+  const Mesh mesh = strip();
+  const Partition partition = partition_mesh(mesh, 2, {});
+  expect_valid(mesh, partition, 2);
+  EXPECT_EQ(partition.vertex_subset, (Subsets{0, 0, 1, 1, 1, 0, 0, 0, 1, 1}));
+  // Face (1, 7, 2) has two vertices in subset 0; (2, 7, 8) two in subset 1.
+  EXPECT_EQ(partition.face_subset, (Subsets{0, 0, 0, 0, 1, 1, 1, 1}));
+  const PartitionMetrics metrics = partition_metrics(mesh, partition);
+  EXPECT_EQ(metrics.subset_faces, (std::vector<uint64_t>{4, 4}));
+  EXPECT_EQ(metrics.cut_edges, 3u);  // 1-2, 7-2, 7-8
+  EXPECT_EQ(metrics.cut_faces, 2u);
+  EXPECT_EQ(metrics.components, (Subsets{1, 1}));
+  EXPECT_EQ(metrics.biggest_faces, 4u);
+  EXPECT_DOUBLE_EQ(metrics.ideal_faces, 4.0);
+  EXPECT_DOUBLE_EQ(metrics.stddev_faces, 0.0);
+
+  // Seed 0 picks vertex 4: the right half first ({4}, {3, 9}, {2, 8}).
+  const Partition mirrored = partition_mesh(mesh, 2, options("greedy", 0));
+  EXPECT_EQ(mirrored.vertex_subset, (Subsets{1, 1, 0, 0, 0, 1, 1, 1, 0, 0}));
+}
+
+TEST(GreedyPartition, OvershootingFrontTakesMinimalUpdatedDegreeFirst) {
+  // p = 3 on the strip: targets 4, 3, 3. Subset 0 from 5: {5}, {0, 6} (3 vertices), then the
+  // front {1, 7} has room for one: after marking 0, 5, 6 the updated degrees are 1: {2} -> 1,
+  // 7: {2, 8} -> 2, so 1 is taken.
+  const Mesh mesh = strip();
+  const Partition partition = partition_mesh(mesh, 3, {});
+  expect_valid(mesh, partition, 3);
+  EXPECT_EQ(partition.vertex_subset[1], 0u);
+  EXPECT_EQ(partition.vertex_subset[7], 1u);  // subset 1 starts next to subset 0
+}
+
+TEST(GreedyPartition, LockedInSubsetContinuesInTheNextComponent) {
+  // Targets 4, 3: subset 0 fills the triangle {0, 1, 2} (start 1: degree 2, seed 1), is locked
+  // in and continues at the unmarked vertex of minimal degree, 3. The isolated vertex comes
+  // last and ends in the last subset.
+  const Mesh mesh = two_triangles(true);
+  const Partition partition = partition_mesh(mesh, 2, {});
+  expect_valid(mesh, partition, 2);
+  EXPECT_EQ(partition.vertex_subset, (Subsets{0, 0, 0, 0, 1, 1, 1}));
+  EXPECT_EQ(partition.face_subset, (Subsets{0, 1}));
+  const PartitionMetrics metrics = partition_metrics(mesh, partition);
+  EXPECT_EQ(metrics.components, (Subsets{2, 2}));  // {0,1,2} + {3}; {4,5} + {6}
+  EXPECT_EQ(metrics.cut_edges, 2u);
+  EXPECT_EQ(metrics.cut_faces, 1u);
+}
+
+TEST(GreedyPartition, DisconnectedTrianglesOnePerSubset) {
+  const Mesh mesh = two_triangles(false);
+  for (const char* algorithm : {"greedy", "bfs"}) {
+    const Partition partition = partition_mesh(mesh, 2, options(algorithm));
+    expect_valid(mesh, partition, 2);
+    EXPECT_EQ(partition.vertex_subset, (Subsets{0, 0, 0, 1, 1, 1})) << algorithm;
+    EXPECT_EQ(partition_metrics(mesh, partition).cut_edges, 0u) << algorithm;
+  }
+}
+
+TEST(GreedyPartition, IsolatedVerticesOnlyStillGetAssigned) {
+  const Mesh mesh = make_mesh(5, {});
+  for (const char* algorithm : {"greedy", "bfs"}) {
+    const Partition partition = partition_mesh(mesh, 2, options(algorithm));
+    expect_valid(mesh, partition, 2);
+  }
+}
+
+TEST(PartitionMesh, GridQuartersAreConnectedAndDeterministic) {
+  const Mesh mesh = grid(8);  // 64 vertices, 98 faces
+  for (const char* algorithm : {"greedy", "bfs"}) {
+    for (uint64_t seed : {0, 1, 7}) {
+      const PartitionOptions opts = options(algorithm, seed);
+      const Partition partition = partition_mesh(mesh, 4, opts);
+      expect_valid(mesh, partition, 4);
+      const Partition again = partition_mesh(mesh, 4, opts);
+      EXPECT_EQ(partition.vertex_subset, again.vertex_subset);
+      EXPECT_EQ(partition.face_subset, again.face_subset);
+      const PartitionMetrics metrics = partition_metrics(mesh, partition, opts);
+      EXPECT_EQ(metrics.components, (Subsets{1, 1, 1, 1})) << algorithm << " seed " << seed;
+      EXPECT_LE(metrics.biggest_faces, 30u) << algorithm;  // ideal 24.5
+    }
+  }
+}
+
+TEST(PartitionMesh, WeightedGrid) {
+  const Mesh mesh = grid(10);  // 100 vertices
+  for (const char* algorithm : {"greedy", "bfs"}) {
+    const PartitionOptions opts = options(algorithm, 1, {1, 2, 3, 4});
+    const Partition partition = partition_mesh(mesh, 4, opts);
+    expect_valid(mesh, partition, 4, opts.weights);  // 10, 20, 30, 40 vertices
+  }
+}
+
+TEST(PartitionMetrics, RejectsAPartitionOfAnotherMesh) {
+  const Partition partition = partition_mesh(strip(), 2, {});
+  EXPECT_THROW(partition_metrics(grid(3), partition), Error);
+}
+
+}  // namespace
+}  // namespace parapm
