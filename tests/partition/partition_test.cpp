@@ -9,6 +9,7 @@
 #include "mesh/mesh.h"
 #include "partition/partition.h"
 #include "partition/partition_metrics.h"
+#include "partition_expectations.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -65,27 +66,6 @@ Mesh grid(uint32_t n) {
     }
   }
   return make_mesh(n * n, faces);
-}
-
-void expect_valid(const Mesh& mesh, const Partition& partition, uint32_t p,
-                  const std::vector<double>& weights = {}) {
-  ASSERT_EQ(partition.subsets, p);
-  ASSERT_EQ(partition.vertex_subset.size(), mesh.vertex_count());
-  ASSERT_EQ(partition.face_subset.size(), mesh.face_count());
-  std::vector<uint32_t> sizes(p, 0);
-  for (uint32_t s : partition.vertex_subset) {
-    ASSERT_LT(s, p);
-    ++sizes[s];
-  }
-  EXPECT_EQ(sizes, partition_targets(uint32_t(mesh.vertex_count()), p, weights));
-  for (size_t f = 0; f < mesh.face_count(); ++f) {
-    // The face rule: the majority subset of its vertices, else the smallest.
-    const auto& face = mesh.faces[f];
-    const uint32_t a = partition.vertex_subset[face[0]], b = partition.vertex_subset[face[1]],
-                   c = partition.vertex_subset[face[2]];
-    const uint32_t expected = (a == b || a == c) ? a : b == c ? b : std::min({a, b, c});
-    EXPECT_EQ(partition.face_subset[f], expected) << "face " << f;
-  }
 }
 
 TEST(PartitionTargets, EqualWeightsSplitTheRemainderToTheLowerSubsets) {
