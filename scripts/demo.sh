@@ -46,6 +46,7 @@ for pct in 50 10 2; do
 done
 printf '\nseconds: time to read the .pm, cut the level and write it. bound/diag: the PM'"'"'s own\n'
 printf 'error bound for that level (RMS distance to the collapsed planes) over the bounding-box\n'
-printf 'diagonal. rms/diag, hausdorff/diag: measured by metro, the independent judge of ../shared/tools.\n'
+printf 'diagonal.\n'
+[[ -n "$metro" ]] && printf 'rms/diag, hausdorff/diag: measured by metro, the independent judge of ../shared/tools.\n'
 [[ -z "$metro" ]] && printf 'For measured errors, build the judge: ../shared/tools/build.sh .peers-build\n'
 printf 'Levels of detail written to %s/%s.lod{50,10,2}.obj\n' "$out" "$name"
