@@ -105,7 +105,7 @@ void add_partition_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"greedy", "bfs"}))
       ->capture_default_str();
   cmd->add_option("--weights", args->weights,
-                  "Relative subset sizes (worker capacities), P comma-separated values")
+                  "Relative subset sizes in vertices (worker capacities), P comma-separated values")
       ->delimiter(',');
   cmd->add_option("--seed", args->seed, "Chooses among equally good start vertices")
       ->capture_default_str();
