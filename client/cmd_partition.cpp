@@ -95,8 +95,9 @@ void add_partition_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<PartitionArgs>();
   CLI::App* cmd =
       app.add_subcommand("partition",
-                         "Split a mesh into P subsets for parallel simplification (Ciarlet-Lamour "
-                         "greedy, or round-robin BFS) and report the thesis' metrics");
+                         "Split a mesh into P subsets of balanced vertex counts for parallel "
+                         "simplification (Ciarlet-Lamour greedy, or round-robin BFS) and report "
+                         "the thesis' metrics");
   cmd->add_option("input", args->input, "Input mesh")->required()->check(CLI::ExistingFile);
   cmd->add_option("-p", args->p, "Number of subsets, 1 to 256")
       ->required()
