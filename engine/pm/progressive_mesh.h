@@ -55,11 +55,11 @@ struct WedgeChange {
 };
 
 struct PmInfo {
-  std::string metric;             // "quadric", "energy"
-  uint64_t input_vertices = 0;    // of the input as read, before repairs
-  uint64_t input_faces = 0;       // triangles of the input as read (polygons fan-split)
-  double seconds = 0;             // construction time; in memory only (not in the .pm, whose
-                                  // bytes depend only on the input and the options)
+  std::string metric;           // "quadric", "energy"
+  uint64_t input_vertices = 0;  // of the input as read, before repairs
+  uint64_t input_faces = 0;     // triangles of the input as read (polygons fan-split)
+  double seconds = 0;           // construction time; in memory only (not in the .pm, whose
+                                // bytes depend only on the input and the options)
 };
 
 struct ProgressiveMesh {
