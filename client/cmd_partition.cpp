@@ -21,6 +21,7 @@ struct PartitionArgs {
   std::string algorithm = "greedy";
   std::vector<double> weights;
   uint64_t seed = 1;
+  std::string balance = "faces";
   bool json = false;
 };
 
@@ -55,6 +56,7 @@ int run_partition(const PartitionArgs& args) {
   options.algorithm = args.algorithm;
   options.weights = args.weights;
   options.seed = args.seed;
+  options.balance = args.balance == "vertices" ? Balance::kVertices : Balance::kFaces;
   const auto start = std::chrono::steady_clock::now();
   const Partition partition = partition_mesh(mesh, args.p, options);
   const double seconds = seconds_since(start);
@@ -95,9 +97,9 @@ void add_partition_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<PartitionArgs>();
   CLI::App* cmd =
       app.add_subcommand("partition",
-                         "Split a mesh into P subsets of balanced vertex counts for parallel "
-                         "simplification (Ciarlet-Lamour greedy, or round-robin BFS) and report "
-                         "the thesis' metrics");
+                         "Split a mesh into P subsets for parallel simplification (Ciarlet-Lamour "
+                         "greedy, or round-robin BFS), balanced by faces (or vertices), and "
+                         "report the thesis' metrics");
   cmd->add_option("input", args->input, "Input mesh")->required()->check(CLI::ExistingFile);
   cmd->add_option("-p", args->p, "Number of subsets, 1 to 256")
       ->required()
@@ -106,8 +108,12 @@ void add_partition_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"greedy", "bfs"}))
       ->capture_default_str();
   cmd->add_option("--weights", args->weights,
-                  "Relative subset sizes in vertices (worker capacities), P comma-separated values")
+                  "Relative subset sizes (worker capacities), P comma-separated values")
       ->delimiter(',');
+  cmd->add_option("--balance", args->balance,
+                  "What the subset sizes count: faces (each vertex weighs its faces) or vertices")
+      ->check(CLI::IsMember({"faces", "vertices"}))
+      ->capture_default_str();
   cmd->add_option("--seed", args->seed, "Chooses among equally good start vertices")
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,

@@ -53,7 +53,7 @@ std::vector<uint32_t> spread_seeds(const VertexGraph& graph, uint32_t count, uin
 
 }  // namespace
 
-Partition bfs_partition(const VertexGraph& graph, const std::vector<uint32_t>& targets,
+Partition bfs_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
                         uint64_t seed) {
   const uint32_t n = graph.vertex_count(), p = uint32_t(targets.size());
   Partition partition;
@@ -72,10 +72,10 @@ Partition bfs_partition(const VertexGraph& graph, const std::vector<uint32_t>& t
   // once, so all queues together see at most 2 |E| pushes.
   std::vector<std::vector<uint32_t>> queue(p);
   std::vector<size_t> head(p, 0);
-  std::vector<uint32_t> size(p, 0);
+  std::vector<uint64_t> size(p, 0);  // the members' weights
   auto mark = [&](uint32_t v, uint32_t k) {
     subset[v] = k;
-    ++size[k];
+    size[k] += graph.weight[v];
     for (uint32_t u : graph.neighbours_of(v)) {
       if (subset[u] == kNoId) queue[k].push_back(u);
     }
@@ -123,9 +123,9 @@ Partition bfs_partition(const VertexGraph& graph, const std::vector<uint32_t>& t
       }
     }
     for (uint32_t v : order) {
-      while (size[k] >= targets[k]) ++k;  // the deficits sum to the vertices left
+      while (k + 1 < p && size[k] >= targets[k]) ++k;  // the last subset takes any excess
       subset[v] = k;
-      ++size[k];
+      size[k] += graph.weight[v];
     }
   }
   return partition;

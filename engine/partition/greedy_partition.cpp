@@ -16,7 +16,7 @@
 
 namespace parapm::partition_detail {
 
-Partition greedy_partition(const VertexGraph& graph, const std::vector<uint32_t>& targets,
+Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
                            uint64_t seed) {
   const uint32_t n = graph.vertex_count(), p = uint32_t(targets.size());
   const uint32_t max_degree = graph.max_degree();
@@ -65,9 +65,10 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint32_t>
   bool first = true;
   // The last subset takes what remains; the others are grown.
   for (uint32_t k = 0; k + 1 < p; ++k) {
-    const uint32_t target = targets[k];
+    const uint64_t target = targets[k];
     if (target == 0) continue;  // a weight too small to be worth a vertex
     members.clear();
+    uint64_t taken = 0;  // the members' weights
 
     // Start vertex: for the first subset, a vertex of minimal degree (a corner or a boundary
     // of the mesh); for the others, the unmarked neighbour of the previous subset with minimal
@@ -90,7 +91,7 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint32_t>
     }
     front.assign(1, start);
 
-    while (members.size() < target) {
+    while (taken < target) {
       if (front.empty()) {
         // Locked in: no unmarked neighbour, still below target. Continue from a new seed
         // (the subset becomes multi-connected) rather than restart the whole partition.
@@ -98,12 +99,14 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint32_t>
         if (s == kNoId) break;  // cannot happen: the targets sum to n; kept for safety
         front.assign(1, s);
       }
-      const size_t remaining = target - members.size();
-      if (front.size() <= remaining) {
+      uint64_t front_weight = 0;
+      for (uint32_t v : front) front_weight += graph.weight[v];
+      if (taken + front_weight <= target) {
         for (uint32_t v : front) {
           mark(v, k);
           members.push_back(v);
         }
+        taken += front_weight;
         ++front_number;
         next_front.clear();
         for (uint32_t v : front) {
@@ -118,10 +121,11 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint32_t>
         // The front would overshoot: take its vertices of minimal updated degree first
         // (updated as they are taken), which leaves the fewest unmarked vertices cut off.
         for (uint32_t v : front) partial_front.insert(v, updated_degree[v]);
-        while (members.size() < target) {
+        while (taken < target) {
           const uint32_t v = partial_front.pop_min();
           mark(v, k);
           members.push_back(v);
+          taken += graph.weight[v];
         }
         for (uint32_t v : front) {
           if (partial_front.contains(v)) partial_front.remove(v);

@@ -158,8 +158,10 @@ void assign_faces(const Mesh& mesh, Partition& partition) {
 
 }  // namespace partition_detail
 
-std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
-                                        const std::vector<double>& weights) {
+namespace partition_detail {
+
+std::vector<uint64_t> share_targets(uint64_t vertices, uint32_t p,
+                                    const std::vector<double>& weights) {
   if (p < 1 || p > kMaxPartitionSubsets) {
     throw_invalid("partition: p must be from 1 to " + std::to_string(kMaxPartitionSubsets) +
                   ", got " + std::to_string(p));
@@ -179,13 +181,14 @@ std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
   if (!std::isfinite(sum)) throw_invalid("partition: the weights' sum is not finite");
   // Largest remainder: floor of each exact share, then one more vertex to the subsets with
   // the largest fractional parts (ties to the lower subset) until the sizes sum to `vertices`.
-  std::vector<uint32_t> targets(p);
+  std::vector<uint64_t> targets(p);
   std::vector<double> remainder(p);
   uint64_t given = 0;
   for (uint32_t i = 0; i < p; ++i) {
-    const double share = weights.empty() ? double(vertices) / p : vertices * (weights[i] / sum);
+    const double share =
+        weights.empty() ? double(vertices) / p : double(vertices) * (weights[i] / sum);
     const double whole = std::min(std::floor(share), double(vertices));
-    targets[i] = uint32_t(whole);
+    targets[i] = uint64_t(whole);
     remainder[i] = share - whole;
     given += targets[i];
   }
@@ -205,11 +208,19 @@ std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
   return targets;
 }
 
+}  // namespace partition_detail
+
+std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
+                                        const std::vector<double>& weights) {
+  const std::vector<uint64_t> shares = partition_detail::share_targets(vertices, p, weights);
+  return std::vector<uint32_t>(shares.begin(), shares.end());
+}
+
 Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& options) {
   using namespace partition_detail;
   if (mesh.vertex_count() >= kNoId) throw_invalid("partition: too many vertices");
   const uint32_t n = uint32_t(mesh.vertex_count());
-  const std::vector<uint32_t> targets = partition_targets(n, p, options.weights);
+  partition_targets(n, p, options.weights);  // validates p and the weights
   if (p > n) {
     throw_invalid("partition: p = " + std::to_string(p) + " subsets but the mesh has only " +
                   std::to_string(n) + " vertices");
@@ -218,7 +229,14 @@ Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& o
     throw_invalid("partition: unknown algorithm '" + options.algorithm +
                   "' (expected greedy or bfs)");
   }
-  const VertexGraph graph = build_vertex_graph(mesh);
+  VertexGraph graph = build_vertex_graph(mesh);
+  graph.weight.assign(n, options.balance == Balance::kVertices ? 1 : 0);
+  if (options.balance == Balance::kFaces)
+    for (const Triangle& face : mesh.faces)
+      for (VertexId v : face) ++graph.weight[v];
+  uint64_t total = 0;
+  for (uint32_t w : graph.weight) total += w;
+  const std::vector<uint64_t> targets = share_targets(total, p, options.weights);
   Partition partition = options.algorithm == "greedy"
                             ? greedy_partition(graph, targets, options.seed)
                             : bfs_partition(graph, targets, options.seed);

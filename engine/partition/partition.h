@@ -20,6 +20,13 @@ namespace parapm {
 
 inline constexpr uint32_t kMaxPartitionSubsets = 256;
 
+// What the subsets' shares count. The workers' work grows with faces, and the balance
+// bound is on faces, so faces is the default: a vertex then weighs the number of faces around
+// it (each face counts once at each of its three corners). Vertex counts are the thesis'
+// original measure; they drift from face counts where vertices have few faces (meshes that
+// the repair step cut into many pieces).
+enum class Balance { kFaces, kVertices };
+
 struct PartitionOptions {
   std::string algorithm = "greedy";  // "greedy" or "bfs"
   // Relative size of each subset (worker capacity): empty means equal, otherwise exactly p
@@ -28,6 +35,7 @@ struct PartitionOptions {
   // Picks the start vertex among the vertices of minimal degree: the (seed mod count)-th of
   // them in id order. Different seeds give different, equally valid partitions.
   uint64_t seed = 1;
+  Balance balance = Balance::kFaces;
 };
 
 struct Partition {

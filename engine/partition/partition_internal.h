@@ -18,6 +18,9 @@ namespace parapm::partition_detail {
 struct VertexGraph {
   std::vector<size_t> offsets;  // vertex_count + 1
   std::vector<uint32_t> neighbours;
+  // What a vertex counts for in its subset's share: 1 (Balance::kVertices) or its number of
+  // faces (Balance::kFaces). Set by partition_mesh.
+  std::vector<uint32_t> weight;
 
   uint32_t vertex_count() const { return uint32_t(offsets.size() - 1); }
   uint32_t degree(uint32_t v) const { return uint32_t(offsets[v + 1] - offsets[v]); }
@@ -67,9 +70,14 @@ uint32_t first_start_vertex(const VertexGraph& graph, const std::vector<uint32_t
 // Fills partition.face_subset from partition.vertex_subset (the rule in partition.h).
 void assign_faces(const Mesh& mesh, Partition& partition);
 
-Partition greedy_partition(const VertexGraph& graph, const std::vector<uint32_t>& targets,
+// Shares of `total` proportional to the weights (equal when empty), by largest remainder.
+std::vector<uint64_t> share_targets(uint64_t total, uint32_t p, const std::vector<double>& weights);
+
+// `targets` are in units of VertexGraph::weight: a subset is grown until its vertices' weights
+// reach its target (overshooting by less than one vertex's weight), the last takes the rest.
+Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
                            uint64_t seed);
-Partition bfs_partition(const VertexGraph& graph, const std::vector<uint32_t>& targets,
+Partition bfs_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
                         uint64_t seed);
 
 }  // namespace parapm::partition_detail
