@@ -22,6 +22,7 @@ struct PartitionArgs {
   std::vector<double> weights;
   uint64_t seed = 1;
   std::string balance = "faces";
+  bool refine = false;
   bool json = false;
 };
 
@@ -57,6 +58,7 @@ int run_partition(const PartitionArgs& args) {
   options.weights = args.weights;
   options.seed = args.seed;
   options.balance = args.balance == "vertices" ? Balance::kVertices : Balance::kFaces;
+  options.refine = args.refine;
   const auto start = std::chrono::steady_clock::now();
   const Partition partition = partition_mesh(mesh, args.p, options);
   const double seconds = seconds_since(start);
@@ -118,6 +120,9 @@ void add_partition_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
                   "Write the mesh with one vertex colour per subset (.ply or .obj)");
+  cmd->add_flag("--refine", args->refine,
+                "Then move boundary vertices and stray pieces to cut fewer edges, keeping every "
+                "subset within 5% of its share");
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args, &exit_code] { exit_code = run_partition(*args); });
 }

@@ -240,6 +240,7 @@ Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& o
   Partition partition = options.algorithm == "greedy"
                             ? greedy_partition(graph, targets, options.seed)
                             : bfs_partition(graph, targets, options.seed);
+  if (options.refine) refine_partition(graph, targets, partition);
   assign_faces(mesh, partition);
   return partition;
 }

@@ -36,6 +36,9 @@ struct PartitionOptions {
   // them in id order. Different seeds give different, equally valid partitions.
   uint64_t seed = 1;
   Balance balance = Balance::kFaces;
+  // After the algorithm: move boundary vertices and stray components to cut fewer edges,
+  // within the balance bound (refine_partition.cpp).
+  bool refine = false;
 };
 
 struct Partition {

@@ -117,6 +117,40 @@ TEST(PartitionRealMeshes, OtherSeedsAreValidToo) {
 // missed on the meshes the repair step cuts into many small pieces (openfoam-motorbike-332k
 // up to 3.01, stanford-dragon-res3/res4 up to 1.17/1.30, cad-cycloidal-43k 1.057), because
 // equal vertex counts are not equal face counts there.
+// Refinement never makes things worse: fewer or as many cut edges and components, the same
+// balance bound, deterministic.
+void expect_refinement_helps(const std::string& name, const Mesh& mesh, uint32_t p) {
+  PartitionOptions plain = options("greedy");
+  PartitionOptions refined = plain;
+  refined.refine = true;
+  const Partition a = partition_mesh(mesh, p, plain);
+  const Partition b = partition_mesh(mesh, p, refined);
+  EXPECT_EQ(b.vertex_subset, partition_mesh(mesh, p, refined).vertex_subset);
+  const PartitionMetrics ma = partition_metrics(mesh, a, plain);
+  const PartitionMetrics mb = partition_metrics(mesh, b, refined);
+  ASSERT_EQ(b.vertex_subset.size(), mesh.vertex_count());
+  for (uint32_t s : b.vertex_subset) ASSERT_LT(s, p);
+  EXPECT_LE(mb.cut_edges, ma.cut_edges) << name << " p=" << p;
+  EXPECT_LE(double(mb.biggest_faces), std::max(1.05 * mb.ideal_faces, double(ma.biggest_faces)))
+      << name << " p=" << p;
+  const auto total = [](const std::vector<uint32_t>& c) {
+    return std::accumulate(c.begin(), c.end(), uint64_t(0));
+  };
+  EXPECT_LE(total(mb.components), total(ma.components)) << name << " p=" << p;
+  std::printf(
+      "%-34s refine p=%-3u cut_edges %6llu -> %6llu  components %6llu -> %6llu  B/ideal %.4f\n",
+      name.c_str(), p, (unsigned long long)ma.cut_edges, (unsigned long long)mb.cut_edges,
+      (unsigned long long)total(ma.components), (unsigned long long)total(mb.components),
+      double(mb.biggest_faces) / mb.ideal_faces);
+}
+
+TEST(PartitionRealMeshes, RefinementCutsFewerEdgesWithinTheBound) {
+  for (const char* name : kCommitted) {
+    const Mesh mesh = read_repaired(testing::test_data(name));
+    for (uint32_t p : {2u, 8u, 32u}) expect_refinement_helps(name, mesh, p);
+  }
+}
+
 TEST(PartitionSharedMeshes, GreedyBiggestSubsetWithinFivePercent) {
   const auto files = testing::shared_meshes();
   if (files.empty()) GTEST_SKIP() << "no shared meshes folder at " << testing::shared_meshes_dir();
@@ -132,6 +166,7 @@ TEST(PartitionSharedMeshes, GreedyBiggestSubsetWithinFivePercent) {
       const PartitionMetrics metrics = partition_metrics(mesh, run.partition, opts, run.seconds);
       print_line(name, metrics);
       EXPECT_LE(metrics.biggest_faces, 1.05 * metrics.ideal_faces) << "p=" << p;
+      if (p == 4 || p == 16) expect_refinement_helps(name, mesh, p);
     }
   }
 }
