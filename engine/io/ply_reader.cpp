@@ -465,76 +465,74 @@ class PlyBody {
     mesh_.faces.push_back({a, b, c});
   }
 
-  void read_faces(const PlyElement& e) {
+  // Calls visit(list property, record index) once per record of `e` at its vertex index
+  // list, skipping the record's other properties: faces and strips differ only in the visit.
+  template <typename Visit>
+  void for_each_index_list(const PlyElement& e, Visit visit) {
     const int list = index_list(ctx_, e);
-    mesh_.faces.reserve(mesh_.faces.size() + size_t(e.count));
-    ReadReport& report = *ctx_.report;
     for (uint64_t i = 0; i < e.count; ++i) {
       src_.begin_record(e, i);
       for (size_t k = 0; k < e.properties.size(); ++k) {
-        const PlyProperty& p = e.properties[k];
-        if (int(k) != list) {
-          skip_property(p);
-          continue;
-        }
-        const uint64_t at = src_.mark();
-        const uint64_t n = src_.list_count(p);
-        if (n < 3)
-          src_.fail_at(
-              at, record_name(e, i) + " has " + std::to_string(n) + " vertices, at least 3 needed");
-        const VertexId first = VertexId(read_index(p, e, i, false));
-        VertexId previous = VertexId(read_index(p, e, i, false));
-        for (uint64_t j = 2; j < n; ++j) {
-          const VertexId current = VertexId(read_index(p, e, i, false));
-          add_triangle(first, previous, current);
-          previous = current;
-        }
-        ++report.polygons;
-        if (n > 3) ++report.triangulated_polygons;
+        if (int(k) == list)
+          visit(e.properties[k], i);
+        else
+          skip_property(e.properties[k]);
       }
     }
   }
 
-  void read_strips(const PlyElement& e) {
-    const int list = index_list(ctx_, e);
+  void read_faces(const PlyElement& e) {
+    mesh_.faces.reserve(mesh_.faces.size() + size_t(e.count));
     ReadReport& report = *ctx_.report;
-    for (uint64_t i = 0; i < e.count; ++i) {
-      src_.begin_record(e, i);
-      for (size_t k = 0; k < e.properties.size(); ++k) {
-        const PlyProperty& p = e.properties[k];
-        if (int(k) != list) {
-          skip_property(p);
+    for_each_index_list(e, [&](const PlyProperty& p, uint64_t i) {
+      const uint64_t at = src_.mark();
+      const uint64_t n = src_.list_count(p);
+      if (n < 3)
+        src_.fail_at(
+            at, record_name(e, i) + " has " + std::to_string(n) + " vertices, at least 3 needed");
+      const VertexId first = VertexId(read_index(p, e, i, false));
+      VertexId previous = VertexId(read_index(p, e, i, false));
+      for (uint64_t j = 2; j < n; ++j) {
+        const VertexId current = VertexId(read_index(p, e, i, false));
+        add_triangle(first, previous, current);
+        previous = current;
+      }
+      ++report.polygons;
+      if (n > 3) ++report.triangulated_polygons;
+    });
+  }
+
+  void read_strips(const PlyElement& e) {
+    ReadReport& report = *ctx_.report;
+    for_each_index_list(e, [&](const PlyProperty& p, uint64_t i) {
+      const uint64_t n = src_.list_count(p);
+      // The last two indices of the current strip and the number of indices in it so far.
+      VertexId a = 0, b = 0;
+      uint64_t in_strip = 0;
+      for (uint64_t j = 0; j < n; ++j) {
+        const int64_t index = read_index(p, e, i, true);
+        if (index < 0) {
+          in_strip = 0;
           continue;
         }
-        const uint64_t n = src_.list_count(p);
-        // The last two indices of the current strip and the number of indices in it so far.
-        VertexId a = 0, b = 0;
-        uint64_t in_strip = 0;
-        for (uint64_t j = 0; j < n; ++j) {
-          const int64_t index = read_index(p, e, i, true);
-          if (index < 0) {
-            in_strip = 0;
-            continue;
+        const VertexId c = VertexId(index);
+        if (in_strip >= 2) {
+          const bool odd = (in_strip - 2) % 2 == 1;
+          if (a == b || b == c || a == c) {
+            ++report.strip_degenerates;
+          } else {
+            if (odd)
+              add_triangle(b, a, c);
+            else
+              add_triangle(a, b, c);
+            ++report.strip_triangles;
           }
-          const VertexId c = VertexId(index);
-          if (in_strip >= 2) {
-            const bool odd = (in_strip - 2) % 2 == 1;
-            if (a == b || b == c || a == c) {
-              ++report.strip_degenerates;
-            } else {
-              if (odd)
-                add_triangle(b, a, c);
-              else
-                add_triangle(a, b, c);
-              ++report.strip_triangles;
-            }
-          }
-          a = b;
-          b = c;
-          ++in_strip;
         }
+        a = b;
+        b = c;
+        ++in_strip;
       }
-    }
+    });
   }
 
   void skip_property(const PlyProperty& p) {
