@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # bench/run.sh MESH... : ParaPM beside the peers of ../shared/tools, measured in one run.
 #
-# For every MESH and every ratio (RATIOS, default "0.5 0.1 0.02") it runs
-#   - parapm simplify --ratio R (the whole PM down to R; median of REPEATS runs), then metro
-#     on the base mesh of that PM;
+# For every MESH and every ratio (RATIOS, default "0.5 0.1 0.02"; 0 is the whole PM, down to
+# the smallest legal base mesh, the peers skip it) it runs
+#   - parapm simplify --metric M --ratio R for every M of METRICS (default "quadric"; also
+#     "energy"), the whole PM down to R, median of REPEATS runs, then metro on its base mesh;
 #   - the peers (meshoptimizer, OpenMesh Decimater, CGAL Garland-Heckbert and Lindstrom-Turk)
 #     through ../shared/tools/bench-peers.sh, with metro on their outputs;
 # and prints one TSV table on stdout: mesh, tool, ratio, out_faces, seconds (simplification
 # only, single thread), hausdorff_rel, rms_rel (metro, relative to the bbox diagonal),
 # normal_mean_deg, and for ParaPM the peak memory in bytes per input face.
-# Environment: RATIOS, REPEATS (default 3), PEERS (default "meshopt openmesh cgal-gh cgal-lt"),
+# Environment: RATIOS, REPEATS (default 3), METRICS, PEERS (default "meshopt openmesh cgal-gh
+# cgal-lt"; "none" skips them),
 # PEERS_BUILD (default ./.peers-build; built with ../shared/tools/build.sh when missing),
 # BENCH_OUT (default ./bench-out), PARAPM_BUILD_DIR (default build/).
 set -euo pipefail
@@ -17,6 +19,8 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 shared="$root/../shared"
 [[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
 ratios="${RATIOS:-0.5 0.1 0.02}"
+metrics="${METRICS:-quadric}"
+peer_ratios="$(tr ' ' '\n' <<< "$ratios" | grep -vx '0' | tr '\n' ' ' || true)"
 repeats="${REPEATS:-3}"
 out="${BENCH_OUT:-$PWD/bench-out}"
 peers_build="${PEERS_BUILD:-$PWD/.peers-build}"
@@ -35,24 +39,27 @@ median() { tr ' ' '\n' | grep -v '^$' | sort -g | awk '{a[NR]=$1} END{if(NR%2)pr
 printf 'mesh\ttool\tratio\tout_faces\tseconds\thausdorff_rel\trms_rel\tnormal_mean_deg\tbytes_per_face\n'
 for mesh in "$@"; do
   name="$(basename "$mesh")"; name="${name%.[gG][zZ]}"; name="${name%.*}"
-  for ratio in $ratios; do
-    pm="$out/$name.parapm.r$ratio.pm"
-    base="$out/$name.parapm.r$ratio.ply"
-    secs=""
-    for ((i = 1; i <= repeats; i++)); do
-      echo "[bench] $name parapm r=$ratio run $i/$repeats" >&2
-      js="$("$bin" --log-level warn simplify "$mesh" -o "$pm" --ratio "$ratio" --json)"
-      secs+=" $(jget "$js" seconds)"
+  for metric in $metrics; do
+    for ratio in $ratios; do
+      pm="$out/$name.parapm-$metric.r$ratio.pm"
+      base="$out/$name.parapm-$metric.r$ratio.ply"
+      secs=""
+      for ((i = 1; i <= repeats; i++)); do
+        echo "[bench] $name parapm-$metric r=$ratio run $i/$repeats" >&2
+        js="$("$bin" --log-level warn simplify "$mesh" -o "$pm" --metric "$metric" --ratio "$ratio" --json)"
+        secs+=" $(jget "$js" seconds)"
+      done
+      "$bin" --log-level warn lod "$pm" --faces "$(jget "$js" base_faces)" -o "$base" > /dev/null
+      m="$("$peers_build/metro" "$mesh" "$base" 2>/dev/null || echo '{}')"
+      bpf=$(( $(jget "$js" peak_memory_bytes) / $(jget "$js" in_faces) ))
+      printf '%s\tparapm-%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$metric" "$ratio" \
+        "$(jget "$js" base_faces)" "$(echo $secs | median)" "$(jget "$m" hausdorff_rel)" \
+        "$(jget "$m" rms_rel)" "$(jget "$m" normal_mean_deg)" "$bpf"
     done
-    "$bin" --log-level warn lod "$pm" --faces "$(jget "$js" base_faces)" -o "$base" > /dev/null
-    m="$("$peers_build/metro" "$mesh" "$base" 2>/dev/null || echo '{}')"
-    bpf=$(( $(jget "$js" peak_memory_bytes) / $(jget "$js" in_faces) ))
-    printf '%s\tparapm-quadric\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$ratio" \
-      "$(jget "$js" base_faces)" "$(echo $secs | median)" "$(jget "$m" hausdorff_rel)" \
-      "$(jget "$m" rms_rel)" "$(jget "$m" normal_mean_deg)" "$bpf"
   done
+  [[ "$PEERS" == none ]] && continue
   # shellcheck disable=SC2086
   PEERS_BUILD="$peers_build" PEERS_OUT="$out" REPEATS="$repeats" \
-    "$shared/tools/bench-peers.sh" "$mesh" $ratios |
+    "$shared/tools/bench-peers.sh" "$mesh" $peer_ratios |
     awk -F'\t' 'NR > 1 { printf "%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t-\n", $1, $2, $3, $4, $5, $6, $7, $11 }'
 done

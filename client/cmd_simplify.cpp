@@ -20,6 +20,8 @@ struct SimplifyArgs {
   uint64_t faces = 0;
   double ratio = 0;
   std::string metric = "quadric";
+  double samples_per_face = 0;
+  double crease_angle = 60;
   uint64_t seed = 1;
   bool keep_order = false;
   bool json = false;
@@ -34,6 +36,8 @@ int run_simplify(const SimplifyArgs& args) {
   options.target_faces = args.faces;
   options.target_ratio = args.ratio;
   options.metric = args.metric;
+  options.samples_per_face = args.samples_per_face;
+  options.crease_angle_degrees = args.crease_angle;
   options.seed = args.seed;
   options.keep_order = args.keep_order;
   SimplifyStats stats;
@@ -101,11 +105,24 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--ratio", args->ratio, "Base mesh size as a fraction of the input faces")
       ->check(CLI::Range(0.0, 1.0))
       ->excludes(faces);
-  cmd->add_option("--metric", args->metric, "Priority metric")
-      ->check(CLI::IsMember({"quadric"}))
+  cmd->add_option("--metric", args->metric,
+                  "Priority metric: quadric (Garland-Heckbert quadrics, fastest) or energy "
+                  "(Hoppe's energy: distances of points sampled on the input)")
+      ->check(CLI::IsMember({"quadric", "energy"}))
+      ->capture_default_str();
+  cmd->add_option("--samples-per-face", args->samples_per_face,
+                  "Energy metric: extra points drawn on the input per face, by area, beyond "
+                  "one per vertex")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  cmd->add_option("--crease-angle", args->crease_angle,
+                  "Energy metric: degrees between face normals above which an edge is a crease, "
+                  "kept as a curve like boundaries and attribute seams (180: none)")
+      ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
   cmd->add_option("--seed", args->seed,
-                  "Seed of randomised steps (the quadric metric has none: same input, same .pm)")
+                  "Seed of the randomised steps (the energy's extra points): same input, "
+                  "options and seed, same .pm")
       ->capture_default_str();
   cmd->add_flag("--keep-order", args->keep_order,
                 "Store the input's vertex and face order, and keep unreferenced vertices");

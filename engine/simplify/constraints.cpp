@@ -4,8 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "simplify/face_fold.h"
 #include "simplify/modules.h"
-#include "simplify/vec_math.h"
 
 namespace parapm {
 namespace {
@@ -99,16 +99,8 @@ class LinkCondition : public ConstraintModule {
   }
 };
 
-// Rejects a collapse after which a face around vs or vt turns by more than 90 degrees or
-// loses (almost) all its area: both make folds that later collapses cannot undo.
+// Rejects a collapse after which a face around vs or vt folds (face_fold.h).
 class FaceGeometry : public ConstraintModule {
-  // |n| is twice the area; a sliver's height is below ~1e-6 of its longest side.
-  static bool is_sliver(const Vec3& n, const Vec3& a, const Vec3& b, const Vec3& c) {
-    const double longest_sq =
-        std::max({dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
-    return dot(n, n) <= 1e-12 * longest_sq * longest_sq;
-  }
-
  public:
   std::string name() const override { return "face-geometry"; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
@@ -120,16 +112,10 @@ class FaceGeometry : public ConstraintModule {
         const Vec3& p0 = mesh.position(t[0]);
         const Vec3& p1 = mesh.position(t[1]);
         const Vec3& p2 = mesh.position(t[2]);
-        const Vec3 before = triangle_normal(p0, p1, p2);
         const int k = corner_of(t, moved);
-        const Vec3& q0 = k == 0 ? c.position : p0;
-        const Vec3& q1 = k == 1 ? c.position : p1;
-        const Vec3& q2 = k == 2 ? c.position : p2;
-        // A face that is already degenerate (zero-area input) has no normal to keep; it is
-        // left to be collapsed away rather than blocking every collapse around it.
-        if (is_sliver(before, p0, p1, p2)) continue;
-        const Vec3 after = triangle_normal(q0, q1, q2);
-        if (dot(before, after) <= 0 || is_sliver(after, q0, q1, q2)) return false;
+        if (face_folds(p0, p1, p2, k == 0 ? c.position : p0, k == 1 ? c.position : p1,
+                       k == 2 ? c.position : p2))
+          return false;
       }
     }
     return true;

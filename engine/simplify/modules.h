@@ -29,8 +29,11 @@ class PriorityModule {
   // when the collapse cannot be placed (the edge is then left alone).
   virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                         CollapseCandidate& out) const = 0;
-  // Called after the mesh performed `done`, to update the module's state.
-  virtual void collapsed(const CollapseMesh& mesh, const CollapseCandidate& done) = 0;
+  // Called after the mesh performed `done`, to update the module's state. `edge` names the two
+  // faces the collapse removed (now dead). The module may refine done.error with what it
+  // learns from the performed collapse (the record takes the refined value).
+  virtual void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
+                         const EdgeFaces& edge) = 0;
 };
 
 class ConstraintModule {

@@ -84,7 +84,7 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   return std::isfinite(out.cost);
 }
 
-void QuadricPriority::collapsed(const CollapseMesh&, const CollapseCandidate& done) {
+void QuadricPriority::collapsed(const CollapseMesh&, CollapseCandidate& done, const EdgeFaces&) {
   quadrics_[done.vs] += quadrics_[done.vt];
 }
 

@@ -26,7 +26,7 @@ class QuadricPriority : public PriorityModule {
   void initialize(const CollapseMesh& mesh) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                 CollapseCandidate& out) const override;
-  void collapsed(const CollapseMesh& mesh, const CollapseCandidate& done) override;
+  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
 
  private:
   std::vector<uint8_t> locked_;

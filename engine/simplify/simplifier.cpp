@@ -11,6 +11,7 @@ Simplifier::Simplifier(CollapseMesh& mesh, PriorityModule& priority,
 void Simplifier::push_edge(VertexId a, VertexId b) {
   if (a > b) std::swap(a, b);
   CollapseCandidate candidate;
+  ++stats_.evaluations;
   if (!priority_.evaluate(mesh_, a, b, candidate)) return;
   heap_.push({static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]});
 }
@@ -42,7 +43,7 @@ bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge
   return true;
 }
 
-CollapseRecord Simplifier::perform(const CollapseCandidate& c, const EdgeFaces& edge) {
+CollapseRecord Simplifier::perform(CollapseCandidate c, const EdgeFaces& edge) {
   CollapseRecord r;
   r.vs = c.vs;
   r.vt = c.vt;
@@ -54,7 +55,6 @@ CollapseRecord Simplifier::perform(const CollapseCandidate& c, const EdgeFaces& 
   r.vt_position = mesh_.position(c.vt);
   r.position = c.position;
   r.cost = c.cost;
-  r.error = static_cast<float>(c.error);
   if (mesh_.has_wedges()) {
     // Corner order of the vertex split: fl = (vs, vt, vl), fr = (vt, vs, vr).
     auto corners = [&](FaceId f, VertexId first, int slot) {
@@ -67,7 +67,8 @@ CollapseRecord Simplifier::perform(const CollapseCandidate& c, const EdgeFaces& 
     corners(edge.right, c.vt, 3);
   }
   mesh_.collapse(c.vs, c.vt, c.position, edge);
-  priority_.collapsed(mesh_, c);
+  priority_.collapsed(mesh_, c, edge);
+  r.error = static_cast<float>(c.error);
   for (const auto& module : constraints_) module->collapsed(mesh_, c);
   return r;
 }
@@ -75,6 +76,7 @@ CollapseRecord Simplifier::perform(const CollapseCandidate& c, const EdgeFaces& 
 std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
                                             const ProgressCallback& progress,
                                             const CancelToken* cancel) {
+  stats_ = {};
   priority_.initialize(mesh_);
   for (const auto& module : constraints_) module->initialize(mesh_);
   version_.assign(mesh_.vertex_capacity(), 0);
@@ -97,13 +99,13 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     }
   }
   heap_.rebuild();
+  stats_.evaluations = heap_.size();  // (edges the module could not place are not counted)
 
   const size_t start_faces = mesh_.live_faces();
   const uint64_t total = start_faces > limits.target_faces ? start_faces - limits.target_faces : 0;
   std::vector<CollapseRecord> records;
   records.reserve(mesh_.live_vertices());
   std::vector<VertexId> ring;
-  stats_ = {};
   stats_.stop_reason = "no legal collapse left";
 
   while (!heap_.empty()) {
@@ -124,6 +126,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     // The entry is current, so the cost and placement are those of the present mesh; only
     // legality depends on the neighbourhood and is checked now (Decimater: re-check on pop).
     CollapseCandidate candidate;
+    ++stats_.evaluations;
     if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate)) continue;
     const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
     if (edge.left == kNoId && edge.right == kNoId) {  // a re-costed edge that is gone

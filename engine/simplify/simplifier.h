@@ -42,6 +42,7 @@ struct SimplifierStats {
   uint64_t rejected = 0;     // pops vetoed by a constraint
   uint64_t stale = 0;        // pops of outdated queue entries
   uint64_t reevaluated = 0;  // rejected edges costed again after their star changed
+  uint64_t evaluations = 0;  // calls to the priority module's evaluate
   std::string stop_reason;   // why the loop ended
 };
 
@@ -79,7 +80,7 @@ class Simplifier {
   bool is_stale(const Entry& entry) const;
   void compact_heap();
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const;
-  CollapseRecord perform(const CollapseCandidate& candidate, const EdgeFaces& edge);
+  CollapseRecord perform(CollapseCandidate candidate, const EdgeFaces& edge);
 
   CollapseMesh& mesh_;
   PriorityModule& priority_;

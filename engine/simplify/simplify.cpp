@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "simplify/energy_priority.h"
 #include "simplify/pm_builder.h"
 #include "simplify/quadric_priority.h"
 #include "simplify/simplifier.h"
@@ -27,8 +28,14 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
                                        SimplifyStats* stats, const ProgressCallback& progress,
                                        const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.metric != "quadric")
-    throw_invalid("unknown metric '" + options.metric + "' (available: quadric)");
+  if (options.metric != "quadric" && options.metric != "energy")
+    throw_invalid("unknown metric '" + options.metric + "' (available: quadric, energy)");
+  if (!(options.crease_angle_degrees >= 0 && options.crease_angle_degrees <= 180))
+    throw_invalid("the crease angle must be in [0, 180] degrees, got " +
+                  std::to_string(options.crease_angle_degrees));
+  if (!(options.samples_per_face >= 0 && options.samples_per_face <= 1000))
+    throw_invalid("samples per face must be in [0, 1000], got " +
+                  std::to_string(options.samples_per_face));
   const Mesh& mesh = repaired.mesh;
 
   // Vertices the repair step duplicated (non-manifold input) stay where they are, so that the
@@ -45,10 +52,20 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   }
 
   CollapseMesh working(mesh);
-  QuadricOptions quadric_options;
-  quadric_options.round_to_float = mesh.positions_are_float;
-  QuadricPriority priority(locked, quadric_options);
-  Simplifier simplifier(working, priority, standard_constraints(locked));
+  std::unique_ptr<PriorityModule> priority;
+  if (options.metric == "energy") {
+    EnergyOptions energy_options;
+    energy_options.samples_per_face = options.samples_per_face;
+    energy_options.seed = options.seed;
+    energy_options.round_to_float = mesh.positions_are_float;
+    energy_options.sharp.crease_angle_degrees = options.crease_angle_degrees;
+    priority = std::make_unique<EnergyPriority>(locked, energy_options);
+  } else {
+    QuadricOptions quadric_options;
+    quadric_options.round_to_float = mesh.positions_are_float;
+    priority = std::make_unique<QuadricPriority>(locked, quadric_options);
+  }
+  Simplifier simplifier(working, *priority, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target_face_count(mesh.face_count(), options);
   const auto records = simplifier.run(limits, progress, cancel);
@@ -56,7 +73,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   PmBuildOptions build_options;
   build_options.keep_order = options.keep_order;
   ProgressiveMesh pm = build_pm_from_collapses(repaired, working, records, build_options);
-  pm.info.metric = priority.name();
+  pm.info.metric = priority->name();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   pm.info.seconds = seconds;
@@ -66,9 +83,10 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
     stats->stop_reason = simplifier.stats().stop_reason;
     stats->seconds = seconds;
   }
-  spdlog::debug("simplified {} -> {} faces in {:.3f} s ({} collapses, {} vetoed; {})",
-                mesh.face_count(), pm.base.face_count(), seconds, simplifier.stats().collapses,
-                simplifier.stats().rejected, simplifier.stats().stop_reason);
+  spdlog::debug(
+      "simplified {} -> {} faces in {:.3f} s ({} collapses, {} vetoed, {} evaluations; {})",
+      mesh.face_count(), pm.base.face_count(), seconds, simplifier.stats().collapses,
+      simplifier.stats().rejected, simplifier.stats().evaluations, simplifier.stats().stop_reason);
   return pm;
 }
 

@@ -16,9 +16,14 @@ struct SimplifyOptions {
   // faces when non-zero, else as far as collapses stay legal.
   uint64_t target_faces = 0;
   double target_ratio = 0;
-  std::string metric = "quadric";  // "quadric" (the energy metric comes with its own issue)
-  uint64_t seed = 1;               // randomised steps only; the quadric metric has none
-  bool keep_order = false;         // store the input's vertex and face order in the PM
+  // "quadric": Garland-Heckbert quadrics, fast. "energy": Hoppe's mesh-optimisation energy,
+  // points sampled on the input measured against the mesh (energy_priority.h).
+  std::string metric = "quadric";
+  double samples_per_face = 0;  // energy: extra area-weighted points beyond one per vertex
+  // energy: an edge whose faces' normals differ by more is a crease, kept as a curve (E_disc)
+  double crease_angle_degrees = 60;
+  uint64_t seed = 1;        // of the randomised steps (the energy's extra points)
+  bool keep_order = false;  // store the input's vertex and face order in the PM
 };
 
 struct SimplifyStats {

@@ -77,6 +77,25 @@ TEST_F(Cli, SimplifyCheckLodInfo) {
   EXPECT_NE(r.out.find("\"texcoords\""), std::string::npos) << r.out;
 }
 
+TEST_F(Cli, SimplifyWithTheEnergyMetric) {
+  const std::string mesh = testing::test_data("stratocaster-9k.ply");
+  const std::string pm = path("strat.pm");
+  CliRun r = parapm("simplify " + mesh + " -o " + pm +
+                    " --metric energy --samples-per-face 1 --seed 3 --ratio 0.1 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("\"metric\":\"energy\""), std::string::npos) << r.out;
+  r = parapm("check " + pm + " --against " + mesh);
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  r = parapm("info " + pm + " --json");
+  EXPECT_NE(r.out.find("\"metric\":\"energy\""), std::string::npos) << r.out;
+
+  r = parapm("simplify " + mesh + " -o " + pm + " --metric hausdorff");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("hausdorff"), std::string::npos) << r.err;
+  r = parapm("simplify " + mesh + " -o " + pm + " --metric energy --samples-per-face -1");
+  EXPECT_EQ(r.status, 2) << r.err;
+}
+
 TEST_F(Cli, CheckFailsAgainstAnotherMesh) {
   const std::string pm = path("strat.pm");
   ASSERT_EQ(parapm("simplify " + testing::test_data("stratocaster-9k.ply") + " -o " + pm).status,

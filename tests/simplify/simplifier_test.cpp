@@ -3,39 +3,16 @@
 
 #include <cmath>
 
+#include "drawn_meshes.h"
 #include "simplify/quadric_priority.h"
 #include "simplify/simplifier.h"
 
 namespace parapm {
 namespace {
 
-// A UV sphere: closed, genus 0, rings x segments.
-Mesh uv_sphere(int rings, int segments) {
-  Mesh m;
-  m.positions.push_back({0, 0, 1});
-  for (int r = 1; r < rings; ++r) {
-    const double theta = M_PI * r / rings;
-    for (int s = 0; s < segments; ++s) {
-      const double phi = 2 * M_PI * s / segments;
-      m.positions.push_back(
-          {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)});
-    }
-  }
-  m.positions.push_back({0, 0, -1});
-  const VertexId south = VertexId(m.positions.size() - 1);
-  auto ring = [&](int r, int s) { return VertexId(1 + (r - 1) * segments + (s % segments)); };
-  for (int s = 0; s < segments; ++s) m.faces.push_back({0, ring(1, s), ring(1, s + 1)});
-  for (int r = 1; r + 1 < rings; ++r)
-    for (int s = 0; s < segments; ++s) {
-      m.faces.push_back({ring(r, s), ring(r + 1, s), ring(r + 1, s + 1)});
-      m.faces.push_back({ring(r, s), ring(r + 1, s + 1), ring(r, s + 1)});
-    }
-  for (int s = 0; s < segments; ++s)
-    m.faces.push_back({south, ring(rings - 1, s + 1), ring(rings - 1, s)});
-  return m;
-}
+using testing::uv_sphere;
 
-std::vector<CollapseRecord> simplify(const Mesh& mesh, size_t target_faces, CollapseMesh& cm) {
+std::vector<CollapseRecord> simplify(const Mesh&, size_t target_faces, CollapseMesh& cm) {
   std::vector<uint8_t> locked;
   QuadricPriority priority(locked, {});
   Simplifier simplifier(cm, priority, standard_constraints(locked));

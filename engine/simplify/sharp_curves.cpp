@@ -1,0 +1,205 @@
+#include "simplify/sharp_curves.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "simplify/point_projection.h"
+
+namespace parapm {
+namespace {
+
+bool contains(const std::vector<VertexId>& list, VertexId v) {
+  return std::find(list.begin(), list.end(), v) != list.end();
+}
+
+void erase_value(std::vector<VertexId>& list, VertexId v) {
+  list.erase(std::remove(list.begin(), list.end(), v), list.end());
+}
+
+}  // namespace
+
+std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& mesh,
+                                                            const SharpEdgeOptions& options) {
+  std::vector<std::pair<VertexId, VertexId>> edges;
+  const double crease_cos = std::cos(options.crease_angle_degrees * M_PI / 180.0);
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3];
+      const FaceId g = mesh.edge_faces(b, a).left;
+      if (g == kNoId) {
+        if (options.boundaries) edges.emplace_back(std::min(a, b), std::max(a, b));
+        continue;
+      }
+      if (a > b) continue;  // an interior edge is seen from both faces: take it once
+      bool sharp = false;
+      if (options.seams && mesh.has_wedges()) {
+        const Triangle& u = mesh.face(g);
+        sharp = mesh.corner_wedges(f)[k] != mesh.corner_wedges(g)[corner_of(u, a)] ||
+                mesh.corner_wedges(f)[(k + 1) % 3] != mesh.corner_wedges(g)[corner_of(u, b)];
+      }
+      if (!sharp) {
+        const Triangle& u = mesh.face(g);
+        const Vec3 nf =
+            triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+        const Vec3 ng =
+            triangle_normal(mesh.position(u[0]), mesh.position(u[1]), mesh.position(u[2]));
+        const double lengths = length(nf) * length(ng);
+        sharp = lengths > 0 && dot(nf, ng) < crease_cos * lengths;
+      }
+      if (sharp) edges.emplace_back(a, b);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  return edges;
+}
+
+void SharpCurves::add_sharp(VertexId a, VertexId b) {
+  neighbors_[a].push_back(b);
+  neighbors_[b].push_back(a);
+}
+
+void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& options) {
+  samples_.clear();
+  neighbors_.assign(mesh.vertex_capacity(), {});
+  listed_at_.assign(mesh.vertex_capacity(), {});
+  const auto edges = find_sharp_edges(mesh, options);
+  edge_count_ = edges.size();
+  for (const auto& [a, b] : edges) add_sharp(a, b);
+  auto add_sample = [&](const Vec3& position, VertexId u, VertexId w) {
+    const auto id = uint32_t(samples_.size());
+    samples_.push_back({position, 0.0, u, w});
+    listed_at_[u].push_back(id);
+    listed_at_[w].push_back(id);
+  };
+  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
+    if (!neighbors_[v].empty()) add_sample(mesh.position(v), v, neighbors_[v][0]);
+  for (const auto& [a, b] : edges)
+    add_sample(scale(add(mesh.position(a), mesh.position(b)), 0.5), a, b);
+}
+
+void SharpCurves::initialize_empty(const CollapseMesh& mesh) {
+  samples_.clear();
+  neighbors_.assign(mesh.vertex_capacity(), {});
+  listed_at_.assign(mesh.vertex_capacity(), {});
+  edge_count_ = 0;
+}
+
+bool SharpCurves::is_sharp(VertexId a, VertexId b) const { return contains(neighbors_[a], b); }
+
+bool SharpCurves::changes_topology(VertexId a, VertexId b) const {
+  const auto& na = neighbors_[a];
+  const auto& nb = neighbors_[b];
+  if (na.empty() || nb.empty()) return false;
+  if (!contains(na, b)) return true;
+  for (VertexId x : na)
+    if (x != b && contains(nb, x)) return true;
+  return na.size() != 2 && nb.size() != 2;
+}
+
+void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh) const {
+  gathered_.clear();
+  ends_.clear();
+  end_positions_.clear();
+  if (samples_.empty()) return;
+  gathered_.insert(gathered_.end(), listed_at_[a].begin(), listed_at_[a].end());
+  for (uint32_t id : listed_at_[b]) {
+    const Sample& s = samples_[id];
+    if (s.u != a && s.w != a) gathered_.push_back(id);  // else listed at a too
+  }
+  for (VertexId end : {a, b})
+    for (VertexId x : neighbors_[end])
+      if (x != a && x != b && !contains(ends_, x)) {
+        ends_.push_back(x);
+        end_positions_.push_back(mesh.position(x));
+      }
+}
+
+SharpCurves::Fit SharpCurves::project(const Vec3& v) const {
+  Fit fit;
+  for (uint32_t id : gathered_) {
+    const Vec3& x = samples_[id].position;
+    double best = std::numeric_limits<double>::infinity();
+    double b0 = 1;
+    Vec3 rest{};
+    if (end_positions_.empty()) {
+      const Vec3 d = sub(x, v);
+      best = dot(d, d);
+    }
+    for (const Vec3& e : end_positions_) {
+      const SegmentProjection p = project_on_segment(x, v, e);
+      if (p.distance_sq < best) best = p.distance_sq, b0 = 1 - p.t, rest = scale(e, p.t);
+    }
+    fit.distance_sq += best;
+    fit.max_distance_sq = std::max(fit.max_distance_sq, best);
+    fit.a += b0 * b0;
+    fit.b = add(fit.b, scale(sub(x, rest), b0));
+  }
+  return fit;
+}
+
+double SharpCurves::gathered_distance_sq() const {
+  double sum = 0;
+  for (uint32_t id : gathered_) sum += samples_[id].distance_sq;
+  return sum;
+}
+
+void SharpCurves::unlist(VertexId v, uint32_t id) {
+  auto& list = listed_at_[v];
+  const auto it = std::find(list.begin(), list.end(), id);
+  if (it == list.end()) return;
+  *it = list.back();
+  list.pop_back();
+}
+
+double SharpCurves::collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh) {
+  if (samples_.empty()) return 0;
+  std::vector<uint32_t>& moved = gathered_;
+  moved.assign(listed_at_[vs].begin(), listed_at_[vs].end());
+  for (uint32_t id : listed_at_[vt]) {
+    const Sample& s = samples_[id];
+    if (s.u != vs && s.w != vs) moved.push_back(id);
+  }
+  for (uint32_t id : moved) {
+    const Sample& s = samples_[id];
+    for (VertexId end : {s.u, s.w})
+      if (end != kNoId && end != vs && end != vt) unlist(end, id);
+  }
+  listed_at_[vs].clear();
+  listed_at_[vt].clear();
+
+  // vt's sharp edges become vs's; the edge (vs, vt) disappears.
+  for (VertexId x : neighbors_[vt]) {
+    if (x == vs) continue;
+    erase_value(neighbors_[x], vt);
+    if (!contains(neighbors_[x], vs)) neighbors_[x].push_back(vs);
+    if (!contains(neighbors_[vs], x)) neighbors_[vs].push_back(x);
+  }
+  erase_value(neighbors_[vs], vt);
+  neighbors_[vt].clear();
+
+  const Vec3& p = mesh.position(vs);
+  double max_distance_sq = 0;
+  for (uint32_t id : moved) {
+    Sample& s = samples_[id];
+    s.u = vs;
+    s.w = kNoId;
+    s.distance_sq = std::numeric_limits<double>::infinity();
+    for (VertexId x : neighbors_[vs]) {
+      const double dist = project_on_segment(s.position, p, mesh.position(x)).distance_sq;
+      if (dist < s.distance_sq) s.distance_sq = dist, s.w = x;
+    }
+    if (s.w == kNoId) {  // the curve is gone here (a penalised collapse): measure to vs
+      const Vec3 d = sub(s.position, p);
+      s.distance_sq = dot(d, d);
+    }
+    listed_at_[vs].push_back(id);
+    if (s.w != kNoId) listed_at_[s.w].push_back(id);
+    max_distance_sq = std::max(max_distance_sq, s.distance_sq);
+  }
+  return max_distance_sq;
+}
+
+}  // namespace parapm

@@ -1,0 +1,91 @@
+// E_disc of Hoppe 96 (section 4.4): the discontinuity curves of the mesh (sharp edges: open
+// boundaries, creases whose dihedral angle exceeds a threshold, attribute seams) sampled on
+// the input, each sample measured against the curves of the current mesh, and the rule that
+// flags a collapse changing the curves' topology (penalised by the energy, not forbidden).
+//
+// The curves are kept as a sharp-neighbour list per vertex; a collapse moves vt's sharp
+// edges to vs (the edge (vs, vt) itself disappears). A sample tracks the sharp edge it
+// projects onto and is listed at both of that edge's ends.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "simplify/collapse_mesh.h"
+
+namespace parapm {
+
+struct SharpEdgeOptions {
+  double crease_angle_degrees = 60;  // sharp when the face normals differ by more
+  bool boundaries = true;
+  bool seams = true;  // edges across which a corner's wedge changes
+};
+
+// Every sharp edge of the mesh once, as (a, b) with a < b.
+std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& mesh,
+                                                            const SharpEdgeOptions& options);
+
+class SharpCurves {
+ public:
+  // One sample at each vertex on a curve and one at the midpoint of every sharp edge.
+  void initialize(const CollapseMesh& mesh, const SharpEdgeOptions& options);
+  // No curves at all (E_disc off), sized for the mesh.
+  void initialize_empty(const CollapseMesh& mesh);
+
+  size_t sample_count() const { return samples_.size(); }
+  size_t sharp_edge_count() const { return edge_count_; }
+  const std::vector<VertexId>& sharp_neighbors(VertexId v) const { return neighbors_[v]; }
+  bool on_curve(VertexId v) const { return !neighbors_[v].empty(); }
+  bool is_sharp(VertexId a, VertexId b) const;
+  // Hoppe 96's test: collapsing {a, b} changes the curves' topology when both ends are on
+  // curves but the edge is not sharp (two curves would touch), when both ends are curve
+  // corners or ends (degree != 2: merging them changes the graph), or when a and b share a
+  // sharp neighbour (a sharp triangle would fold into a double edge).
+  bool changes_topology(VertexId a, VertexId b) const;
+
+  // The samples a collapse of {a, b} moves, and the curve segments (v, x) after it: x runs
+  // over the sharp neighbours of a and b other than a and b.
+  void gather(VertexId a, VertexId b, const CollapseMesh& mesh) const;
+  struct Fit {
+    double distance_sq = 0, max_distance_sq = 0, a = 0;
+    Vec3 b{};  // as EnergyPriority's: sum of b0^2 and of b0 (x - (1 - b0) x_other)
+  };
+  // The gathered samples projected onto the gathered segments with the moved vertex at v
+  // (onto v itself when no segment is left).
+  Fit project(const Vec3& v) const;
+  double gathered_distance_sq() const;  // their distances before the collapse
+  size_t gathered() const { return gathered_.size(); }
+
+  // Updates the curves and re-projects the samples after the collapse of vt into vs;
+  // returns the largest distance squared among the samples it moved.
+  double collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh);
+
+  // Observers for tests: a sample's position, distance squared and the edge it is on.
+  const Vec3& sample_position(size_t i) const { return samples_[i].position; }
+  double sample_distance_sq(size_t i) const { return samples_[i].distance_sq; }
+  std::pair<VertexId, VertexId> sample_edge(size_t i) const {
+    return {samples_[i].u, samples_[i].w};
+  }
+
+ private:
+  struct Sample {
+    Vec3 position{};
+    double distance_sq = 0;
+    VertexId u = kNoId, w = kNoId;  // the sharp edge it projects onto (w = kNoId: onto u)
+  };
+  void add_sharp(VertexId a, VertexId b);
+  void unlist(VertexId v, uint32_t id);
+
+  std::vector<Sample> samples_;
+  std::vector<std::vector<VertexId>> neighbors_;
+  std::vector<std::vector<uint32_t>> listed_at_;  // per vertex: samples on its sharp edges
+  size_t edge_count_ = 0;
+
+  // Scratch of one evaluation.
+  mutable std::vector<uint32_t> gathered_;
+  mutable std::vector<VertexId> ends_;  // the x of the segments (v, x)
+  mutable std::vector<Vec3> end_positions_;
+};
+
+}  // namespace parapm
