@@ -11,11 +11,13 @@ double Box::diagonal() const {
   return std::sqrt(sum);
 }
 
-Box bounding_box(const Mesh& mesh) {
+Box bounding_box(const Mesh& mesh) { return bounding_box(mesh.positions); }
+
+Box bounding_box(const std::vector<Vec3>& positions) {
   Box box;
-  if (mesh.positions.empty()) return box;
-  box.min = box.max = mesh.positions[0];
-  for (const Vec3& p : mesh.positions) {
+  if (positions.empty()) return box;
+  box.min = box.max = positions[0];
+  for (const Vec3& p : positions) {
     for (int k = 0; k < 3; ++k) {
       box.min[k] = std::min(box.min[k], p[k]);
       box.max[k] = std::max(box.max[k], p[k]);

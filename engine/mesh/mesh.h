@@ -69,6 +69,7 @@ struct Box {
   double diagonal() const;
 };
 Box bounding_box(const Mesh& mesh);
+Box bounding_box(const std::vector<Vec3>& positions);
 
 // x rounded to the nearest float32, as a double. The empty asm keeps GCC 12 at -O2/-O3 from
 // folding the (double)(float)x pair away when it vectorises (seen here: the rounding of the

@@ -41,6 +41,7 @@ class CollapseMesh {
   bool has_wedges() const { return !corner_wedges_.empty(); }
   const std::vector<FaceId>& faces_of(VertexId v) const { return faces_of_[v]; }
   const Vec3& position(VertexId v) const { return positions_[v]; }
+  const std::vector<Vec3>& positions() const { return positions_; }  // removed ones included
   bool is_boundary(VertexId v) const { return boundary_[v]; }
 
   EdgeFaces edge_faces(VertexId a, VertexId b) const;

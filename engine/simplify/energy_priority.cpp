@@ -43,19 +43,9 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
     curves_ = SharpCurves{};
     curves_.initialize_empty(mesh);
   }
-  // Large against any ordinary change of energy: (bounding-box diagonal)^2 per point.
-  Vec3 low{}, high{};
-  bool first = true;
-  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
-    if (!mesh.vertex_alive(v)) continue;
-    for (int k = 0; k < 3; ++k) {
-      low[k] = first ? mesh.position(v)[k] : std::min(low[k], mesh.position(v)[k]);
-      high[k] = first ? mesh.position(v)[k] : std::max(high[k], mesh.position(v)[k]);
-    }
-    first = false;
-  }
-  const Vec3 diagonal = sub(high, low);
-  topology_penalty_ = dot(diagonal, diagonal) * double(std::max<size_t>(1, mesh.live_vertices()));
+  // Large against any ordinary change of energy: (bounding-box diagonal)^2 per vertex.
+  const double diagonal = bounding_box(mesh.positions()).diagonal();
+  topology_penalty_ = diagonal * diagonal * double(std::max<size_t>(1, mesh.live_vertices()));
 
   points_.clear();
   points_.reserve(samples.size());
@@ -273,6 +263,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     double energy;
     double max_distance_sq;
     double curve_distance_sq;
+    double spring;  // kappa * E_spring after the collapse
   };
   std::array<Placement, 16> placements;
   size_t placed = 0;
@@ -280,11 +271,11 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   auto measure = [&](const Vec3& v, Fit& fit) {
     fit = project_points(evaluated_, evaluated_homes_, v);
     curve_fit = curves_.gathered() ? curves_.project(v) : SharpCurves::Fit{};
-    const double energy =
-        weight * fit.distance_sq + curve_fit.distance_sq + kappa * spring_energy_after(v);
+    const double spring = kappa * spring_energy_after(v);
+    const double energy = weight * fit.distance_sq + curve_fit.distance_sq + spring;
     if (placed < placements.size())
       placements[placed++] = {v, energy, std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
-                              curve_fit.distance_sq};
+                              curve_fit.distance_sq, spring};
   };
   auto solve = [&](const Fit& fit, const Vec3& from) -> Vec3 {
     const double denominator = weight * fit.a + curve_fit.a + spring_weight;
@@ -332,7 +323,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     double all_before = 0;
     for (uint32_t id : star_points_) all_before += points_[id].distance_sq;
     out.cost = all.distance_sq - all_before + chosen->curve_distance_sq - curve_before +
-               kappa * (spring_energy_after(chosen->v) - spring_before);
+               chosen->spring - kappa * spring_before;
     out.error = std::sqrt(std::max(all.max_distance_sq, chosen->max_distance_sq));
   }
   // Penalised, not forbidden (Hoppe 96): such collapses come after every ordinary one.

@@ -29,13 +29,6 @@ std::vector<Segment> sharp_segments(const Mesh& mesh) {
   return out;
 }
 
-double diagonal(const Mesh& mesh) {
-  Vec3 low = mesh.positions[0], high = mesh.positions[0];
-  for (const Vec3& p : mesh.positions)
-    for (int k = 0; k < 3; ++k) low[k] = std::min(low[k], p[k]), high[k] = std::max(high[k], p[k]);
-  return length(sub(high, low));
-}
-
 // The share of the input's sharp-edge midpoints that lie within `tolerance` of a sharp edge
 // of the level of detail at `ratio` of the faces.
 double kept_sharp_share(const std::string& path, const std::string& metric, double ratio,
@@ -48,7 +41,7 @@ double kept_sharp_share(const std::string& path, const std::string& metric, doub
   const Mesh lod = level_of_detail(pm, 0);
   const auto input = sharp_segments(repaired.mesh);
   const auto kept = sharp_segments(lod);
-  const double tolerance = tolerance_of_diagonal * diagonal(repaired.mesh);
+  const double tolerance = tolerance_of_diagonal * bounding_box(repaired.mesh).diagonal();
   size_t near = 0;
   for (const Segment& s : input) {
     const Vec3 mid = scale(add(s.a, s.b), 0.5);
