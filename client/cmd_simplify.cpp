@@ -22,6 +22,7 @@ struct SimplifyArgs {
   std::string metric = "quadric";
   double samples_per_face = 0;
   double crease_angle = 60;
+  double attribute_weight = 0.01;
   uint64_t seed = 1;
   bool keep_order = false;
   bool json = false;
@@ -38,6 +39,7 @@ int run_simplify(const SimplifyArgs& args) {
   options.metric = args.metric;
   options.samples_per_face = args.samples_per_face;
   options.crease_angle_degrees = args.crease_angle;
+  options.attribute_weight = args.attribute_weight;
   options.seed = args.seed;
   options.keep_order = args.keep_order;
   SimplifyStats stats;
@@ -119,6 +121,12 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                   "Energy metric: degrees between face normals above which an edge is a crease, "
                   "kept as a curve like boundaries and attribute seams (180: none)")
       ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  cmd->add_option("--attribute-weight", args->attribute_weight,
+                  "Energy metric: weight of colours, normals and texture coordinates against "
+                  "geometry (an attribute difference of 1 costs like this fraction of the "
+                  "bounding-box diagonal); 0: wedges keep their input values at every level")
+      ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   cmd->add_option("--seed", args->seed,
                   "Seed of the randomised steps (the energy's extra points): same input, "

@@ -47,6 +47,10 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
   const double diagonal = bounding_box(mesh.positions()).diagonal();
   topology_penalty_ = diagonal * diagonal * double(std::max<size_t>(1, mesh.live_vertices()));
 
+  const bool scalar = mesh.has_wedges() && attributes_.layout.any();
+  scalar_.initialize(scalar ? attributes_.layout : AttributeLayout{}, attributes_.values,
+                     options_.attribute_weight * diagonal);
+
   points_.clear();
   points_.reserve(samples.size());
   face_first_.assign(mesh.face_capacity(), kNoPoint);
@@ -57,6 +61,7 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
     const auto id = uint32_t(points_.size());
     points_.push_back({s.position, 0.0, s.face, kNoPoint});
     sample_vertex_.push_back(s.vertex);
+    if (scalar_.enabled()) scalar_.add_point(mesh, s.face, s.position);
     if (s.vertex != kNoId) {
       parked_point_[s.vertex] = id;
     } else {
@@ -81,9 +86,10 @@ void EnergyPriority::unpark(VertexId v) {
 }
 
 EnergyPriority::Fit EnergyPriority::project_points(const std::vector<uint32_t>& ids,
-                                                   const std::vector<int>& homes,
-                                                   const Vec3& v) const {
+                                                   const std::vector<int>& homes, const Vec3& v,
+                                                   std::vector<Projected>* where) const {
   Fit fit;
+  if (where) where->resize(ids.size());
   prepared_.resize(star_.size());
   prepared_ready_.assign(star_.size(), 0);
   for (size_t i = 0; i < ids.size(); ++i) {
@@ -92,14 +98,14 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<uint32_t>& 
     // two faces beside it. (The performed collapse projects onto the whole star.)
     Projection best;
     best.distance_sq = std::numeric_limits<double>::infinity();
-    const StarFace* best_face = nullptr;
+    int best_j = 0;
     auto consider = [&](int j) {
       if (!prepared_ready_[j]) {
         prepared_[j] = PreparedTriangle(v, star_[j].p1, star_[j].p2);
         prepared_ready_[j] = 1;
       }
       const Projection p = prepared_[j].project(x);
-      if (p.distance_sq < best.distance_sq) best = p, best_face = &star_[j];
+      if (p.distance_sq < best.distance_sq) best = p, best_j = j;
     };
     const int home = homes[i];
     if (home < 0) {
@@ -116,6 +122,8 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<uint32_t>& 
       if (star_[home].next >= 0) consider(star_[home].next);
       if (star_[home].previous >= 0) consider(star_[home].previous);
     }
+    const StarFace* best_face = &star_[best_j];
+    if (where) (*where)[i] = {best_j, best.bary};
     fit.distance_sq += best.distance_sq;
     fit.max_distance_sq = std::max(fit.max_distance_sq, best.distance_sq);
     const double b0 = best.bary[0];
@@ -178,6 +186,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   star_homes_.clear();
   std::array<VertexId, 2> edge_apexes{kNoId, kNoId};
   int edge_faces = 0;
+  joined_count_ = 0;
   double spring_before = 0;
   for (VertexId end : {a, b}) {
     if (end == b) a_side_faces_ = int(star_.size());
@@ -194,11 +203,19 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       if (other_corner >= 0) {
         if (edge_faces < 2) {
           edge_apexes[edge_faces] = t[3 - k - other_corner];
+          if (scalar_.enabled()) {
+            const auto& w = mesh.corner_wedges(f);
+            joined_[joined_count_++] = {w[k], w[other_corner]};
+          }
           gather_face(f, -2 - edge_faces);
           ++edge_faces;
         }
       } else {
         star_.push_back({p1, p2, p0, t[(k + 1) % 3], t[(k + 2) % 3]});
+        if (scalar_.enabled()) {
+          const auto& w = mesh.corner_wedges(f);
+          star_.back().wedges = {w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
+        }
         gather_face(f, int(star_.size()) - 1);
       }
     }
@@ -318,17 +335,70 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   out.position = chosen->v;
   out.cost = chosen->energy - distance_before - curve_before - kappa * spring_before;
   out.error = std::sqrt(chosen->max_distance_sq);
-  if (evaluated_.size() < total) {
-    const Fit all = project_points(star_points_, star_homes_, chosen->v);
+  if (evaluated_.size() < total || scalar_.enabled()) {
+    const Fit all = project_points(star_points_, star_homes_, chosen->v,
+                                   scalar_.enabled() ? &projected_ : nullptr);
     double all_before = 0;
     for (uint32_t id : star_points_) all_before += points_[id].distance_sq;
     out.cost = all.distance_sq - all_before + chosen->curve_distance_sq - curve_before +
                chosen->spring - kappa * spring_before;
     out.error = std::sqrt(std::max(all.max_distance_sq, chosen->max_distance_sq));
+    if (scalar_.enabled()) out.cost += scalar_change();
   }
   // Penalised, not forbidden (Hoppe 96): such collapses come after every ordinary one.
   if (topology) out.cost += topology_penalty_;
   return std::isfinite(out.cost);
+}
+
+// The change of E_scalar over the star's points, projected as in projected_, with the
+// wedges of the moving vertex at their best values.
+double EnergyPriority::scalar_change() const {
+  scalar_.begin_star(joined_, joined_count_);
+  for (StarFace& face : star_) face.group = scalar_.group_of(face.wedges[0]);
+  double before = 0;
+  for (size_t i = 0; i < star_points_.size(); ++i) {
+    const uint32_t id = star_points_[i];
+    const Projected& p = projected_[i];
+    const StarFace& face = star_[p.face];
+    scalar_.add(face.group, id, p.bary[0], face.wedges[1], p.bary[1], face.wedges[2], p.bary[2]);
+    before += scalar_.residual(id);
+  }
+  return scalar_.star_energy() - before;
+}
+
+// E_scalar after a performed collapse: the wedges joined for good, the star's wedges given the
+// values that fit the star's points as they now project, and the points' errors updated.
+void EnergyPriority::update_attributes(const CollapseMesh& mesh, CollapseCandidate& done,
+                                       const EdgeFaces& edge) {
+  for (FaceId f : {edge.left, edge.right}) {
+    if (f == kNoId) continue;
+    const Triangle& t = mesh.face(f);  // a removed face keeps its corners
+    const auto& w = mesh.corner_wedges(f);
+    scalar_.join(w[corner_of(t, done.vs)], w[corner_of(t, done.vt)]);
+  }
+  scalar_.begin_star({}, 0);
+  // Every wedge at vs takes part, also on faces no point projects onto.
+  for (FaceId f : mesh.faces_of(done.vs))
+    scalar_.group_of(mesh.corner_wedges(f)[corner_of(mesh.face(f), done.vs)]);
+  auto corners = [&](FaceId f, int k) {
+    const auto& w = mesh.corner_wedges(f);
+    return std::array<WedgeId, 3>{w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
+  };
+  for (size_t i = 0; i < star_points_.size(); ++i) {
+    const FaceId f = moved_faces_[i];
+    const int k = corner_of(mesh.face(f), done.vs);
+    const auto& b = moved_bary_[i];
+    const auto w = corners(f, k);
+    scalar_.add(scalar_.group_of(w[0]), star_points_[i], b[k], w[1], b[(k + 1) % 3], w[2],
+                b[(k + 2) % 3]);
+  }
+  scalar_.apply(done.changed_wedges, done.changed_values);
+  for (size_t i = 0; i < star_points_.size(); ++i) {
+    const FaceId f = moved_faces_[i];
+    scalar_.set_residual(
+        star_points_[i],
+        scalar_.residual_against(star_points_[i], mesh.corner_wedges(f), moved_bary_[i]));
+  }
 }
 
 void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
@@ -347,26 +417,41 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   for (FaceId f : faces) take(f);
   unpark(done.vt);
   const uint32_t vs_sample = parked_point_[done.vs];
-  if (vs_sample != kNoPoint && points_[vs_sample].position != done.position) unpark(done.vs);
+  // vs's own sample stays exact while vs stays put, unless E_scalar gives its wedges new
+  // values.
+  if (vs_sample != kNoPoint && (points_[vs_sample].position != done.position || scalar_.enabled()))
+    unpark(done.vs);
   double max_distance_sq = curves_.collapsed(done.vs, done.vt, mesh);
   if (faces.empty()) return;
+  moved_faces_.clear();
+  moved_bary_.clear();
   for (uint32_t id : star_points_) {
     Point& point = points_[id];
-    double best = std::numeric_limits<double>::infinity();
+    Projection best;
+    best.distance_sq = std::numeric_limits<double>::infinity();
     FaceId best_face = faces[0];
+    double best_score = std::numeric_limits<double>::infinity();
     for (FaceId f : faces) {
       const Triangle& t = mesh.face(f);
-      const double d = project_on_triangle(point.position, mesh.position(t[0]), mesh.position(t[1]),
-                                           mesh.position(t[2]))
-                           .distance_sq;
-      if (d < best) best = d, best_face = f;
+      const Projection p = project_on_triangle(point.position, mesh.position(t[0]),
+                                               mesh.position(t[1]), mesh.position(t[2]));
+      // With E_scalar a point goes where its whole energy is least: a point on a seam is as
+      // close to the faces of both sides and belongs to the side whose attributes it has.
+      const double score =
+          scalar_.enabled()
+              ? p.distance_sq + scalar_.residual_against(id, mesh.corner_wedges(f), p.bary)
+              : p.distance_sq;
+      if (score < best_score) best_score = score, best = p, best_face = f;
     }
-    point.distance_sq = best;
+    moved_faces_.push_back(best_face);
+    moved_bary_.push_back(best.bary);
+    point.distance_sq = best.distance_sq;
     point.face = best_face;
     point.next = face_first_[best_face];
     face_first_[best_face] = id;
-    max_distance_sq = std::max(max_distance_sq, best);
+    max_distance_sq = std::max(max_distance_sq, best.distance_sq);
   }
+  if (scalar_.enabled()) update_attributes(mesh, done, edge);
   // The exact largest distance of the star's points, where the evaluation may have looked at
   // a subset.
   done.error = std::sqrt(max_distance_sq);

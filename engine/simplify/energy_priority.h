@@ -6,14 +6,17 @@
 //   projects onto), E_spring = kappa * sum over edges of |e|^2, with kappa adapted per
 //   collapse from the ratio of points to faces around the edge (a regulariser that fades as
 //   points accumulate), and E_disc the same distance for points sampled on the sharp curves
-//   (boundaries, creases, seams), measured against the curves (sharp_curves.h). A collapse
-//   that changes the curves' topology is penalised.
+//   (boundaries, creases, seams), measured against the curves (sharp_curves.h), and E_scalar
+//   the attributes' error at the same points (scalar_attributes.h). A collapse that changes
+//   the curves' topology is penalised.
 //
 // The cost of collapsing {a, b} is the change of E restricted to the star of the edge and the
 // points on it, with the surviving vertex placed by the best of three starts (a, b, the
 // midpoint), each refined by alternating projection of the points onto the new star and a
 // least-squares solve for the position (one moving vertex: the normal equations are a scalar
-// times the identity, solved in closed form).
+// times the identity, solved in closed form). As in Hoppe 96, the attributes do not move the
+// vertex: with the position chosen, the wedges' values are solved for and their change of
+// E_scalar is added to the cost.
 //
 // Bounded cost, the fix for the 1999 implementation's quadratic behaviour: late collapses
 // cover hundreds of points, but a candidate evaluation looks at no more than
@@ -33,6 +36,7 @@
 
 #include "simplify/modules.h"
 #include "simplify/point_projection.h"
+#include "simplify/scalar_attributes.h"
 #include "simplify/sharp_curves.h"
 
 namespace parapm {
@@ -45,6 +49,16 @@ struct EnergyOptions {
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
   bool discontinuities = true;  // E_disc: sample and keep the sharp curves (sharp_curves.h)
   SharpEdgeOptions sharp;
+  // E_scalar's c_scalar relative to the bounding-box diagonal: an attribute difference of 1
+  // (a colour channel's whole range) costs as much as a distance of weight x diagonal. 0: off
+  // (the wedges keep their input values at every level).
+  double attribute_weight = 0;
+};
+
+// The input's wedge values, for E_scalar (CollapseMesh holds only the corners' wedge ids).
+struct WedgeAttributes {
+  AttributeLayout layout;
+  std::vector<float> values;  // layout.floats_per_wedge() per wedge
 };
 
 // Hoppe 96 section 4.2: the spring constant from the ratio r of points to faces in the
@@ -53,8 +67,9 @@ double spring_constant(double points_per_face);
 
 class EnergyPriority : public PriorityModule {
  public:
-  EnergyPriority(std::vector<uint8_t> locked, EnergyOptions options)
-      : locked_(std::move(locked)), options_(options) {}
+  EnergyPriority(std::vector<uint8_t> locked, EnergyOptions options,
+                 WedgeAttributes attributes = {})
+      : locked_(std::move(locked)), options_(options), attributes_(std::move(attributes)) {}
   std::string name() const override { return "energy"; }
   void initialize(const CollapseMesh& mesh) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
@@ -89,6 +104,13 @@ class EnergyPriority : public PriorityModule {
     Vec3 p1, p2, before;
     VertexId id1, id2;
     int next = -1, previous = -1;
+    std::array<WedgeId, 3> wedges{};  // of the corners v, p1, p2 (with E_scalar)
+    int group = 0;                    // E_scalar's group of the corner at v
+  };
+  // Where one point projected: a star face and barycentric coordinates on (v, p1, p2).
+  struct Projected {
+    int face = 0;
+    std::array<double, 3> bary{};
   };
   // The projections of the evaluated points onto the star with v at one position, summed
   // for the energy and for the next least-squares solve.
@@ -99,8 +121,10 @@ class EnergyPriority : public PriorityModule {
     Vec3 b{};                    // sum of b0 (x - b1 p1 - b2 p2)
   };
 
-  Fit project_points(const std::vector<uint32_t>& ids, const std::vector<int>& homes,
-                     const Vec3& v) const;
+  Fit project_points(const std::vector<uint32_t>& ids, const std::vector<int>& homes, const Vec3& v,
+                     std::vector<Projected>* where = nullptr) const;
+  double scalar_change() const;
+  void update_attributes(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge);
   void gather_face(FaceId f, int home) const;
   void unpark(VertexId v);
   double spring_energy_after(const Vec3& v) const;
@@ -113,7 +137,9 @@ class EnergyPriority : public PriorityModule {
   std::vector<uint32_t> parked_point_;   // per vertex: its sample while it has not moved
   std::vector<VertexId> sample_vertex_;  // per point: the vertex it samples, or kNoId
   SharpCurves curves_;
-  double topology_penalty_ = 0;  // added to a collapse that changes the curves' topology
+  WedgeAttributes attributes_;       // the input's; initialize copies them into scalar_
+  mutable ScalarAttributes scalar_;  // its star scratch is used by the const evaluate
+  double topology_penalty_ = 0;      // added to a collapse that changes the curves' topology
 
   // Scratch of one evaluation (evaluate is const but, like CollapseMesh, not thread-safe).
   mutable std::vector<StarFace> star_;
@@ -122,7 +148,12 @@ class EnergyPriority : public PriorityModule {
   mutable std::vector<int> star_homes_;
   mutable std::vector<uint32_t> evaluated_;
   mutable std::vector<int> evaluated_homes_;
-  mutable int a_side_faces_ = 0;                    // star_ holds a's faces, then b's
+  mutable int a_side_faces_ = 0;                                 // star_ holds a's faces, then b's
+  mutable std::array<std::pair<WedgeId, WedgeId>, 2> joined_{};  // wedges of a, b in fl, fr
+  mutable int joined_count_ = 0;
+  mutable std::vector<Projected> projected_;  // per star point, at the chosen placement
+  std::vector<FaceId> moved_faces_;           // collapsed: per star point, its new face
+  std::vector<std::array<double, 3>> moved_bary_;
   mutable std::vector<PreparedTriangle> prepared_;  // star_ with v at the projected position
   mutable std::vector<uint8_t> prepared_ready_;
 };

@@ -18,6 +18,10 @@ struct CollapseCandidate {
   Vec3 position{};
   double cost = 0;   // priority: smaller collapses first; units are the module's own
   double error = 0;  // geometric error of the collapse in model units (for cutting a PM)
+  // Filled by PriorityModule::collapsed when the module changed wedge values (E_scalar): the
+  // wedges and their new values, floats_per_wedge each.
+  std::vector<WedgeId> changed_wedges;
+  std::vector<float> changed_values;
 };
 
 class PriorityModule {

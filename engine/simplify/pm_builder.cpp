@@ -7,21 +7,20 @@
 namespace parapm {
 namespace {
 
-// Assigns PM wedge ids in order of first use and copies the values of new wedges.
+// Assigns PM wedge ids in order of first use and copies the values of new wedges: `values`
+// are the wedges' values at the base mesh, which for a wedge the base mesh does not use is
+// its value when its last face was collapsed away, the value its split brings back.
 class WedgeNumbering {
  public:
-  WedgeNumbering(const Mesh& mesh, ProgressiveMesh& pm)
-      : mesh_(mesh),
-        pm_(pm),
-        pm_id_(mesh.wedge_count(), kNoId),
-        floats_(mesh.layout.floats_per_wedge()) {}
+  WedgeNumbering(const std::vector<float>& values, size_t wedge_count, int floats,
+                 ProgressiveMesh& pm)
+      : values_(values), pm_(pm), pm_id_(wedge_count, kNoId), floats_(floats) {}
 
   WedgeId base(WedgeId w) {
     if (pm_id_[w] == kNoId) {
       pm_id_[w] = next_++;
       pm_.base.wedge_vertex.push_back(kNoId);  // filled by the caller with the PM vertex
-      pm_.base.wedge_values.insert(pm_.base.wedge_values.end(), mesh_.wedge(w),
-                                   mesh_.wedge(w) + floats_);
+      pm_.base.wedge_values.insert(pm_.base.wedge_values.end(), value(w), value(w) + floats_);
     }
     return pm_id_[w];
   }
@@ -30,19 +29,44 @@ class WedgeNumbering {
     if (pm_id_[w] == kNoId) {
       pm_id_[w] = next_++;
       ++new_count;
-      pm_.new_wedge_values.insert(pm_.new_wedge_values.end(), mesh_.wedge(w),
-                                  mesh_.wedge(w) + floats_);
+      pm_.new_wedge_values.insert(pm_.new_wedge_values.end(), value(w), value(w) + floats_);
     }
+    return pm_id_[w];
+  }
+  // A wedge a split changes exists at the coarser level, so it is numbered already.
+  WedgeId existing(WedgeId w) const {
+    if (pm_id_[w] == kNoId) throw_internal("PM builder: a split changes a wedge not yet in use");
     return pm_id_[w];
   }
 
  private:
-  const Mesh& mesh_;
+  const float* value(WedgeId w) const { return values_.data() + size_t(w) * size_t(floats_); }
+
+  const std::vector<float>& values_;
   ProgressiveMesh& pm_;
   std::vector<WedgeId> pm_id_;
   int floats_;
   WedgeId next_ = 0;
 };
+
+// Replays the records' wedge value changes from the input's values: returns the values at the
+// base mesh and, per change in record order, the values it replaced (floats each).
+std::vector<float> replay_wedge_changes(const Mesh& mesh,
+                                        const std::vector<CollapseRecord>& records,
+                                        std::vector<float>& replaced) {
+  const size_t floats = size_t(mesh.layout.floats_per_wedge());
+  std::vector<float> values = mesh.wedge_values;
+  for (const CollapseRecord& r : records) {
+    if (r.changed_values.size() != r.changed_wedges.size() * floats)
+      throw_internal("PM builder: a record's wedge changes and values disagree");
+    for (size_t c = 0; c < r.changed_wedges.size(); ++c) {
+      float* current = values.data() + size_t(r.changed_wedges[c]) * floats;
+      replaced.insert(replaced.end(), current, current + floats);
+      std::copy_n(r.changed_values.data() + c * floats, floats, current);
+    }
+  }
+  return values;
+}
 
 }  // namespace
 
@@ -73,8 +97,15 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
   // Faces: the survivors in their original order, then fl, fr of each split.
   std::vector<FaceId> pm_face(mesh.face_count(), kNoId);
   FaceId next_face = 0;
-  WedgeNumbering wedges(mesh, pm);
   const bool attributes = mesh.layout.any();
+  const size_t floats = size_t(mesh.layout.floats_per_wedge());
+  std::vector<float> replaced;  // per wedge change, in record order: the values before it
+  const std::vector<float> base_values = replay_wedge_changes(mesh, records, replaced);
+  // Where each record's changes start in `replaced` (walked last to first below).
+  std::vector<size_t> replaced_begin(records.size() + 1, 0);
+  for (size_t i = 0; i < records.size(); ++i)
+    replaced_begin[i + 1] = replaced_begin[i] + records[i].changed_wedges.size() * floats;
+  WedgeNumbering wedges(base_values, mesh.wedge_count(), int(floats), pm);
   for (FaceId f = 0; f < mesh.face_count(); ++f) {
     if (!final_mesh.face_alive(f)) continue;
     pm_face[f] = next_face++;
@@ -111,6 +142,17 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
       for (int k = 0; k < 6; ++k)
         if (r.corner_wedges[k] != kNoId)
           s.corner_wedges[k] = wedges.split(r.corner_wedges[k], s.new_wedge_count);
+      // The split undoes the collapse's changes: coarse (after the collapse), then fine.
+      s.wedge_changes_begin = uint32_t(pm.wedge_changes.size());
+      s.wedge_changes_count = uint32_t(r.changed_wedges.size());
+      for (size_t c = 0; c < r.changed_wedges.size(); ++c) {
+        pm.wedge_changes.push_back(
+            {wedges.existing(r.changed_wedges[c]), uint32_t(pm.wedge_change_values.size())});
+        const float* coarse = r.changed_values.data() + c * floats;
+        const float* fine = replaced.data() + replaced_begin[i] + c * floats;
+        pm.wedge_change_values.insert(pm.wedge_change_values.end(), coarse, coarse + floats);
+        pm.wedge_change_values.insert(pm.wedge_change_values.end(), fine, fine + floats);
+      }
     }
     for (FaceId f : {r.fl, r.fr})
       if (f != kNoId) pm_face[f] = next_face++;

@@ -1,6 +1,7 @@
 #include "simplify/simplifier.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace parapm {
 
@@ -69,6 +70,8 @@ CollapseRecord Simplifier::perform(CollapseCandidate c, const EdgeFaces& edge) {
   mesh_.collapse(c.vs, c.vt, c.position, edge);
   priority_.collapsed(mesh_, c, edge);
   r.error = static_cast<float>(c.error);
+  r.changed_wedges = std::move(c.changed_wedges);
+  r.changed_values = std::move(c.changed_values);
   for (const auto& module : constraints_) module->collapsed(mesh_, c);
   return r;
 }

@@ -31,6 +31,10 @@ struct CollapseRecord {
   std::array<WedgeId, 6> corner_wedges{kNoId, kNoId, kNoId, kNoId, kNoId, kNoId};
   double cost = 0;
   float error = 0;  // the priority module's geometric error, model units
+  // Wedges whose values the collapse changed (E_scalar), with their values after it
+  // (floats_per_wedge each); the values before are those the previous records left.
+  std::vector<WedgeId> changed_wedges;
+  std::vector<float> changed_values;
 };
 
 struct SimplifierLimits {

@@ -33,6 +33,9 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   if (!(options.crease_angle_degrees >= 0 && options.crease_angle_degrees <= 180))
     throw_invalid("the crease angle must be in [0, 180] degrees, got " +
                   std::to_string(options.crease_angle_degrees));
+  if (!(options.attribute_weight >= 0 && options.attribute_weight <= 1000))
+    throw_invalid("the attribute weight must be in [0, 1000], got " +
+                  std::to_string(options.attribute_weight));
   if (!(options.samples_per_face >= 0 && options.samples_per_face <= 1000))
     throw_invalid("samples per face must be in [0, 1000], got " +
                   std::to_string(options.samples_per_face));
@@ -59,7 +62,9 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
     energy_options.seed = options.seed;
     energy_options.round_to_float = mesh.positions_are_float;
     energy_options.sharp.crease_angle_degrees = options.crease_angle_degrees;
-    priority = std::make_unique<EnergyPriority>(locked, energy_options);
+    energy_options.attribute_weight = options.attribute_weight;
+    priority = std::make_unique<EnergyPriority>(locked, energy_options,
+                                                WedgeAttributes{mesh.layout, mesh.wedge_values});
   } else {
     QuadricOptions quadric_options;
     quadric_options.round_to_float = mesh.positions_are_float;

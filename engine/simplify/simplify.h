@@ -22,6 +22,10 @@ struct SimplifyOptions {
   double samples_per_face = 0;  // energy: extra area-weighted points beyond one per vertex
   // energy: an edge whose faces' normals differ by more is a crease, kept as a curve (E_disc)
   double crease_angle_degrees = 60;
+  // energy: E_scalar's weight of attributes (colours, normals, texture coordinates) against
+  // geometry: an attribute difference of 1 costs as much as this fraction of the bounding-box
+  // diagonal in distance. 0: attributes are not optimised (each wedge keeps its input value).
+  double attribute_weight = 0.01;
   uint64_t seed = 1;        // of the randomised steps (the energy's extra points)
   bool keep_order = false;  // store the input's vertex and face order in the PM
 };
