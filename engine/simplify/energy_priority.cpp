@@ -281,18 +281,30 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     double max_distance_sq;
     double curve_distance_sq;
     double spring;  // kappa * E_spring after the collapse
+    size_t index;   // into placement_projections_
   };
   std::array<Placement, 16> placements;
   size_t placed = 0;
   SharpCurves::Fit curve_fit;
+  // With E_scalar and every point evaluated, each placement keeps its projections, so that
+  // the chosen one's need not be computed again.
+  const bool keep_projections = scalar_.enabled() && evaluated_.size() == total;
   auto measure = [&](const Vec3& v, Fit& fit) {
-    fit = project_points(evaluated_, evaluated_homes_, v);
+    fit = project_points(
+        evaluated_, evaluated_homes_, v,
+        keep_projections && placed < placements.size() ? &placement_projections_[placed] : nullptr);
     curve_fit = curves_.gathered() ? curves_.project(v) : SharpCurves::Fit{};
     const double spring = kappa * spring_energy_after(v);
     const double energy = weight * fit.distance_sq + curve_fit.distance_sq + spring;
-    if (placed < placements.size())
-      placements[placed++] = {v, energy, std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
-                              curve_fit.distance_sq, spring};
+    if (placed < placements.size()) {
+      placements[placed] = {v,
+                            energy,
+                            std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
+                            curve_fit.distance_sq,
+                            spring,
+                            placed};
+      ++placed;
+    }
   };
   auto solve = [&](const Fit& fit, const Vec3& from) -> Vec3 {
     const double denominator = weight * fit.a + curve_fit.a + spring_weight;
@@ -335,7 +347,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   out.position = chosen->v;
   out.cost = chosen->energy - distance_before - curve_before - kappa * spring_before;
   out.error = std::sqrt(chosen->max_distance_sq);
-  if (evaluated_.size() < total || scalar_.enabled()) {
+  if (keep_projections) projected_.swap(placement_projections_[chosen->index]);
+  if (evaluated_.size() < total) {
     const Fit all = project_points(star_points_, star_homes_, chosen->v,
                                    scalar_.enabled() ? &projected_ : nullptr);
     double all_before = 0;
@@ -343,8 +356,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     out.cost = all.distance_sq - all_before + chosen->curve_distance_sq - curve_before +
                chosen->spring - kappa * spring_before;
     out.error = std::sqrt(std::max(all.max_distance_sq, chosen->max_distance_sq));
-    if (scalar_.enabled()) out.cost += scalar_change();
   }
+  if (scalar_.enabled()) out.cost += scalar_change();
   // Penalised, not forbidden (Hoppe 96): such collapses come after every ordinary one.
   if (topology) out.cost += topology_penalty_;
   return std::isfinite(out.cost);

@@ -152,7 +152,8 @@ class EnergyPriority : public PriorityModule {
   mutable std::array<std::pair<WedgeId, WedgeId>, 2> joined_{};  // wedges of a, b in fl, fr
   mutable int joined_count_ = 0;
   mutable std::vector<Projected> projected_;  // per star point, at the chosen placement
-  std::vector<FaceId> moved_faces_;           // collapsed: per star point, its new face
+  mutable std::array<std::vector<Projected>, 16> placement_projections_;
+  std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
   std::vector<std::array<double, 3>> moved_bary_;
   mutable std::vector<PreparedTriangle> prepared_;  // star_ with v at the projected position
   mutable std::vector<uint8_t> prepared_ready_;
