@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Dense>
+
 #include "simplify/face_fold.h"
 #include "simplify/point_projection.h"
 #include "simplify/surface_samples.h"
@@ -43,9 +45,12 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
     curves_ = SharpCurves{};
     curves_.initialize_empty(mesh);
   }
-  // Large against any ordinary change of energy: (bounding-box diagonal)^2 per vertex.
-  const double diagonal = bounding_box(mesh.positions()).diagonal();
-  topology_penalty_ = diagonal * diagonal * double(std::max<size_t>(1, mesh.live_vertices()));
+  const double diagonal = options_.reference_diagonal > 0
+                              ? options_.reference_diagonal
+                              : bounding_box(mesh.positions()).diagonal();
+  // Large against any ordinary change of energy (each point costs at most diagonal^2), and the
+  // same for every subset of a mesh, so that penalised costs still compare across subsets.
+  topology_penalty_ = diagonal * diagonal * 1e9;
 
   const bool scalar = mesh.has_wedges() && attributes_.layout.any();
   scalar_.initialize(scalar ? attributes_.layout : AttributeLayout{}, attributes_.values,
@@ -54,6 +59,8 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
   points_.clear();
   points_.reserve(samples.size());
   face_first_.assign(mesh.face_capacity(), kNoPoint);
+  moments_.assign(mesh.face_capacity(), PointMoments{});
+  moments_ready_.assign(mesh.face_capacity(), 0);
   parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
   sample_vertex_.clear();
   sample_vertex_.reserve(samples.size());
@@ -76,6 +83,96 @@ void EnergyPriority::gather_face(FaceId f, int home) const {
     star_points_.push_back(id);
     star_homes_.push_back(home);
   }
+}
+
+const PointMoments& EnergyPriority::moments_of(FaceId f) const {
+  if (!moments_ready_[f]) {
+    PointMoments m;
+    for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next)
+      m.add(points_[id].position);
+    moments_[f] = m;
+    moments_ready_[f] = 1;
+  }
+  return moments_[f];
+}
+
+// The squared distances of face f's points to the plane of (q0, q1, q2); to the triangle
+// itself when it is too thin to have a plane.
+double EnergyPriority::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1,
+                                         const Vec3& q2) const {
+  const PointMoments& m = moments_of(f);
+  if (m.count == 0) return 0;
+  const Vec3 n = triangle_normal(q0, q1, q2);
+  const double n_sq = dot(n, n);
+  const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
+  if (n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0)
+    return m.plane_distance_sq(q0, scale(n, 1.0 / std::sqrt(n_sq)));
+  double sum = 0;
+  for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next)
+    sum += project_on_triangle(points_[id].position, q0, q1, q2).distance_sq;
+  return sum;
+}
+
+// E_dist of a star too rich in points to project each one, in O(faces of the star): each
+// face's points are measured against its plane (by their moments), before and after alike, so
+// that the error of a point whose closest point is on a face's rim, not inside, is left out of
+// both rather than one. Only the samples of a and b (parked, at distance 0 before) are
+// projected one by one.
+double EnergyPriority::moment_distance_before(const CollapseMesh& mesh) const {
+  double sum = 0;
+  for (const StarFace& f : star_) sum += plane_distance_sq(f.source, f.before, f.p1, f.p2);
+  for (const FaceId f : edge_faces_)
+    if (f != kNoId) {
+      const Triangle& t = mesh.face(f);
+      sum += plane_distance_sq(f, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+    }
+  return sum;
+}
+
+double EnergyPriority::moment_distance_after(const Vec3& v) const {
+  double sum = 0;
+  for (const StarFace& f : star_) sum += plane_distance_sq(f.source, v, f.p1, f.p2);
+  for (int e = 0; e < 2; ++e)
+    if (edge_faces_[e] != kNoId) {
+      const StarFace& home = star_[edge_face_homes_[e]];
+      sum += plane_distance_sq(edge_faces_[e], v, home.p1, home.p2);
+    }
+  if (!parked_ends_.empty()) sum += project_points(parked_ends_, parked_end_homes_, v).distance_sq;
+  return sum;
+}
+
+// One step of iteratively reweighted least squares on the planes: each face's |n(v)|^2 taken
+// at `from`, the rest is quadratic in v (add_plane_quadratic); `iso_a` |v|^2 - 2 iso_b.v are
+// the springs' and the curves' terms, as in the projection solve.
+Vec3 EnergyPriority::moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b) const {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Identity() * iso_a;
+  Eigen::Vector3d r(iso_b[0], iso_b[1], iso_b[2]);
+  auto add_face = [&](FaceId source, const Vec3& p1, const Vec3& p2) {
+    const PointMoments& m = moments_of(source);
+    if (m.count == 0) return;
+    const Vec3 n = triangle_normal(from, p1, p2);
+    const double n_sq = dot(n, n);
+    if (n_sq > 0) add_plane_quadratic(m, p1, p2, 1.0 / n_sq, h, r);
+  };
+  for (const StarFace& f : star_) add_face(f.source, f.p1, f.p2);
+  for (int e = 0; e < 2; ++e)
+    if (edge_faces_[e] != kNoId)
+      add_face(edge_faces_[e], star_[edge_face_homes_[e]].p1, star_[edge_face_homes_[e]].p2);
+  if (!parked_ends_.empty()) {
+    const Fit fit = project_points(parked_ends_, parked_end_homes_, from);
+    h += Eigen::Matrix3d::Identity() * fit.a;
+    r += Eigen::Vector3d(fit.b[0], fit.b[1], fit.b[2]);
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> solver(h);
+  const Eigen::Vector3d v = solver.solve(r);
+  if (solver.info() != Eigen::Success || !v.allFinite()) return from;
+  return {v[0], v[1], v[2]};
+}
+
+double EnergyPriority::exact_distance_sq() const {
+  double sum = 0;
+  for (uint32_t id : star_points_) sum += points_[id].distance_sq;
+  return sum;
 }
 
 void EnergyPriority::unpark(VertexId v) {
@@ -182,10 +279,12 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   // with the moving corner first. Points of the two faces that disappear are homed next to
   // their apex once the fan is known.
   star_.clear();
+  star_lists_.clear();
   star_points_.clear();
   star_homes_.clear();
   std::array<VertexId, 2> edge_apexes{kNoId, kNoId};
   int edge_faces = 0;
+  edge_faces_ = {kNoId, kNoId};
   joined_count_ = 0;
   double spring_before = 0;
   for (VertexId end : {a, b}) {
@@ -207,16 +306,18 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
             const auto& w = mesh.corner_wedges(f);
             joined_[joined_count_++] = {w[k], w[other_corner]};
           }
-          gather_face(f, -2 - edge_faces);
+          edge_faces_[edge_faces] = f;
+          star_lists_.push_back({f, -2 - edge_faces});
           ++edge_faces;
         }
       } else {
         star_.push_back({p1, p2, p0, t[(k + 1) % 3], t[(k + 2) % 3]});
+        star_.back().source = f;
         if (scalar_.enabled()) {
           const auto& w = mesh.corner_wedges(f);
           star_.back().wedges = {w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
         }
-        gather_face(f, int(star_.size()) - 1);
+        star_lists_.push_back({f, int(star_.size()) - 1});
       }
     }
   }
@@ -235,39 +336,35 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     // A neighbour's parked sample sits on the star's rim: half of it counts as the star's.
     if (parked_point_[face.id1] != kNoPoint) parked_around += 0.5;
   }
-  for (int& home : star_homes_)
-    if (home < 0) home = apex_home[-2 - home];
+  edge_face_homes_ = apex_home;
   // The samples of a and b themselves, where they still are.
+  parked_ends_.clear();
+  parked_end_homes_.clear();
   for (VertexId end : {a, b})
     if (parked_point_[end] != kNoPoint) {
-      star_points_.push_back(parked_point_[end]);
-      star_homes_.push_back(end == a ? -1 : -2);
+      parked_ends_.push_back(parked_point_[end]);
+      parked_end_homes_.push_back(end == a ? -1 : -2);
     }
-  const double points_around = double(star_points_.size()) + parked_around;
-
-  // The points the placement is optimised on: all of them, or an evenly strided subset
-  // standing for all. (The cost is then measured on all of them at the chosen placement: a
-  // cost estimated on a subset is noisy, and the queue, which picks minima, would pick the
-  // lucky draws; that once grew vertices of valence 40 around point-rich stars.)
-  const size_t total = star_points_.size();
+  // How many points the star holds: the faces' counts are their moments' (kept per face).
+  size_t in_faces = 0;
+  for (const auto& list : star_lists_) in_faces += size_t(moments_of(list.first).count);
+  const size_t total = in_faces + parked_ends_.size();
+  const double points_around = double(total) + parked_around;
   const size_t cap = std::max<uint32_t>(1, options_.max_points_per_evaluation);
-  evaluated_.clear();
-  evaluated_homes_.clear();
-  if (total <= cap) {
-    evaluated_ = star_points_;
-    evaluated_homes_ = star_homes_;
-  } else {
-    for (size_t i = 0; i < cap; ++i) {
-      evaluated_.push_back(star_points_[(i * total) / cap]);
-      evaluated_homes_.push_back(star_homes_[(i * total) / cap]);
-    }
+  // A star with more points than cap is placed and costed on its faces' point moments, in
+  // O(faces) whatever its points (moment_solve, moment_distance_after): late collapses cover
+  // hundreds of points. A smaller one projects each point, exactly. With E_scalar the points
+  // are gathered either way: the attributes need where each one lands.
+  const bool by_moments = total > cap;
+  if (!by_moments || scalar_.enabled()) {
+    for (const auto& [f, home] : star_lists_)
+      gather_face(f, home < 0 ? apex_home[-2 - home] : home);
+    star_points_.insert(star_points_.end(), parked_ends_.begin(), parked_ends_.end());
+    star_homes_.insert(star_homes_.end(), parked_end_homes_.begin(), parked_end_homes_.end());
   }
   curves_.gather(a, b, mesh);
   const double curve_before = curves_.gathered_distance_sq();
-  const double weight = evaluated_.empty() ? 0.0 : double(total) / double(evaluated_.size());
-  double distance_before = 0;
-  for (uint32_t id : evaluated_) distance_before += points_[id].distance_sq;
-  distance_before *= weight;
+  const double distance_before = by_moments ? moment_distance_before(mesh) : exact_distance_sq();
 
   const double kappa = spring_constant(points_around / double(star_.size()));
   Vec3 spring_pull{};  // kappa/2 * sum (p1 + p2): the springs' part of the normal equations
@@ -286,16 +383,22 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   std::array<Placement, 16> placements;
   size_t placed = 0;
   SharpCurves::Fit curve_fit;
-  // With E_scalar and every point evaluated, each placement keeps its projections, so that
+  // With E_scalar and every point projected, each placement keeps its projections, so that
   // the chosen one's need not be computed again.
-  const bool keep_projections = scalar_.enabled() && evaluated_.size() == total;
+  const bool keep_projections = scalar_.enabled() && !by_moments;
   auto measure = [&](const Vec3& v, Fit& fit) {
-    fit = project_points(
-        evaluated_, evaluated_homes_, v,
-        keep_projections && placed < placements.size() ? &placement_projections_[placed] : nullptr);
+    if (by_moments) {
+      fit = Fit{};
+      fit.distance_sq = moment_distance_after(v);
+    } else {
+      fit = project_points(star_points_, star_homes_, v,
+                           keep_projections && placed < placements.size()
+                               ? &placement_projections_[placed]
+                               : nullptr);
+    }
     curve_fit = curves_.gathered() ? curves_.project(v) : SharpCurves::Fit{};
     const double spring = kappa * spring_energy_after(v);
-    const double energy = weight * fit.distance_sq + curve_fit.distance_sq + spring;
+    const double energy = fit.distance_sq + curve_fit.distance_sq + spring;
     if (placed < placements.size()) {
       placements[placed] = {v,
                             energy,
@@ -307,9 +410,14 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     }
   };
   auto solve = [&](const Fit& fit, const Vec3& from) -> Vec3 {
-    const double denominator = weight * fit.a + curve_fit.a + spring_weight;
-    if (!(denominator > 0)) return from;
-    Vec3 v = scale(add(add(scale(fit.b, weight), curve_fit.b), spring_pull), 1.0 / denominator);
+    Vec3 v;
+    if (by_moments) {
+      v = moment_solve(from, curve_fit.a + spring_weight, add(curve_fit.b, spring_pull));
+    } else {
+      const double denominator = fit.a + curve_fit.a + spring_weight;
+      if (!(denominator > 0)) return from;
+      v = scale(add(add(fit.b, curve_fit.b), spring_pull), 1.0 / denominator);
+    }
     if (boundary_a && boundary_b && curves_.sample_count() == 0) {
       // Without curve samples (discontinuities off), a boundary edge keeps its vertex on the
       // segment, so that the boundary keeps its place (the energy is isotropic in v, so the
@@ -348,15 +456,9 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   out.cost = chosen->energy - distance_before - curve_before - kappa * spring_before;
   out.error = std::sqrt(chosen->max_distance_sq);
   if (keep_projections) projected_.swap(placement_projections_[chosen->index]);
-  if (evaluated_.size() < total) {
-    const Fit all = project_points(star_points_, star_homes_, chosen->v,
-                                   scalar_.enabled() ? &projected_ : nullptr);
-    double all_before = 0;
-    for (uint32_t id : star_points_) all_before += points_[id].distance_sq;
-    out.cost = all.distance_sq - all_before + chosen->curve_distance_sq - curve_before +
-               chosen->spring - kappa * spring_before;
-    out.error = std::sqrt(std::max(all.max_distance_sq, chosen->max_distance_sq));
-  }
+  // E_scalar wants every point's projection at the chosen placement.
+  if (scalar_.enabled() && by_moments)
+    project_points(star_points_, star_homes_, chosen->v, &projected_);
   if (scalar_.enabled()) out.cost += scalar_change();
   // Penalised, not forbidden (Hoppe 96): such collapses come after every ordinary one.
   if (topology) out.cost += topology_penalty_;
@@ -423,6 +525,7 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
     for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next)
       star_points_.push_back(id);
     face_first_[f] = kNoPoint;
+    moments_ready_[f] = 0;
   };
   if (edge.left != kNoId) take(edge.left);
   if (edge.right != kNoId) take(edge.right);
@@ -438,16 +541,20 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   if (faces.empty()) return;
   moved_faces_.clear();
   moved_bary_.clear();
+  prepared_.clear();
+  for (FaceId f : faces) {
+    const Triangle& t = mesh.face(f);
+    prepared_.emplace_back(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+  }
   for (uint32_t id : star_points_) {
     Point& point = points_[id];
     Projection best;
     best.distance_sq = std::numeric_limits<double>::infinity();
     FaceId best_face = faces[0];
     double best_score = std::numeric_limits<double>::infinity();
-    for (FaceId f : faces) {
-      const Triangle& t = mesh.face(f);
-      const Projection p = project_on_triangle(point.position, mesh.position(t[0]),
-                                               mesh.position(t[1]), mesh.position(t[2]));
+    for (size_t j = 0; j < faces.size(); ++j) {
+      const FaceId f = faces[j];
+      const Projection p = prepared_[j].project(point.position);
       // With E_scalar a point goes where its whole energy is least: a point on a seam is as
       // close to the faces of both sides and belongs to the side whose attributes it has.
       const double score =

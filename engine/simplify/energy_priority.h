@@ -19,11 +19,14 @@
 // E_scalar is added to the cost.
 //
 // Bounded cost, the fix for the 1999 implementation's quadratic behaviour: late collapses
-// cover hundreds of points, but a candidate evaluation looks at no more than
-// max_points_per_evaluation of them (an evenly strided subset, weighted to stand for all, the
-// same subset for the energy before and after, so that the difference is paired). Only the
-// collapse actually performed re-projects every point of its star, so that the stored
-// distances, and the error recorded in the PM, are exact.
+// cover hundreds of points. A star holding more than max_points_per_evaluation points is
+// measured on its faces' point moments (point_moments.h, kept per face until its points
+// change): the points' squared distances to each face's plane, before and after, and the
+// placement by iteratively reweighted least squares on those planes, both O(faces of the
+// star) whatever its points. Smaller stars project each point onto the new star (and may move
+// it to the face beside). Only the collapse actually performed re-projects every point of its
+// star onto its closest face, so that the stored distances, and the error recorded in the PM,
+// are exact.
 //
 // The sample of a vertex that has not moved lies on the mesh, on that vertex, whatever
 // happens around it: it is "parked" at its vertex (in no face's list) and costs nothing until
@@ -35,6 +38,7 @@
 #include <vector>
 
 #include "simplify/modules.h"
+#include "simplify/point_moments.h"
 #include "simplify/point_projection.h"
 #include "simplify/scalar_attributes.h"
 #include "simplify/sharp_curves.h"
@@ -44,6 +48,7 @@ namespace parapm {
 struct EnergyOptions {
   double samples_per_face = 0;  // extra area-weighted points, beyond one per vertex
   uint64_t seed = 1;            // of those extra points
+  // Stars with more points are costed by their faces' point moments, not point by point.
   uint32_t max_points_per_evaluation = 16;
   int solves_per_start = 1;     // least-squares solves after the first projection, per start
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
@@ -53,6 +58,10 @@ struct EnergyOptions {
   // (a colour channel's whole range) costs as much as a distance of weight x diagonal. 0: off
   // (the wedges keep their input values at every level).
   double attribute_weight = 0;
+  // The scale costs are measured against: the bounding-box diagonal of the whole mesh. 0: that
+  // of the mesh the module is given. A subset job passes the whole mesh's, so that the costs of
+  // different subsets (and the weights derived from the diagonal) are comparable.
+  double reference_diagonal = 0;
 };
 
 // The input's wedge values, for E_scalar (CollapseMesh holds only the corners' wedge ids).
@@ -103,6 +112,7 @@ class EnergyPriority : public PriorityModule {
   struct StarFace {
     Vec3 p1, p2, before;
     VertexId id1, id2;
+    FaceId source = kNoId;  // the face it is the image of
     int next = -1, previous = -1;
     std::array<WedgeId, 3> wedges{};  // of the corners v, p1, p2 (with E_scalar)
     int group = 0;                    // E_scalar's group of the corner at v
@@ -124,6 +134,12 @@ class EnergyPriority : public PriorityModule {
   Fit project_points(const std::vector<uint32_t>& ids, const std::vector<int>& homes, const Vec3& v,
                      std::vector<Projected>* where = nullptr) const;
   double scalar_change() const;
+  const PointMoments& moments_of(FaceId f) const;
+  double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2) const;
+  double exact_distance_sq() const;
+  double moment_distance_before(const CollapseMesh& mesh) const;
+  double moment_distance_after(const Vec3& v) const;
+  Vec3 moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b) const;
   void update_attributes(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge);
   void gather_face(FaceId f, int home) const;
   void unpark(VertexId v);
@@ -143,12 +159,22 @@ class EnergyPriority : public PriorityModule {
 
   // Scratch of one evaluation (evaluate is const but, like CollapseMesh, not thread-safe).
   mutable std::vector<StarFace> star_;
+  // The faces whose points are the star's (the star's sources and the two removed faces),
+  // with the star face their points are measured against (-2, -3: the removed faces, homed
+  // once the fan is known).
+  mutable std::vector<std::pair<FaceId, int>> star_lists_;
   mutable std::vector<uint32_t> star_points_;
   // Per star point: the star face its face becomes (-1, -2: the samples of a and b).
   mutable std::vector<int> star_homes_;
-  mutable std::vector<uint32_t> evaluated_;
-  mutable std::vector<int> evaluated_homes_;
-  mutable int a_side_faces_ = 0;                                 // star_ holds a's faces, then b's
+  mutable int a_side_faces_ = 0;
+  mutable std::array<FaceId, 2> edge_faces_{kNoId, kNoId};  // the two faces the collapse removes
+  mutable std::array<int, 2> edge_face_homes_{};            // the star faces their points go to
+  mutable std::vector<uint32_t> parked_ends_;               // the samples of a and b, while parked
+  mutable std::vector<int> parked_end_homes_;
+  // Per face, the moments of the points projecting onto it (computed when first needed,
+  // forgotten when its point list changes).
+  mutable std::vector<PointMoments> moments_;
+  mutable std::vector<uint8_t> moments_ready_;                   // star_ holds a's faces, then b's
   mutable std::array<std::pair<WedgeId, WedgeId>, 2> joined_{};  // wedges of a, b in fl, fr
   mutable int joined_count_ = 0;
   mutable std::vector<Projected> projected_;  // per star point, at the chosen placement
