@@ -1,4 +1,5 @@
-// parapm simplify IN -o OUT.pm: read, repair, build the Progressive Mesh, write it.
+// parapm simplify IN -o OUT.pm: read, repair, build the Progressive Mesh (sequentially, or
+// with --parallel P subsets on a thread pool), write it.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -7,6 +8,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "parallel/parallel_build.h"
 #include "pm/pm_file.h"
 #include "simplify/simplify.h"
 #include "util/memory.h"
@@ -25,8 +27,43 @@ struct SimplifyArgs {
   double attribute_weight = 0.01;
   uint64_t seed = 1;
   bool keep_order = false;
+  uint32_t parallel = 1;  // subsets p; 1: the sequential build
+  unsigned threads = 0;   // 0: min(p, hardware threads)
+  double handover = 0.3;
   bool json = false;
 };
+
+nlohmann::json parallel_json(const ParallelStats& stats) {
+  nlohmann::json rounds = nlohmann::json::array();
+  for (const RoundStats& r : stats.round_stats) {
+    nlohmann::json subsets = nlohmann::json::array();
+    for (const SubsetTiming& s : r.subsets)
+      subsets.push_back({{"subset", s.subset},
+                         {"faces", s.faces},
+                         {"owned_faces", s.owned_faces},
+                         {"collapses", s.collapses},
+                         {"wall_seconds", s.wall_seconds},
+                         {"cpu_seconds", s.cpu_seconds},
+                         {"stop_reason", s.stop_reason}});
+    rounds.push_back({{"round", r.round},
+                      {"faces_before", r.faces_before},
+                      {"goal_faces", r.goal_faces},
+                      {"faces_after", r.faces_after},
+                      {"partition_seconds", r.partition_seconds},
+                      {"extract_seconds", r.extract_seconds},
+                      {"subsets_seconds", r.subsets_seconds},
+                      {"merge_seconds", r.merge_seconds},
+                      {"subsets", subsets}});
+  }
+  return {{"p", stats.subsets},
+          {"rounds", stats.rounds},
+          {"threads", stats.threads},
+          {"round_stats", rounds},
+          {"final_pass_collapses", stats.final_pass_collapses},
+          {"final_pass_seconds", stats.final_pass_seconds},
+          {"pm_build_seconds", stats.pm_build_seconds},
+          {"cpu_seconds", stats.cpu_seconds}};
+}
 
 int run_simplify(const SimplifyArgs& args) {
   RepairOptions repair_options;
@@ -43,9 +80,22 @@ int run_simplify(const SimplifyArgs& args) {
   options.seed = args.seed;
   options.keep_order = args.keep_order;
   SimplifyStats stats;
+  ParallelStats parallel_stats;
   ProgressBar bar("simplify");
-  ProgressiveMesh pm =
-      build_progressive_mesh(loaded.repaired, options, &stats, bar.callback(), nullptr);
+  ProgressiveMesh pm;
+  if (args.parallel > 1) {
+    ParallelOptions parallel;
+    parallel.subsets = args.parallel;
+    parallel.threads = args.threads;
+    parallel.handover_ratio = args.handover;
+    pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
+                                         bar.callback(), nullptr);
+    stats.collapses = parallel_stats.collapses;
+    stats.stop_reason = parallel_stats.stop_reason;
+    stats.seconds = parallel_stats.seconds;
+  } else {
+    pm = build_progressive_mesh(loaded.repaired, options, &stats, bar.callback(), nullptr);
+  }
   bar.finish();
 
   const auto write_start = std::chrono::steady_clock::now();
@@ -59,25 +109,27 @@ int run_simplify(const SimplifyArgs& args) {
                pm.splits.size(), stats.seconds, stats.stop_reason, args.output);
 
   if (args.json) {
-    print_json({{"input", args.input},
-                {"output", args.output},
-                {"in_vertices", loaded.input_vertices},
-                {"in_faces", loaded.input_faces},
-                {"repaired_vertices", loaded.repaired.mesh.vertex_count()},
-                {"repaired_faces", loaded.repaired.mesh.face_count()},
-                {"base_vertices", pm.base.vertex_count()},
-                {"base_faces", pm.base.face_count()},
-                {"vsplits", pm.splits.size()},
-                {"seconds", stats.seconds},
-                {"read_seconds", loaded.read_seconds},
-                {"repair_seconds", loaded.repair_seconds},
-                {"write_seconds", write_seconds},
-                {"metric", pm.info.metric},
-                {"stop_reason", stats.stop_reason},
-                {"pm_bytes", pm_bytes},
-                {"binary_ply_bytes", ply_bytes},
-                {"peak_memory_bytes", peak},
-                {"repairs", repair_report_json(loaded.repaired.report)}});
+    nlohmann::json out = {{"input", args.input},
+                          {"output", args.output},
+                          {"in_vertices", loaded.input_vertices},
+                          {"in_faces", loaded.input_faces},
+                          {"repaired_vertices", loaded.repaired.mesh.vertex_count()},
+                          {"repaired_faces", loaded.repaired.mesh.face_count()},
+                          {"base_vertices", pm.base.vertex_count()},
+                          {"base_faces", pm.base.face_count()},
+                          {"vsplits", pm.splits.size()},
+                          {"seconds", stats.seconds},
+                          {"read_seconds", loaded.read_seconds},
+                          {"repair_seconds", loaded.repair_seconds},
+                          {"write_seconds", write_seconds},
+                          {"metric", pm.info.metric},
+                          {"stop_reason", stats.stop_reason},
+                          {"pm_bytes", pm_bytes},
+                          {"binary_ply_bytes", ply_bytes},
+                          {"peak_memory_bytes", peak},
+                          {"repairs", repair_report_json(loaded.repaired.report)}};
+    if (args.parallel > 1) out["parallel"] = parallel_json(parallel_stats);
+    print_json(out);
   } else {
     std::printf("input      %s: %llu vertices, %llu faces\n", args.input.c_str(),
                 (unsigned long long)loaded.input_vertices, (unsigned long long)loaded.input_faces);
@@ -86,6 +138,19 @@ int run_simplify(const SimplifyArgs& args) {
     std::printf("vsplits    %zu (%s)\n", pm.splits.size(), stats.stop_reason.c_str());
     std::printf("time       %.3f s simplification, %.3f s read, %.3f s repair\n", stats.seconds,
                 loaded.read_seconds, loaded.repair_seconds);
+    if (args.parallel > 1) {
+      double subsets = 0, merge = 0;
+      for (const RoundStats& r : parallel_stats.round_stats) {
+        subsets += r.subsets_seconds;
+        merge += r.merge_seconds;
+      }
+      std::printf(
+          "parallel   p=%u on %u threads: subsets %.3f s, merge %.3f s, final pass "
+          "%.3f s (%llu collapses), %.3f s CPU in all\n",
+          parallel_stats.subsets, parallel_stats.threads, subsets, merge,
+          parallel_stats.final_pass_seconds,
+          (unsigned long long)parallel_stats.final_pass_collapses, parallel_stats.cpu_seconds);
+    }
     std::printf("size       %llu bytes .pm, %llu bytes binary PLY (%.2fx)\n",
                 (unsigned long long)pm_bytes, (unsigned long long)ply_bytes,
                 ply_bytes ? double(pm_bytes) / double(ply_bytes) : 0.0);
@@ -134,7 +199,24 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_flag("--keep-order", args->keep_order,
                 "Store the input's vertex and face order, and keep unreferenced vertices");
-  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->add_option("--parallel", args->parallel,
+                  "Build with P subsets simplified in parallel (Langis 1999): partition, one "
+                  "round of subset jobs down to the handover, merge by cost, then a sequential "
+                  "final pass over the borders to the target. 1: the sequential build")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads,
+                  "With --parallel: threads of the pool (0: min(P, hardware threads)); the .pm "
+                  "does not depend on it")
+      ->capture_default_str();
+  cmd->add_option("--handover-ratio", args->handover,
+                  "With --parallel: the subsets simplify the mesh down to this fraction of the "
+                  "input faces (or the target if larger); the final pass does the rest")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_flag("--json", args->json,
+                "Print one JSON object on stdout (with --parallel: p, rounds, per-subset wall "
+                "and CPU seconds, merge and final-pass seconds under \"parallel\")");
   cmd->callback([args, &exit_code] { exit_code = run_simplify(*args); });
 }
 

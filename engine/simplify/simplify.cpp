@@ -24,10 +24,7 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
   return 0;
 }
 
-ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const SimplifyOptions& options,
-                                       SimplifyStats* stats, const ProgressCallback& progress,
-                                       const CancelToken* cancel) {
-  const auto start = std::chrono::steady_clock::now();
+void check_simplify_options(const SimplifyOptions& options) {
   if (options.metric != "quadric" && options.metric != "energy")
     throw_invalid("unknown metric '" + options.metric + "' (available: quadric, energy)");
   if (!(options.crease_angle_degrees >= 0 && options.crease_angle_degrees <= 180))
@@ -39,23 +36,26 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   if (!(options.samples_per_face >= 0 && options.samples_per_face <= 1000))
     throw_invalid("samples per face must be in [0, 1000], got " +
                   std::to_string(options.samples_per_face));
+}
+
+std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired) {
   const Mesh& mesh = repaired.mesh;
-
-  // Vertices the repair step duplicated (non-manifold input) stay where they are, so that the
-  // copies of one input vertex never drift apart and open a crack.
   std::vector<uint8_t> locked(mesh.vertex_count(), 0);
-  {
-    std::vector<uint32_t> uses(repaired.input_vertex.empty() ? 0 : mesh.vertex_count(), 0);
-    for (VertexId in : repaired.input_vertex) {
-      if (in >= uses.size()) uses.resize(size_t(in) + 1, 0);
-      ++uses[in];
-    }
-    for (VertexId v = 0; v < mesh.vertex_count(); ++v)
-      if (!repaired.input_vertex.empty() && uses[repaired.input_vertex[v]] > 1) locked[v] = 1;
+  if (repaired.input_vertex.empty()) return locked;
+  std::vector<uint32_t> uses(mesh.vertex_count(), 0);
+  for (VertexId in : repaired.input_vertex) {
+    if (in >= uses.size()) uses.resize(size_t(in) + 1, 0);
+    ++uses[in];
   }
+  for (VertexId v = 0; v < mesh.vertex_count(); ++v)
+    if (uses[repaired.input_vertex[v]] > 1) locked[v] = 1;
+  return locked;
+}
 
-  CollapseMesh working(mesh);
-  std::unique_ptr<PriorityModule> priority;
+std::unique_ptr<PriorityModule> make_priority_module(const SimplifyOptions& options,
+                                                     const Mesh& mesh,
+                                                     const std::vector<uint8_t>& locked,
+                                                     double reference_diagonal) {
   if (options.metric == "energy") {
     EnergyOptions energy_options;
     energy_options.samples_per_face = options.samples_per_face;
@@ -63,13 +63,27 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
     energy_options.round_to_float = mesh.positions_are_float;
     energy_options.sharp.crease_angle_degrees = options.crease_angle_degrees;
     energy_options.attribute_weight = options.attribute_weight;
-    priority = std::make_unique<EnergyPriority>(locked, energy_options,
-                                                WedgeAttributes{mesh.layout, mesh.wedge_values});
-  } else {
-    QuadricOptions quadric_options;
-    quadric_options.round_to_float = mesh.positions_are_float;
-    priority = std::make_unique<QuadricPriority>(locked, quadric_options);
+    energy_options.reference_diagonal = reference_diagonal;
+    return std::make_unique<EnergyPriority>(locked, energy_options,
+                                            WedgeAttributes{mesh.layout, mesh.wedge_values});
   }
+  QuadricOptions quadric_options;
+  quadric_options.round_to_float = mesh.positions_are_float;
+  return std::make_unique<QuadricPriority>(locked, quadric_options);
+}
+
+ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const SimplifyOptions& options,
+                                       SimplifyStats* stats, const ProgressCallback& progress,
+                                       const CancelToken* cancel) {
+  const auto start = std::chrono::steady_clock::now();
+  check_simplify_options(options);
+  const Mesh& mesh = repaired.mesh;
+
+  // Vertices the repair step duplicated (non-manifold input) stay where they are, so that the
+  // copies of one input vertex never drift apart and open a crack.
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh working(mesh);
+  std::unique_ptr<PriorityModule> priority = make_priority_module(options, mesh, locked);
   Simplifier simplifier(working, *priority, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target_face_count(mesh.face_count(), options);

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "mesh/repair.h"
 #include "pm/progressive_mesh.h"
@@ -45,5 +47,20 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
                                        const CancelToken* cancel = nullptr);
 
 uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options);
+
+// The steps of build_progressive_mesh that the parallel build (engine/parallel) shares.
+// Throws Error(kInvalidInput) for an unknown metric or an option out of range.
+void check_simplify_options(const SimplifyOptions& options);
+// Per vertex of repaired.mesh: 1 when the repair step made copies of its input vertex (such
+// vertices never move, so that the copies of one input vertex never crack apart).
+std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired);
+class PriorityModule;
+// The priority module of options.metric for `mesh` (per vertex `locked`). reference_diagonal:
+// the scale energy costs are measured against; 0 means mesh's own bounding-box diagonal (a
+// subset job passes the whole mesh's, so that costs compare across subsets).
+std::unique_ptr<PriorityModule> make_priority_module(const SimplifyOptions& options,
+                                                     const Mesh& mesh,
+                                                     const std::vector<uint8_t>& locked,
+                                                     double reference_diagonal = 0);
 
 }  // namespace parapm

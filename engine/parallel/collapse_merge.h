@@ -1,0 +1,36 @@
+// Merging the subsets' collapse records into one sequence, and replaying it on the whole
+// mesh (METHOD.md section 4, weakness 4: the 1999 merge interleaved the workers' records
+// round-robin, so a prefix of the PM was not the cheapest part of the work).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "simplify/collapse_mesh.h"
+#include "simplify/modules.h"
+#include "simplify/simplifier.h"
+
+namespace parapm {
+
+// k-way merge by cost: repeatedly takes, among the first untaken record of each list, the one
+// of least cost (ties to the lower list index). Each list's own order is kept, which is all
+// the subset rule needs for the sequence to replay (subset_rule.h); a list's costs need not
+// be sorted (a subset's cost sequence is only roughly increasing). O(n log k).
+std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord>> lists);
+
+struct ReplayReport {
+  uint64_t collapses = 0;
+  // Records whose wedge changes differ from those `priority` computed on the whole mesh (the
+  // module's state then differs from the subset's: extra random points drawn per subset).
+  uint64_t attribute_mismatches = 0;
+};
+
+// Performs `records` on `mesh` in order, checking that each is an edge of the present mesh
+// with the faces and apexes the record names (else Error(kInternal): the subset rule was
+// broken). When `priority` is given (initialised on `mesh` before the first record), it is
+// told of every collapse, so that its state follows the mesh (the final pass continues
+// with it); the records' own wedge changes and errors are kept.
+ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseRecord>& records,
+                              PriorityModule* priority);
+
+}  // namespace parapm

@@ -1,0 +1,82 @@
+#include "parallel/simplify_subset.h"
+
+#include <time.h>
+
+#include <chrono>
+
+#include <spdlog/spdlog.h>
+
+#include "parallel/subset_rule.h"
+#include "simplify/simplify.h"
+
+namespace parapm {
+namespace {
+
+// Local ids to global ids, in place.
+void globalise(CollapseRecord& r, const SubsetJob& job) {
+  auto vertex = [&](VertexId v) { return v == kNoId ? kNoId : job.global_vertex[v]; };
+  auto face = [&](FaceId f) { return f == kNoId ? kNoId : job.global_face[f]; };
+  auto wedge = [&](WedgeId w) { return w == kNoId ? kNoId : job.global_wedge[w]; };
+  r.vs = vertex(r.vs);
+  r.vt = vertex(r.vt);
+  r.vl = vertex(r.vl);
+  r.vr = vertex(r.vr);
+  r.fl = face(r.fl);
+  r.fr = face(r.fr);
+  for (WedgeId& w : r.corner_wedges) w = wedge(w);
+  for (WedgeId& w : r.changed_wedges) w = wedge(w);
+}
+
+}  // namespace
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress,
+                             const CancelToken* cancel) {
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_seconds();
+  validate_subset_job(job);
+  SimplifyOptions options;
+  options.metric = job.options.metric;
+  options.samples_per_face = job.options.samples_per_face;
+  options.crease_angle_degrees = job.options.crease_angle_degrees;
+  options.attribute_weight = job.options.attribute_weight;
+  options.seed = job.options.seed;
+  check_simplify_options(options);
+
+  SubsetResult result;
+  result.round = job.round;
+  result.subset = job.subset;
+  result.faces = job.mesh.face_count();
+  result.owned_faces = job.owned_faces;
+  std::vector<uint8_t> free_vertex = free_vertices(job.mesh, job.owned);
+  for (uint8_t f : free_vertex) result.free_vertices += f;
+
+  CollapseMesh working(job.mesh);
+  std::unique_ptr<PriorityModule> metric =
+      make_priority_module(options, job.mesh, job.locked, job.options.reference_diagonal);
+  std::unique_ptr<PriorityModule> priority = make_subset_priority(*metric, std::move(free_vertex));
+  auto constraints = standard_constraints(job.locked);
+  constraints.push_back(make_subset_constraint(job.owned));
+  Simplifier simplifier(working, *priority, std::move(constraints));
+  SimplifierLimits limits;
+  limits.target_faces = job.options.target_faces;
+  result.records = simplifier.run(limits, progress, cancel);
+  for (CollapseRecord& r : result.records) globalise(r, job);
+  result.stats = simplifier.stats();
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.cpu_seconds = thread_cpu_seconds() - cpu_start;
+  spdlog::debug(
+      "round {} subset {} simplified {}->{} faces ({} owned, {} free vertices) in {:.3f} s"
+      " ({:.3f} s CPU; {})",
+      job.round, job.subset, result.faces, working.live_faces(), result.owned_faces,
+      result.free_vertices, result.wall_seconds, result.cpu_seconds, result.stats.stop_reason);
+  return result;
+}
+
+}  // namespace parapm

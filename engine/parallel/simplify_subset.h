@@ -1,0 +1,38 @@
+// The worker's function of the parallel construction: simplify one subset job under the
+// subset rule (subset_rule.h) and return its collapse records in the whole mesh's ids. The
+// in-process build runs it on a thread pool; a worker daemon will run exactly this.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "parallel/subset_job.h"
+#include "simplify/simplifier.h"
+#include "util/progress.h"
+
+namespace parapm {
+
+struct SubsetResult {
+  uint32_t round = 0;
+  uint32_t subset = 0;
+  // In the order performed, in global ids (vs, vt, vl, vr, fl, fr, corner and changed
+  // wedges), with their costs: ready to be merged (collapse_merge.h) or streamed.
+  std::vector<CollapseRecord> records;
+  uint64_t faces = 0;        // of the job's mesh, halo included
+  uint64_t owned_faces = 0;  // of those, the faces with three owned vertices
+  uint64_t free_vertices = 0;
+  SimplifierStats stats;
+  double wall_seconds = 0;
+  double cpu_seconds = 0;  // of the calling thread (CLOCK_THREAD_CPUTIME_ID)
+};
+
+// Throws Error(kInvalidInput) for an invalid job or options, Error(kCancelled /
+// kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing.
+SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress = {},
+                             const CancelToken* cancel = nullptr);
+
+// CPU seconds used by the calling thread so far.
+double thread_cpu_seconds();
+
+}  // namespace parapm

@@ -1,0 +1,149 @@
+#include "parallel/subset_job.h"
+
+#include <algorithm>
+
+#include "util/error.h"
+
+namespace parapm {
+namespace {
+
+// Local id of `global` in the sorted list `ids` (present by construction).
+uint32_t local_of(const std::vector<uint32_t>& ids, uint32_t global) {
+  return uint32_t(std::lower_bound(ids.begin(), ids.end(), global) - ids.begin());
+}
+
+SubsetJob extract_one(const CollapseMesh& mesh, const AttributeLayout& layout,
+                      const std::vector<float>& wedge_values, bool positions_are_float,
+                      const std::vector<uint8_t>& locked,
+                      const std::vector<uint32_t>& vertex_subset,
+                      const std::vector<VertexId>& owned_vertices, uint32_t subset, uint32_t round,
+                      const SubsetOptions& options) {
+  SubsetJob job;
+  job.round = round;
+  job.subset = subset;
+  job.options = options;
+  // Mixed per round and subset, so that subsets do not draw the same sequence.
+  job.options.seed = options.seed + 0x9E3779B97F4A7C15ull * (uint64_t(round) * 257 + subset + 1);
+
+  // Faces: every live face around an owned vertex (the subset's faces and the halo).
+  for (VertexId v : owned_vertices)
+    for (FaceId f : mesh.faces_of(v)) job.global_face.push_back(f);
+  std::sort(job.global_face.begin(), job.global_face.end());
+  job.global_face.erase(std::unique(job.global_face.begin(), job.global_face.end()),
+                        job.global_face.end());
+  // Vertices: the corners of those faces.
+  for (FaceId f : job.global_face)
+    for (VertexId v : mesh.face(f)) job.global_vertex.push_back(v);
+  std::sort(job.global_vertex.begin(), job.global_vertex.end());
+  job.global_vertex.erase(std::unique(job.global_vertex.begin(), job.global_vertex.end()),
+                          job.global_vertex.end());
+
+  Mesh& out = job.mesh;
+  out.positions_are_float = positions_are_float;
+  out.positions.reserve(job.global_vertex.size());
+  job.owned.reserve(job.global_vertex.size());
+  job.locked.reserve(job.global_vertex.size());
+  for (VertexId g : job.global_vertex) {
+    out.positions.push_back(mesh.position(g));
+    job.owned.push_back(vertex_subset[g] == subset ? 1 : 0);
+    job.locked.push_back(!locked.empty() && locked[g] ? 1 : 0);
+  }
+  out.faces.reserve(job.global_face.size());
+  for (FaceId f : job.global_face) {
+    const Triangle& t = mesh.face(f);
+    Triangle local;
+    bool all_owned = true;
+    for (int k = 0; k < 3; ++k) {
+      local[k] = local_of(job.global_vertex, t[k]);
+      all_owned = all_owned && job.owned[local[k]];
+    }
+    out.faces.push_back(local);
+    if (all_owned) ++job.owned_faces;
+  }
+
+  if (layout.any() && mesh.has_wedges()) {
+    out.layout = layout;
+    for (FaceId f : job.global_face)
+      for (WedgeId w : mesh.corner_wedges(f)) job.global_wedge.push_back(w);
+    std::sort(job.global_wedge.begin(), job.global_wedge.end());
+    job.global_wedge.erase(std::unique(job.global_wedge.begin(), job.global_wedge.end()),
+                           job.global_wedge.end());
+    const size_t floats = size_t(layout.floats_per_wedge());
+    out.wedge_vertex.assign(job.global_wedge.size(), kNoId);
+    out.wedge_values.reserve(job.global_wedge.size() * floats);
+    for (WedgeId g : job.global_wedge)
+      out.wedge_values.insert(out.wedge_values.end(), wedge_values.begin() + ptrdiff_t(g * floats),
+                              wedge_values.begin() + ptrdiff_t((g + 1) * floats));
+    out.face_wedges.reserve(job.global_face.size());
+    for (size_t i = 0; i < job.global_face.size(); ++i) {
+      const auto& w = mesh.corner_wedges(job.global_face[i]);
+      std::array<WedgeId, 3> local;
+      for (int k = 0; k < 3; ++k) {
+        local[k] = local_of(job.global_wedge, w[k]);
+        out.wedge_vertex[local[k]] = out.faces[i][k];  // a wedge's corners share one vertex
+      }
+      out.face_wedges.push_back(local);
+    }
+  }
+  return job;
+}
+
+}  // namespace
+
+std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const AttributeLayout& layout,
+                                       const std::vector<float>& wedge_values,
+                                       bool positions_are_float, const std::vector<uint8_t>& locked,
+                                       const std::vector<uint32_t>& vertex_subset, uint32_t subsets,
+                                       uint32_t round, const SubsetOptions& options) {
+  if (vertex_subset.size() != mesh.vertex_capacity())
+    throw_invalid("extract_subsets: the partition has " + std::to_string(vertex_subset.size()) +
+                  " vertices, the mesh " + std::to_string(mesh.vertex_capacity()));
+  std::vector<std::vector<VertexId>> owned(subsets);
+  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
+    if (!mesh.vertex_alive(v)) continue;
+    if (vertex_subset[v] >= subsets)
+      throw_invalid("extract_subsets: vertex " + std::to_string(v) + " has subset " +
+                    std::to_string(vertex_subset[v]) + " of " + std::to_string(subsets));
+    owned[vertex_subset[v]].push_back(v);
+  }
+  std::vector<SubsetJob> jobs;
+  jobs.reserve(subsets);
+  for (uint32_t s = 0; s < subsets; ++s)
+    jobs.push_back(extract_one(mesh, layout, wedge_values, positions_are_float, locked,
+                               vertex_subset, owned[s], s, round, options));
+  return jobs;
+}
+
+void validate_subset_job(const SubsetJob& job) {
+  const Mesh& m = job.mesh;
+  const std::string name = "subset job " + std::to_string(job.subset) + ": ";
+  auto increasing = [&](const std::vector<uint32_t>& ids, const char* what) {
+    for (size_t i = 1; i < ids.size(); ++i)
+      if (!(ids[i - 1] < ids[i])) throw_invalid(name + what + " ids are not increasing");
+  };
+  if (job.global_vertex.size() != m.vertex_count() || job.owned.size() != m.vertex_count() ||
+      job.locked.size() != m.vertex_count())
+    throw_invalid(name + "per-vertex arrays disagree with the mesh");
+  if (job.global_face.size() != m.face_count()) throw_invalid(name + "face map size");
+  if (job.global_wedge.size() != m.wedge_count()) throw_invalid(name + "wedge map size");
+  if (!m.face_wedges.empty() && m.face_wedges.size() != m.face_count())
+    throw_invalid(name + "corner wedges size");
+  if (m.wedge_values.size() != m.wedge_count() * size_t(m.layout.floats_per_wedge()))
+    throw_invalid(name + "wedge values size");
+  increasing(job.global_vertex, "vertex");
+  increasing(job.global_face, "face");
+  increasing(job.global_wedge, "wedge");
+  for (FaceId f = 0; f < m.face_count(); ++f) {
+    bool touches = false;
+    for (int k = 0; k < 3; ++k) {
+      const VertexId v = m.faces[f][k];
+      if (v >= m.vertex_count()) throw_invalid(name + "face " + std::to_string(f) + " corner");
+      touches = touches || job.owned[v];
+      if (!m.face_wedges.empty() && m.face_wedges[f][k] >= m.wedge_count())
+        throw_invalid(name + "face " + std::to_string(f) + " wedge");
+    }
+    if (!touches) throw_invalid(name + "face " + std::to_string(f) + " touches no owned vertex");
+  }
+}
+
+}  // namespace parapm

@@ -1,0 +1,72 @@
+// A subset job: everything one worker needs to simplify its subset of a mesh, and nothing
+// more (METHOD.md section 4, weakness 1: the 1999 workers each loaded the whole mesh). Plain
+// data, so that the service layer can serialise it; the same job runs in a thread of the
+// in-process parallel build (parallel_build.h) and, later, in a worker daemon.
+//
+// Contents: the live faces that touch a vertex the subset owns (a vertex belongs to exactly
+// one subset, partition.h), in local ids. Those faces are the subset's own faces plus a
+// one-ring halo of read-only faces: every face around an owned vertex is present, so that
+// the fan, boundary status, quadric, sharp edges and sample points of every owned vertex are
+// those of the whole mesh (subset_rule.h says why that is all a legal collapse reads).
+// Local ids follow the global order (vertex, face and wedge i < j locally iff globally), so
+// that the simplifier's ties, broken by ids, fall as on the whole mesh.
+//
+// Memory: proportional to the subset plus its halo (about 24 B + 9 B per vertex, 12 B +
+// 4 B per face, plus attributes), never to the whole mesh.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mesh/mesh.h"
+#include "simplify/collapse_mesh.h"
+
+namespace parapm {
+
+// The options of a subset's simplification (a subset of SimplifyOptions, plus what only the
+// whole mesh knows).
+struct SubsetOptions {
+  std::string metric = "quadric";  // "quadric" or "energy"
+  double samples_per_face = 0;
+  double crease_angle_degrees = 60;
+  double attribute_weight = 0.01;
+  uint64_t seed = 1;  // already mixed with the round and subset index by the extraction
+  // The whole mesh's bounding-box diagonal: energy costs are measured against it, so that
+  // the costs of different subsets compare (quadric costs are absolute already).
+  double reference_diagonal = 0;
+  // Stop once the job's mesh (halo included) has at most this many live faces; 0: go as far
+  // as the subset rule allows.
+  uint64_t target_faces = 0;
+};
+
+struct SubsetJob {
+  uint32_t round = 0;                   // 0-based
+  uint32_t subset = 0;                  // index in the partition
+  Mesh mesh;                            // local ids; positions_are_float is the whole mesh's
+  std::vector<VertexId> global_vertex;  // local vertex -> id in the whole mesh
+  std::vector<FaceId> global_face;      // local face -> id in the whole mesh
+  std::vector<WedgeId> global_wedge;    // local wedge -> id (empty without attributes)
+  std::vector<uint8_t> owned;           // per local vertex: 1 if the subset owns it, 0: halo
+  std::vector<uint8_t> locked;          // per local vertex: a repair copy (never moves)
+  uint64_t owned_faces = 0;             // faces whose three vertices are owned
+  SubsetOptions options;
+};
+
+// Builds the job of every subset of `vertex_subset` (per global vertex its subset in
+// [0, subsets), ignored for dead vertices) over the live part of `mesh`. `wedge_values` are
+// the current values of the whole mesh's wedges (layout.floats_per_wedge() each; empty
+// without attributes); `locked` per global vertex (may be empty). `options` is copied into
+// every job (target_faces is left for the caller). O(live faces + sum of the jobs' sizes).
+std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const AttributeLayout& layout,
+                                       const std::vector<float>& wedge_values,
+                                       bool positions_are_float, const std::vector<uint8_t>& locked,
+                                       const std::vector<uint32_t>& vertex_subset, uint32_t subsets,
+                                       uint32_t round, const SubsetOptions& options);
+
+// Checks what a job can check on its own: sizes agree, local ids in range, global ids
+// strictly increasing, every face touches an owned vertex. Throws Error(kInvalidInput)
+// naming the first violation. A worker calls it on a job that came over the network.
+void validate_subset_job(const SubsetJob& job);
+
+}  // namespace parapm

@@ -1,0 +1,196 @@
+// The non-conflict rule (engine/parallel/subset_rule.h), proved on real meshes: the subsets'
+// collapse sequences, run each on its own job, replay on the whole mesh in any interleaving
+// that keeps each subset's order, every collapse finding the faces and apexes its subset saw,
+// and every interleaving ends in the same mesh.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "parallel/collapse_merge.h"
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_job.h"
+#include "parallel/subset_rule.h"
+#include "parallel_test_support.h"
+#include "partition/partition.h"
+#include "simplify/modules.h"
+#include "simplify/simplify.h"
+
+namespace parapm {
+namespace {
+
+struct Round {
+  RepairedMesh repaired;
+  Partition partition;
+  std::vector<SubsetJob> jobs;
+  std::vector<SubsetResult> results;
+};
+
+Round run_round(const std::string& name, const std::string& metric, uint32_t p) {
+  Round round;
+  round.repaired = testing::repaired_test_mesh(name);
+  const Mesh& mesh = round.repaired.mesh;
+  round.partition = partition_mesh(mesh, p);
+  SubsetOptions options;
+  options.metric = metric;
+  options.reference_diagonal = bounding_box(mesh).diagonal();
+  const CollapseMesh whole(mesh);
+  round.jobs = extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
+                               locked_vertices(round.repaired), round.partition.vertex_subset, p, 0,
+                               options);
+  for (const SubsetJob& job : round.jobs) round.results.push_back(simplify_subset(job));
+  return round;
+}
+
+std::vector<std::vector<CollapseRecord>> lists_of(const Round& round) {
+  std::vector<std::vector<CollapseRecord>> lists;
+  for (const SubsetResult& r : round.results) lists.push_back(r.records);
+  return lists;
+}
+
+// Live faces of a CollapseMesh, for comparing end states.
+std::vector<std::pair<FaceId, Triangle>> live_faces(const CollapseMesh& mesh) {
+  std::vector<std::pair<FaceId, Triangle>> faces;
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
+    if (mesh.face_alive(f)) faces.emplace_back(f, mesh.face(f));
+  return faces;
+}
+
+TEST(SubsetRule, JobsHoldTheirSubsetAndAOneRingHaloOnly) {
+  const Round round = run_round("cad-cycloidal-43k.ply", "quadric", 4);
+  const Mesh& mesh = round.repaired.mesh;
+  size_t job_faces = 0, owned_faces = 0;
+  std::vector<uint32_t> whole_valence(mesh.vertex_count(), 0);
+  for (const Triangle& t : mesh.faces)
+    for (VertexId v : t) ++whole_valence[v];
+  for (const SubsetJob& job : round.jobs) {
+    validate_subset_job(job);
+    job_faces += job.mesh.face_count();
+    owned_faces += job.owned_faces;
+    EXPECT_LT(job.mesh.face_count(), mesh.face_count() / 2) << "subset " << job.subset;
+    // Every face around an owned vertex is in the job: same valence as in the whole mesh.
+    std::vector<uint32_t> valence(job.mesh.vertex_count(), 0);
+    for (const Triangle& t : job.mesh.faces)
+      for (VertexId v : t) ++valence[v];
+    for (VertexId v = 0; v < job.mesh.vertex_count(); ++v) {
+      if (job.owned[v]) {
+        ASSERT_EQ(valence[v], whole_valence[job.global_vertex[v]]) << "owned vertex " << v;
+      } else {
+        ASSERT_LE(valence[v], whole_valence[job.global_vertex[v]]) << "halo vertex " << v;
+      }
+    }
+  }
+  // Faces with three owned vertices are counted once; halos add a band along the cuts.
+  EXPECT_LE(owned_faces, mesh.face_count());
+  EXPECT_LT(job_faces, mesh.face_count() * 12 / 10) << "the halos are a thin band";
+}
+
+TEST(SubsetRule, EveryCollapseHasItsWholeStarInItsSubset) {
+  const Round round = run_round("stratocaster-9k.ply", "quadric", 4);
+  for (const SubsetResult& result : round.results) {
+    ASSERT_GT(result.records.size(), 100u);
+    CollapseMesh whole(round.repaired.mesh);
+    // Replaying one subset alone: before each collapse, the star of (vs, vt) on the whole mesh
+    // has only vertices of that subset.
+    for (const CollapseRecord& r : result.records) {
+      for (VertexId end : {r.vs, r.vt})
+        for (FaceId f : whole.faces_of(end))
+          for (VertexId n : whole.face(f))
+            ASSERT_EQ(round.partition.vertex_subset[n], result.subset)
+                << "collapse (" << r.vs << ", " << r.vt << ") reads vertex " << n;
+      whole.collapse(r.vs, r.vt, r.position, whole.edge_faces(r.vs, r.vt));
+    }
+  }
+}
+
+// The theorem: any interleaving that keeps each subset's order replays (replay_collapses
+// checks fl, fr, vl, vr of every record against the whole mesh) and ends in the same mesh.
+void expect_interleavings_commute(const std::string& name, const std::string& metric, uint32_t p) {
+  const Round round = run_round(name, metric, p);
+  const Mesh& mesh = round.repaired.mesh;
+  std::vector<std::vector<CollapseRecord>> orders;
+  orders.push_back(merge_by_cost(lists_of(round)));
+  // Subset after subset, last subset first.
+  {
+    std::vector<CollapseRecord> seq;
+    for (size_t s = round.results.size(); s-- > 0;)
+      seq.insert(seq.end(), round.results[s].records.begin(), round.results[s].records.end());
+    orders.push_back(seq);
+  }
+  // Round-robin, the 1999 merge.
+  {
+    std::vector<CollapseRecord> seq;
+    for (size_t i = 0;; ++i) {
+      bool any = false;
+      for (const SubsetResult& r : round.results)
+        if (i < r.records.size()) seq.push_back(r.records[i]), any = true;
+      if (!any) break;
+    }
+    orders.push_back(seq);
+  }
+  std::vector<std::pair<FaceId, Triangle>> first_end;
+  std::vector<Vec3> first_positions;
+  for (size_t k = 0; k < orders.size(); ++k) {
+    CollapseMesh whole(mesh);
+    SimplifyOptions options;
+    options.metric = metric;
+    auto priority = make_priority_module(options, mesh, locked_vertices(round.repaired));
+    priority->initialize(whole);
+    ReplayReport report;
+    ASSERT_NO_THROW(report = replay_collapses(whole, orders[k], priority.get()))
+        << name << " order " << k;
+    EXPECT_EQ(report.collapses, orders[k].size());
+    // One random point per vertex only: the whole mesh's metric state follows each subset's
+    // exactly, down to the attribute values E_scalar computes.
+    EXPECT_EQ(report.attribute_mismatches, 0u) << name << " order " << k;
+    if (k == 0) {
+      first_end = live_faces(whole);
+      first_positions = whole.positions();
+    } else {
+      EXPECT_EQ(live_faces(whole), first_end) << name << " order " << k;
+      EXPECT_EQ(whole.positions(), first_positions) << name << " order " << k;
+    }
+  }
+}
+
+TEST(SubsetRule, InterleavingsReplayAndCommuteQuadric) {
+  expect_interleavings_commute("stratocaster-9k.ply", "quadric", 4);
+  expect_interleavings_commute("cad-cycloidal-43k.ply", "quadric", 3);
+}
+
+TEST(SubsetRule, InterleavingsReplayAndCommuteEnergy) {
+  expect_interleavings_commute("pymeshlab-colored-airplane-11k.ply", "energy", 3);
+  expect_interleavings_commute("stratocaster-9k.ply", "energy", 2);
+}
+
+TEST(SubsetRule, ABrokenOrderIsCaughtByTheReplay) {
+  const Round round = run_round("stratocaster-9k.ply", "quadric", 2);
+  std::vector<CollapseRecord> records = round.results[0].records;
+  ASSERT_GT(records.size(), 10u);
+  // Swap a collapse with a later one that uses its surviving vertex: the replay must notice.
+  size_t later = 0;
+  for (size_t i = 1; i < records.size() && later == 0; ++i)
+    if (records[i].vs == records[0].vs || records[i].vt == records[0].vs) later = i;
+  ASSERT_NE(later, 0u);
+  std::swap(records[0], records[later]);
+  CollapseMesh whole(round.repaired.mesh);
+  EXPECT_THROW(replay_collapses(whole, records, nullptr), Error);
+}
+
+TEST(SubsetRule, MergeByCostKeepsEachListsOrderAndPrefersCheapHeads) {
+  auto record = [](double cost, VertexId tag) {
+    CollapseRecord r;
+    r.cost = cost;
+    r.vs = tag;
+    return r;
+  };
+  std::vector<std::vector<CollapseRecord>> lists = {
+      {record(1, 0), record(5, 1), record(2, 2)}, {record(1, 10), record(3, 11)}, {}};
+  const auto merged = merge_by_cost(lists);
+  std::vector<VertexId> tags;
+  for (const auto& r : merged) tags.push_back(r.vs);
+  // Ties go to the lower list; list 0's 2 waits behind its 5, as its order demands.
+  EXPECT_EQ(tags, (std::vector<VertexId>{0, 10, 11, 1, 2}));
+}
+
+}  // namespace
+}  // namespace parapm
