@@ -29,7 +29,8 @@ struct SimplifyArgs {
   bool keep_order = false;
   uint32_t parallel = 1;  // subsets p; 1: the sequential build
   unsigned threads = 0;   // 0: min(p, hardware threads)
-  double handover = 0.3;
+  uint32_t rounds = ParallelOptions{}.rounds;
+  double handover = ParallelOptions{}.handover_ratio;
   bool json = false;
 };
 
@@ -53,16 +54,22 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"extract_seconds", r.extract_seconds},
                       {"subsets_seconds", r.subsets_seconds},
                       {"merge_seconds", r.merge_seconds},
+                      {"slowest_subset_cpu_seconds", r.slowest_subset_cpu_seconds},
+                      {"water_level", r.water_level},
+                      {"band_pass_collapses", r.band_pass_collapses},
+                      {"band_pass_seconds", r.band_pass_seconds},
                       {"subsets", subsets}});
   }
   return {{"p", stats.subsets},
           {"rounds", stats.rounds},
           {"threads", stats.threads},
           {"round_stats", rounds},
+          {"setup_seconds", stats.setup_seconds},
           {"final_pass_collapses", stats.final_pass_collapses},
           {"final_pass_seconds", stats.final_pass_seconds},
           {"pm_build_seconds", stats.pm_build_seconds},
-          {"cpu_seconds", stats.cpu_seconds}};
+          {"cpu_seconds", stats.cpu_seconds},
+          {"critical_path_seconds", stats.critical_path_seconds}};
 }
 
 int run_simplify(const SimplifyArgs& args) {
@@ -87,6 +94,7 @@ int run_simplify(const SimplifyArgs& args) {
     ParallelOptions parallel;
     parallel.subsets = args.parallel;
     parallel.threads = args.threads;
+    parallel.rounds = args.rounds;
     parallel.handover_ratio = args.handover;
     pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
                                          bar.callback(), nullptr);
@@ -145,11 +153,12 @@ int run_simplify(const SimplifyArgs& args) {
         merge += r.merge_seconds;
       }
       std::printf(
-          "parallel   p=%u on %u threads: subsets %.3f s, merge %.3f s, final pass "
-          "%.3f s (%llu collapses), %.3f s CPU in all\n",
-          parallel_stats.subsets, parallel_stats.threads, subsets, merge,
+          "parallel   p=%u, %u rounds on %u threads: subsets %.3f s, merge %.3f s, final pass "
+          "%.3f s (%llu collapses), %.3f s CPU in all, critical path %.3f s\n",
+          parallel_stats.subsets, parallel_stats.rounds, parallel_stats.threads, subsets, merge,
           parallel_stats.final_pass_seconds,
-          (unsigned long long)parallel_stats.final_pass_collapses, parallel_stats.cpu_seconds);
+          (unsigned long long)parallel_stats.final_pass_collapses, parallel_stats.cpu_seconds,
+          parallel_stats.critical_path_seconds);
     }
     std::printf("size       %llu bytes .pm, %llu bytes binary PLY (%.2fx)\n",
                 (unsigned long long)pm_bytes, (unsigned long long)ply_bytes,
@@ -200,23 +209,31 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--keep-order", args->keep_order,
                 "Store the input's vertex and face order, and keep unreferenced vertices");
   cmd->add_option("--parallel", args->parallel,
-                  "Build with P subsets simplified in parallel (Langis 1999): partition, one "
-                  "round of subset jobs down to the handover, merge by cost, then a sequential "
-                  "final pass over the borders to the target. 1: the sequential build")
+                  "Build with P subsets simplified in parallel (Langis 1999): --rounds rounds, "
+                  "each partitioning the current mesh anew and simplifying the subsets in "
+                  "parallel (merged by cost), down to the handover; then a sequential final "
+                  "pass over the last borders to the target. 1: the sequential build")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
   cmd->add_option("--threads", args->threads,
                   "With --parallel: threads of the pool (0: min(P, hardware threads)); the .pm "
                   "does not depend on it")
       ->capture_default_str();
+  cmd->add_option("--rounds", args->rounds,
+                  "With --parallel: parallel rounds, each on a new partition (the borders "
+                  "move); they take the mesh geometrically down to the handover")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   cmd->add_option("--handover-ratio", args->handover,
-                  "With --parallel: the subsets simplify the mesh down to this fraction of the "
-                  "input faces (or the target if larger); the final pass does the rest")
+                  "With --parallel: the rounds simplify the mesh down to this fraction of the "
+                  "input faces (or the target if larger); the sequential final pass does the "
+                  "rest")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_flag("--json", args->json,
-                "Print one JSON object on stdout (with --parallel: p, rounds, per-subset wall "
-                "and CPU seconds, merge and final-pass seconds under \"parallel\")");
+                "Print one JSON object on stdout (with --parallel, under \"parallel\": p, rounds "
+                "performed, per round the partition, extraction, subset (per subset wall and "
+                "CPU) and merge seconds, the final pass, the CPU in all and the critical path)");
   cmd->callback([args, &exit_code] { exit_code = run_simplify(*args); });
 }
 

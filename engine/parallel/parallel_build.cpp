@@ -3,17 +3,21 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
 #include "parallel/collapse_merge.h"
 #include "parallel/job_pool.h"
+#include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
 #include "partition/partition.h"
+#include "simplify/energy_priority.h"
 #include "simplify/modules.h"
 #include "simplify/pm_builder.h"
 #include "simplify/simplifier.h"
+#include "simplify/surface_samples.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -23,25 +27,31 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The master's priority module, already initialised and brought up to date by the replay:
-// the final pass continues with its state instead of starting afresh.
-class ContinuedPriority : public PriorityModule {
- public:
-  explicit ContinuedPriority(PriorityModule& inner) : inner_(inner) {}
-  std::string name() const override { return inner_.name(); }
-  void initialize(const CollapseMesh&) override {}
-  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                CollapseCandidate& out) const override {
-    return inner_.evaluate(mesh, a, b, out);
-  }
-  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
-                 const EdgeFaces& edge) override {
-    inner_.collapsed(mesh, done, edge);
-  }
-
- private:
-  PriorityModule& inner_;
-};
+// Partitions the live part of `mesh` (a compact copy: the partitioner wants a plain mesh) into
+// p subsets; vertex_subset gets, per vertex of `mesh`, its subset (0 for dead vertices), and
+// assigned the faces each subset was given.
+void partition_live(const CollapseMesh& mesh, uint32_t p, const PartitionOptions& options,
+                    std::vector<uint32_t>& vertex_subset, std::vector<uint64_t>& assigned) {
+  std::vector<VertexId> compact(mesh.vertex_capacity(), kNoId);
+  Mesh live;
+  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
+    if (mesh.vertex_alive(v)) {
+      compact[v] = VertexId(live.positions.size());
+      live.positions.push_back(mesh.position(v));
+    }
+  live.faces.reserve(mesh.live_faces());
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
+    if (mesh.face_alive(f)) {
+      const Triangle& t = mesh.face(f);
+      live.faces.push_back({compact[t[0]], compact[t[1]], compact[t[2]]});
+    }
+  const Partition partition = partition_mesh(live, p, options);
+  vertex_subset.assign(mesh.vertex_capacity(), 0);
+  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
+    if (compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[compact[v]];
+  assigned.assign(p, 0);
+  for (uint32_t s : partition.face_subset) ++assigned[s];
+}
 
 void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
   if (parallel.subsets < 1 || parallel.subsets > kMaxPartitionSubsets)
@@ -50,20 +60,74 @@ void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
   if (parallel.subsets > vertices)
     throw_invalid("the subset count p = " + std::to_string(parallel.subsets) +
                   " exceeds the vertex count " + std::to_string(vertices));
-  if (parallel.rounds != 1)
-    throw_invalid("parallel rounds: only 1 is supported so far, got " +
-                  std::to_string(parallel.rounds));
+  if (parallel.rounds < 1 || parallel.rounds > 64)
+    throw_invalid("parallel rounds must be in [1, 64], got " + std::to_string(parallel.rounds));
   if (!(parallel.handover_ratio > 0 && parallel.handover_ratio <= 1))
     throw_invalid("the handover ratio must be in (0, 1], got " +
                   std::to_string(parallel.handover_ratio));
 }
 
+// The partitioner's seed of a round. It picks the start vertex as the (seed mod count)-th
+// vertex of least degree in id order: consecutive seeds pick neighbouring ids, often close on
+// the surface, and nearly the same partition, whose borders would stay where they were. A
+// mixed seed starts each round somewhere else.
+uint64_t round_seed(uint64_t seed, uint32_t round) {
+  if (round == 0) return seed;
+  SplitMix64 mix(seed + round);
+  return mix.next() >> 1;
+}
+
+// The jobs' cost ceiling of a round: `factor` times its water level. The water level: a
+// sample of the live inner edges (both ends in one subset; every `stride`-th, about 1024 per
+// subset) costed by the master's module, and the cost below which the sampled edges, scaled
+// to all edges, would give the round's collapses. A sequential run, cheapest first, would
+// not go far above it in this round (the costs of the edges it creates grow, hence the
+// factor); a subset whose region holds few
+// cheap collapses would, if it had to remove its share of the faces whatever they cost.
+// Deterministic: the sample depends on the mesh only.
+double water_level(const CollapseMesh& mesh, const PriorityModule& master,
+                   const std::vector<uint32_t>& vertex_subset, uint32_t p, uint64_t remove,
+                   double factor) {
+  uint64_t total_edges = 0;
+  auto inner = [&](VertexId a, VertexId b) {
+    return a < b && vertex_subset[a] == vertex_subset[b];
+  };
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    for (int k = 0; k < 3; ++k) total_edges += inner(t[k], t[(k + 1) % 3]) ? 1 : 0;
+  }
+  const uint64_t stride = std::max<uint64_t>(1, total_edges / (1024 * uint64_t(p)));
+  std::vector<double> costs;
+  uint64_t index = 0;
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3];
+      if (!inner(a, b) || index++ % stride != 0) continue;
+      CollapseCandidate c;
+      costs.push_back(master.evaluate(mesh, a, b, c) ? c.cost
+                                                     : std::numeric_limits<double>::infinity());
+    }
+  }
+  if (costs.empty()) return std::numeric_limits<double>::infinity();
+  // A collapse removes two faces and about three edges.
+  const double fraction = std::min(1.0, double(remove) / 2 / double(total_edges));
+  auto quantile = [&](double q) {
+    const auto k = std::min(costs.size() - 1, size_t(q * double(costs.size())));
+    std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
+    return costs[k];
+  };
+  // At least the cost below which twice the round's collapses lie: where most sampled edges
+  // cost nothing (coplanar quadrics), factor x 0 would stop every job at once.
+  return std::max(factor * quantile(fraction), quantile(std::min(1.0, 2 * fraction)));
+}
+
 // Each subset removes its share of the round's faces, in proportion to the faces the
-// partition gave it (partition.h: each face to exactly one subset).
-void set_targets(std::vector<SubsetJob>& jobs, const Partition& partition, uint64_t faces_before,
-                 uint64_t goal) {
-  std::vector<uint64_t> assigned(jobs.size(), 0);
-  for (uint32_t s : partition.face_subset) ++assigned[s];
+// partition gave it.
+void set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& assigned,
+                 uint64_t faces_before, uint64_t goal) {
   const uint64_t remove = faces_before > goal ? faces_before - goal : 0;
   for (size_t s = 0; s < jobs.size(); ++s) {
     const auto share = uint64_t(std::llround(double(remove) * double(assigned[s]) /
@@ -73,6 +137,32 @@ void set_targets(std::vector<SubsetJob>& jobs, const Partition& partition, uint6
     jobs[s].options.target_faces = std::max<uint64_t>(1, faces > share ? faces - share : 0);
   }
 }
+
+// The band pass's priority: the master's metric, restricted to edges with an end that no
+// collapse has touched yet (an input vertex, around which input faces may remain) and a cost
+// of at most `ceiling`; an edge above it is left alone until its star changes.
+class BandPriority : public PriorityModule {
+ public:
+  BandPriority(PriorityModule& inner, std::vector<uint8_t>& touched, double ceiling)
+      : inner_(inner), touched_(touched), ceiling_(ceiling) {}
+  std::string name() const override { return inner_.name(); }
+  void initialize(const CollapseMesh&) override {}
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
+                CollapseCandidate& out) const override {
+    if (touched_[a] && touched_[b]) return false;
+    return inner_.evaluate(mesh, a, b, out) && out.cost <= ceiling_;
+  }
+  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
+                 const EdgeFaces& edge) override {
+    touched_[done.vs] = touched_[done.vt] = 1;
+    inner_.collapsed(mesh, done, edge);
+  }
+
+ private:
+  PriorityModule& inner_;
+  std::vector<uint8_t>& touched_;
+  double ceiling_;
+};
 
 }  // namespace
 
@@ -97,11 +187,16 @@ ProgressiveMesh build_progressive_mesh_parallel(
       target, uint64_t(std::llround(parallel.handover_ratio * double(input_faces))));
   const std::vector<uint8_t> locked = locked_vertices(repaired);
 
-  // The whole mesh and the master's copy of the metric, which follows every merged collapse
-  // so that the final pass continues from the state a sequential run would have.
+  // The whole mesh and the master's metric, initialised once on the whole mesh (so that the
+  // sample points are the sequential build's); every round's jobs take their part of its
+  // state and give back what they own, so that the final pass continues from the state a
+  // sequential run would have after the same collapses.
+  auto t = std::chrono::steady_clock::now();
   CollapseMesh whole(mesh);
   std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
   master->initialize(whole);
+  st.setup_seconds = seconds_since(t);
+  st.critical_path_seconds = st.setup_seconds;
 
   SubsetOptions subset_options;
   subset_options.metric = options.metric;
@@ -110,30 +205,60 @@ ProgressiveMesh build_progressive_mesh_parallel(
   subset_options.attribute_weight = options.attribute_weight;
   subset_options.seed = options.seed;
   subset_options.reference_diagonal = bounding_box(mesh).diagonal();
+  // Jobs leave the energy's penalised collapses (changing the curves' topology) to the final
+  // pass, which takes them last, as the sequential build does.
+  if (options.metric == "energy")
+    subset_options.max_cost = 0.1 * EnergyPriority::kTopologyPenalty *
+                              subset_options.reference_diagonal * subset_options.reference_diagonal;
 
   std::vector<CollapseRecord> records;
+  std::vector<uint8_t> touched(whole.vertex_capacity(), 0);  // vs or vt of a collapse so far
   double subsets_cpu = 0;
   for (uint32_t round = 0; round < parallel.rounds; ++round) {
     RoundStats rs;
     rs.round = round;
     rs.faces_before = whole.live_faces();
-    if (rs.faces_before <= handover) break;
+    if (rs.faces_before <= handover || whole.live_vertices() < 4 * size_t(parallel.subsets)) break;
     // Geometric steps from the present face count to the handover.
     rs.goal_faces = uint64_t(
         std::llround(double(rs.faces_before) * std::pow(double(handover) / double(rs.faces_before),
                                                         1.0 / double(parallel.rounds - round))));
 
-    auto t = std::chrono::steady_clock::now();
+    // A new partition of the current mesh: the previous round's borders, whose vertices could
+    // not move, are inside subsets now.
+    t = std::chrono::steady_clock::now();
     PartitionOptions partition_options;
-    partition_options.seed = options.seed + round;
-    const Partition partition = partition_mesh(mesh, parallel.subsets, partition_options);
+    partition_options.seed = round_seed(options.seed, round);
+    std::vector<uint32_t> vertex_subset;
+    std::vector<uint64_t> assigned;
+    partition_live(whole, parallel.subsets, partition_options, vertex_subset, assigned);
     rs.partition_seconds = seconds_since(t);
 
     t = std::chrono::steady_clock::now();
+    // The jobs' meshes carry the input's wedge values; the metric's current ones (E_scalar)
+    // travel in the state.
     std::vector<SubsetJob> jobs =
         extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                        partition.vertex_subset, partition.subsets, round, subset_options);
-    set_targets(jobs, partition, rs.faces_before, rs.goal_faces);
+                        vertex_subset, parallel.subsets, round, subset_options);
+    set_targets(jobs, assigned, rs.faces_before, rs.goal_faces);
+    if (parallel.water_level_factor > 0) {
+      const auto ts = std::chrono::steady_clock::now();
+      rs.water_level = water_level(whole, *master, vertex_subset, parallel.subsets,
+                                   rs.faces_before - rs.goal_faces, parallel.water_level_factor);
+      for (SubsetJob& job : jobs)
+        job.options.max_cost = job.options.max_cost > 0
+                                   ? std::min(job.options.max_cost, rs.water_level)
+                                   : rs.water_level;
+      rs.share_seconds = seconds_since(ts);
+    }
+    // The master's state of each job (const reads of the master: concurrently).
+    std::vector<double> export_cpu(jobs.size(), 0);
+    run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
+      const double cpu = thread_cpu_seconds();
+      jobs[i].state = export_job_state(*master, jobs[i]);
+      export_cpu[i] = thread_cpu_seconds() - cpu;
+    });
+    for (double c : export_cpu) subsets_cpu += c;  // master work, on the pool's threads
     rs.extract_seconds = seconds_since(t);
 
     t = std::chrono::steady_clock::now();
@@ -152,28 +277,66 @@ ProgressiveMesh build_progressive_mesh_parallel(
       rs.subsets.push_back({r.subset, r.faces, r.owned_faces, r.records.size(), r.wall_seconds,
                             r.cpu_seconds, r.stats.stop_reason});
       subsets_cpu += r.cpu_seconds;
+      rs.slowest_subset_cpu_seconds = std::max(rs.slowest_subset_cpu_seconds, r.cpu_seconds);
       lists.push_back(std::move(r.records));
     }
     std::vector<CollapseRecord> merged = merge_by_cost(std::move(lists));
-    const ReplayReport replay = replay_collapses(whole, merged, master.get());
+    const ReplayReport replay =
+        replay_collapses(whole, merged, parallel.replay_state ? master.get() : nullptr);
+    if (!parallel.replay_state)
+      for (const SubsetResult& r : results) import_result_state(*master, r.state);
+    // The water level of the round: 95% of its collapses cost less.
+    double ceiling = 0;
+    if (!merged.empty()) {
+      std::vector<double> costs;
+      costs.reserve(merged.size());
+      for (const CollapseRecord& r : merged) costs.push_back(r.cost);
+      const size_t k = costs.size() * 95 / 100;
+      std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
+      ceiling = costs[k];
+    }
+    for (const CollapseRecord& r : merged) touched[r.vs] = touched[r.vt] = 1;
     records.insert(records.end(), std::make_move_iterator(merged.begin()),
                    std::make_move_iterator(merged.end()));
     rs.merge_seconds = seconds_since(t);
+
+    // The band pass, after every round but the first: what two rounds' borders both kept
+    // (vertices next to both cuts, at full resolution) and is below the round's water level,
+    // sequentially on the whole mesh, cheapest first. (After the first round the next round's
+    // new partition takes its band in parallel.)
+    t = std::chrono::steady_clock::now();
+    if (parallel.band_pass && round >= 1) {
+      BandPriority band(*master, touched, ceiling);
+      Simplifier pass(whole, band, standard_constraints(locked));
+      SimplifierLimits band_limits;
+      band_limits.target_faces = std::max<uint64_t>(1, target);
+      std::vector<CollapseRecord> band_records = pass.run(band_limits, {}, cancel);
+      rs.band_pass_collapses = band_records.size();
+      records.insert(records.end(), std::make_move_iterator(band_records.begin()),
+                     std::make_move_iterator(band_records.end()));
+    }
+    rs.band_pass_seconds = seconds_since(t);
     rs.faces_after = whole.live_faces();
+    st.critical_path_seconds += rs.partition_seconds + rs.extract_seconds +
+                                rs.slowest_subset_cpu_seconds + rs.merge_seconds +
+                                rs.band_pass_seconds;
     spdlog::debug(
         "parallel round {}: {} subsets {}->{} faces (goal {}), partition {:.3f} s, extract "
-        "{:.3f} s, subsets {:.3f} s, merge {:.3f} s ({} attribute mismatches)",
+        "{:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} replayed), band "
+        "pass {} collapses in {:.3f} s",
         round, parallel.subsets, rs.faces_before, rs.faces_after, rs.goal_faces,
-        rs.partition_seconds, rs.extract_seconds, rs.subsets_seconds, rs.merge_seconds,
-        replay.attribute_mismatches);
+        rs.partition_seconds, rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds,
+        rs.merge_seconds, replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
     st.round_stats.push_back(std::move(rs));
     if (progress) progress(input_faces - whole.live_faces(), input_faces - target);
   }
 
+  st.rounds = uint32_t(st.round_stats.size());
+
   // The final pass: the borders and whatever remains down to the target, sequentially.
-  auto t = std::chrono::steady_clock::now();
-  ContinuedPriority continued(*master);
-  Simplifier final_pass(whole, continued, standard_constraints(locked));
+  t = std::chrono::steady_clock::now();
+  std::unique_ptr<PriorityModule> continued = without_initialize(*master);
+  Simplifier final_pass(whole, *continued, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target;
   const uint64_t done_before = input_faces - whole.live_faces();
@@ -196,6 +359,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   pm.info.metric = master->name();
   st.pm_build_seconds = seconds_since(t);
   st.collapses = records.size();
+  st.critical_path_seconds += st.final_pass_seconds + st.pm_build_seconds;
   st.seconds = seconds_since(start);
   st.cpu_seconds = subsets_cpu + (thread_cpu_seconds() - master_cpu_start);
   pm.info.seconds = st.seconds;

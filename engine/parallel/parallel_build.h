@@ -1,8 +1,9 @@
 // Parallel construction of a Progressive Mesh (Langis 1999, the "galaxy" method; METHOD.md
-// section 4): partition, simplify the subsets in parallel under a rule that keeps their
-// collapses independent, merge the records by cost, replay them on the whole mesh, and finish
-// the border with a sequential final pass. docs/ARCHITECTURE.md, "Parallel construction",
-// says why each step is as it is.
+// section 4): in rounds, each on a new partition of the current mesh, simplify the subsets in
+// parallel under a rule that keeps their collapses independent (the metric's state travelling
+// in the jobs), merge the records by cost, replay them on the whole mesh and import the jobs'
+// states; then finish the last borders with a sequential final pass. docs/ARCHITECTURE.md,
+// "Parallel construction", says why each step is as it is.
 #pragma once
 
 #include <cstdint>
@@ -18,15 +19,25 @@ namespace parapm {
 
 struct ParallelOptions {
   uint32_t subsets = 2;  // p, in [1, 256]
-  uint32_t rounds = 1;   // parallel rounds, each on a new partition of the current mesh
+  // Parallel rounds, in [1, 64], each on a new partition of the current mesh (the borders
+  // move), with the metric's state travelling in the jobs (job_state.h).
+  uint32_t rounds = 3;
   unsigned threads = 0;  // 0: min(p, hardware threads)
-  // The parallel rounds take the mesh from F faces down to max(target, handover_ratio x F)
-  // faces (geometrically across rounds); the final pass, sequential on the whole mesh,
-  // collapses the borders and goes on to the target. Smaller: more parallel work, but the
-  // levels near the handover keep the subsets' borders at full resolution (dragon 203k,
-  // energy, p = 2: at 0.1 the 10% level's RMS error doubles; at 0.3 every level is within 2%
-  // of the sequential build's, docs/ARCHITECTURE.md).
-  double handover_ratio = 0.3;
+  // The rounds take the mesh from F faces down to max(target, handover_ratio x F) faces,
+  // geometrically (round r of R aims at F x ratio^((r + 1) / R)); the final pass, sequential
+  // on the whole mesh, collapses what the last round's borders kept and goes on to the
+  // target. The defaults are measured in docs/ARCHITECTURE.md, "Parallel construction".
+  double handover_ratio = 0.1;
+  // Jobs leave alone edges costing more than this factor times the round's water level
+  // (parallel_build.cpp, water_level: the cost below which a sample of the edges would give
+  // the round's collapses), besides stopping at their share of the faces; 0: shares only.
+  double water_level_factor = 8;
+  // After each round but the first, a sequential pass over the edges around vertices no
+  // collapse has touched, up to the 95th percentile of the round's costs (parallel_build.cpp).
+  bool band_pass = true;
+  // Tests only: the master follows each round by re-running its module's collapsed() on every
+  // merged record (the first step's path) instead of importing the jobs' returned states.
+  bool replay_state = false;
 };
 
 struct SubsetTiming {
@@ -45,17 +56,23 @@ struct RoundStats {
   uint64_t goal_faces = 0;  // what the round aimed at
   uint64_t faces_after = 0;
   double partition_seconds = 0;
-  double extract_seconds = 0;
+  double extract_seconds = 0;  // jobs and their state, shares included
+  double share_seconds = 0;    // of which costing the edge sample for the water level
+  double water_level = 0;      // the jobs' cost ceiling (ParallelOptions::water_level_factor)
   double subsets_seconds = 0;  // wall time of the round's jobs
-  double merge_seconds = 0;    // k-way merge and replay on the whole mesh
+  double merge_seconds = 0;    // k-way merge, replay on the whole mesh, state import
+  double slowest_subset_cpu_seconds = 0;
+  uint64_t band_pass_collapses = 0;  // sequential, after the merge (ParallelOptions::band_pass)
+  double band_pass_seconds = 0;
   std::vector<SubsetTiming> subsets;
 };
 
 struct ParallelStats {
   uint32_t subsets = 0;
-  uint32_t rounds = 0;
+  uint32_t rounds = 0;  // performed (fewer than asked when the mesh reached the handover)
   unsigned threads = 0;
   std::vector<RoundStats> round_stats;
+  double setup_seconds = 0;  // the master's metric, initialised once on the whole mesh
   uint64_t final_pass_collapses = 0;
   double final_pass_seconds = 0;
   double pm_build_seconds = 0;
@@ -63,6 +80,10 @@ struct ParallelStats {
   std::string stop_reason;  // of the final pass
   double seconds = 0;       // the whole construction, wall
   double cpu_seconds = 0;   // the subsets' CPU plus the master's (partition, merge, final pass)
+  // What the build would take with one processor per subset: setup, then per round the
+  // partition, extraction, the slowest subset's CPU and the merge, then the final pass and
+  // the PM assembly (subset CPU, not wall: on a loaded machine wall time is not the job's).
+  double critical_path_seconds = 0;
 };
 
 // Same contract as build_progressive_mesh (simplify.h), whose options it takes; the result is

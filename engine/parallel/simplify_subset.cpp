@@ -3,9 +3,11 @@
 #include <time.h>
 
 #include <chrono>
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
+#include "parallel/job_state.h"
 #include "parallel/subset_rule.h"
 #include "simplify/simplify.h"
 
@@ -59,7 +61,15 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   CollapseMesh working(job.mesh);
   std::unique_ptr<PriorityModule> metric =
       make_priority_module(options, job.mesh, job.locked, job.options.reference_diagonal);
-  std::unique_ptr<PriorityModule> priority = make_subset_priority(*metric, std::move(free_vertex));
+  // With a state, the metric is the master's over the job: imported, not initialised.
+  std::unique_ptr<PriorityModule> imported;
+  if (!job.state.empty()) {
+    import_job_state(*metric, working, job);
+    imported = without_initialize(*metric);
+  }
+  std::unique_ptr<PriorityModule> priority = make_subset_priority(
+      imported ? *imported : *metric, std::move(free_vertex),
+      job.options.max_cost > 0 ? job.options.max_cost : std::numeric_limits<double>::infinity());
   auto constraints = standard_constraints(job.locked);
   constraints.push_back(make_subset_constraint(job.owned));
   Simplifier simplifier(working, *priority, std::move(constraints));
@@ -67,6 +77,7 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   limits.target_faces = job.options.target_faces;
   result.records = simplifier.run(limits, progress, cancel);
   for (CollapseRecord& r : result.records) globalise(r, job);
+  if (!job.state.empty()) result.state = export_result_state(*metric, working, job);
   result.stats = simplifier.stats();
   result.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -19,6 +19,9 @@ struct SubsetResult {
   // In the order performed, in global ids (vs, vt, vl, vr, fl, fr, corner and changed
   // wedges), with their costs: ready to be merged (collapse_merge.h) or streamed.
   std::vector<CollapseRecord> records;
+  // With a job state: the metric's state at the end, of the faces with three owned corners,
+  // the owned vertices and their wedges, in global ids (job_state.h). Empty otherwise.
+  MetricState state;
   uint64_t faces = 0;        // of the job's mesh, halo included
   uint64_t owned_faces = 0;  // of those, the faces with three owned vertices
   uint64_t free_vertices = 0;

@@ -21,6 +21,7 @@
 
 #include "mesh/mesh.h"
 #include "simplify/collapse_mesh.h"
+#include "simplify/module_state.h"
 
 namespace parapm {
 
@@ -38,6 +39,11 @@ struct SubsetOptions {
   // Stop once the job's mesh (halo included) has at most this many live faces; 0: go as far
   // as the subset rule allows.
   uint64_t target_faces = 0;
+  // Collapses costing more are left to later rounds or the final pass; 0: no limit. The
+  // parallel build sets it below the energy's topology penalty, so that a job that must
+  // remove its share does not change the curves' topology where a sequential run, cheapest
+  // first, would not have come to that yet.
+  double max_cost = 0;
 };
 
 struct SubsetJob {
@@ -51,6 +57,10 @@ struct SubsetJob {
   std::vector<uint8_t> locked;          // per local vertex: a repair copy (never moves)
   uint64_t owned_faces = 0;             // faces whose three vertices are owned
   SubsetOptions options;
+  // The metric's state over the job, in local ids (job_state.h): the master's sample points,
+  // curves, wedge classes or quadrics. Empty: the job initialises its metric on its own mesh
+  // (its own random points, seeded per round and subset).
+  MetricState state;
 };
 
 // Builds the job of every subset of `vertex_subset` (per global vertex its subset in

@@ -13,39 +13,15 @@ class SubsetConstraint : public ConstraintModule {
   // Components of the job's mesh: how many owned vertices each holds and whether it also
   // holds halo vertices (then it continues in other subsets).
   void initialize(const CollapseMesh& mesh) override {
-    const size_t n = mesh.vertex_capacity();
-    std::vector<VertexId> parent(n);
-    for (VertexId v = 0; v < n; ++v) parent[v] = v;
-    auto find = [&](VertexId v) {
-      while (parent[v] != v) v = parent[v] = parent[parent[v]];
-      return v;
-    };
-    for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-      if (!mesh.face_alive(f)) continue;
-      const Triangle& t = mesh.face(f);
-      for (int k = 1; k < 3; ++k) {
-        const VertexId a = find(t[0]), b = find(t[k]);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-      }
-    }
-    component_.assign(n, kNoId);
-    owned_count_.clear();
-    continues_.clear();
-    std::vector<uint32_t> index_of_root(n, kNoId);
-    for (VertexId v = 0; v < n; ++v) {
-      if (!mesh.vertex_alive(v)) continue;
-      const VertexId root = find(v);
-      if (index_of_root[root] == kNoId) {
-        index_of_root[root] = uint32_t(owned_count_.size());
-        owned_count_.push_back(0);
-        continues_.push_back(0);
-      }
-      const uint32_t c = index_of_root[root];
-      component_[v] = c;
+    const uint32_t components = connected_components(mesh, component_);
+    owned_count_.assign(components, 0);
+    continues_.assign(components, 0);
+    for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
+      if (component_[v] == kNoId) continue;
       if (owned_[v])
-        ++owned_count_[c];
+        ++owned_count_[component_[v]];
       else
-        continues_[c] = 1;
+        continues_[component_[v]] = 1;
     }
   }
 
@@ -74,14 +50,14 @@ class SubsetConstraint : public ConstraintModule {
 
 class SubsetPriority : public PriorityModule {
  public:
-  SubsetPriority(PriorityModule& inner, std::vector<uint8_t> free_vertex)
-      : inner_(inner), free_(std::move(free_vertex)) {}
+  SubsetPriority(PriorityModule& inner, std::vector<uint8_t> free_vertex, double max_cost)
+      : inner_(inner), free_(std::move(free_vertex)), max_cost_(max_cost) {}
   std::string name() const override { return inner_.name(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                 CollapseCandidate& out) const override {
     if (!free_[a] || !free_[b]) return false;
-    return inner_.evaluate(mesh, a, b, out);
+    return inner_.evaluate(mesh, a, b, out) && out.cost <= max_cost_;
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                  const EdgeFaces& edge) override {
@@ -91,6 +67,7 @@ class SubsetPriority : public PriorityModule {
  private:
   PriorityModule& inner_;
   std::vector<uint8_t> free_;
+  double max_cost_;
 };
 
 }  // namespace
@@ -110,8 +87,9 @@ std::unique_ptr<ConstraintModule> make_subset_constraint(std::vector<uint8_t> ow
 }
 
 std::unique_ptr<PriorityModule> make_subset_priority(PriorityModule& inner,
-                                                     std::vector<uint8_t> free_vertex) {
-  return std::make_unique<SubsetPriority>(inner, std::move(free_vertex));
+                                                     std::vector<uint8_t> free_vertex,
+                                                     double max_cost) {
+  return std::make_unique<SubsetPriority>(inner, std::move(free_vertex), max_cost);
 }
 
 }  // namespace parapm

@@ -123,4 +123,32 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
     if (v != kNoId) boundary_[v] = !faces_of_[v].empty() && compute_boundary(v);
 }
 
+uint32_t connected_components(const CollapseMesh& mesh, std::vector<uint32_t>& component) {
+  const size_t n = mesh.vertex_capacity();
+  std::vector<VertexId> parent(n);
+  for (VertexId v = 0; v < n; ++v) parent[v] = v;
+  auto find = [&](VertexId v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    for (int k = 1; k < 3; ++k) {
+      const VertexId a = find(t[0]), b = find(t[k]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  component.assign(n, kNoId);
+  std::vector<uint32_t> index_of_root(n, kNoId);
+  uint32_t count = 0;
+  for (VertexId v = 0; v < n; ++v) {
+    if (!mesh.vertex_alive(v)) continue;
+    const VertexId root = find(v);
+    if (index_of_root[root] == kNoId) index_of_root[root] = count++;
+    component[v] = index_of_root[root];
+  }
+  return count;
+}
+
 }  // namespace parapm

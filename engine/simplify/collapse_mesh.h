@@ -86,6 +86,11 @@ class CollapseMesh {
   mutable uint32_t stamp_ = 0;
 };
 
+// Numbers the connected components of the live part of `mesh`: component[v] is the index of
+// v's component (in order of their smallest vertex), kNoId for a removed vertex. Returns the
+// number of components.
+uint32_t connected_components(const CollapseMesh& mesh, std::vector<uint32_t>& component);
+
 // Index of vertex v among the corners of face t (0, 1, 2), or -1.
 inline int corner_of(const Triangle& t, VertexId v) {
   return t[0] == v ? 0 : t[1] == v ? 1 : t[2] == v ? 2 : -1;

@@ -31,34 +31,13 @@ class ComponentMinimum : public ConstraintModule {
  public:
   std::string name() const override { return "component-minimum"; }
   void initialize(const CollapseMesh& mesh) override {
-    const size_t n = mesh.vertex_capacity();
-    std::vector<VertexId> parent(n);
-    for (VertexId v = 0; v < n; ++v) parent[v] = v;
-    auto find = [&](VertexId v) {
-      while (parent[v] != v) v = parent[v] = parent[parent[v]];
-      return v;
-    };
-    for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-      const Triangle& t = mesh.face(f);
-      for (int k = 1; k < 3; ++k) {
-        const VertexId a = find(t[0]), b = find(t[k]);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-      }
-    }
-    component_.assign(n, kNoId);
-    std::vector<uint32_t> index_of_root(n, kNoId);
-    for (VertexId v = 0; v < n; ++v) {
-      if (!mesh.vertex_alive(v)) continue;
-      const VertexId root = find(v);
-      if (index_of_root[root] == kNoId) {
-        index_of_root[root] = uint32_t(count_.size());
-        count_.push_back(0);
-        closed_.push_back(1);
-      }
-      const uint32_t c = index_of_root[root];
-      component_[v] = c;
-      ++count_[c];
-      if (mesh.is_boundary(v)) closed_[c] = 0;
+    const uint32_t components = connected_components(mesh, component_);
+    count_.assign(components, 0);
+    closed_.assign(components, 1);
+    for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
+      if (component_[v] == kNoId) continue;
+      ++count_[component_[v]];
+      if (mesh.is_boundary(v)) closed_[component_[v]] = 0;
     }
   }
   bool allows(const CollapseMesh&, const CollapseCandidate& c, const EdgeFaces&) const override {

@@ -11,6 +11,7 @@
 #include "simplify/point_projection.h"
 #include "simplify/surface_samples.h"
 #include "simplify/vec_math.h"
+#include "util/error.h"
 
 namespace parapm {
 namespace {
@@ -45,17 +46,16 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
     curves_ = SharpCurves{};
     curves_.initialize_empty(mesh);
   }
-  const double diagonal = options_.reference_diagonal > 0
-                              ? options_.reference_diagonal
-                              : bounding_box(mesh.positions()).diagonal();
+  const double diagonal = diagonal_of(mesh);
   // Large against any ordinary change of energy (each point costs at most diagonal^2), and the
   // same for every subset of a mesh, so that penalised costs still compare across subsets.
-  topology_penalty_ = diagonal * diagonal * 1e9;
+  topology_penalty_ = diagonal * diagonal * kTopologyPenalty;
 
   const bool scalar = mesh.has_wedges() && attributes_.layout.any();
   scalar_.initialize(scalar ? attributes_.layout : AttributeLayout{}, attributes_.values,
                      options_.attribute_weight * diagonal);
 
+  point_id_.clear();
   points_.clear();
   points_.reserve(samples.size());
   face_first_.assign(mesh.face_capacity(), kNoPoint);
@@ -78,6 +78,137 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
   }
 }
 
+double EnergyPriority::diagonal_of(const CollapseMesh& mesh) const {
+  return options_.reference_diagonal > 0 ? options_.reference_diagonal
+                                         : bounding_box(mesh.positions()).diagonal();
+}
+
+void EnergyPriority::export_state(const std::vector<FaceId>& faces,
+                                  const std::vector<VertexId>& vertices,
+                                  const std::vector<WedgeId>& wedges, const IdMaps& maps,
+                                  bool to_local, EnergyState& out) const {
+  const IdTranslation to_face{maps.face, to_local}, to_vertex{maps.vertex, to_local};
+  const int floats = scalar_.enabled() ? scalar_.floats() : 0;
+  auto add_point = [&](uint32_t id, FaceId face, VertexId vertex) {
+    const Point& p = points_[id];
+    out.points.push_back({point_id_.empty() ? id : point_id_[id], face, vertex, p.position,
+                          p.distance_sq, floats ? scalar_.residual(id) : 0.0});
+    if (floats)
+      out.point_values.insert(out.point_values.end(), scalar_.point_values(id),
+                              scalar_.point_values(id) + floats);
+  };
+  for (FaceId f : faces) {
+    const FaceId written = to_face(f);
+    out.faces.push_back(written);
+    for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next)
+      add_point(id, written, kNoId);
+  }
+  for (VertexId v : vertices) {
+    const VertexId written = to_vertex(v);
+    out.vertices.push_back(written);
+    if (parked_point_[v] != kNoPoint) add_point(parked_point_[v], kNoId, written);
+  }
+  curves_.export_state(vertices, to_vertex, out);
+  if (floats) scalar_.export_wedges(wedges, IdTranslation{maps.wedge, to_local}, out);
+}
+
+EnergyState EnergyPriority::export_local(const IdMaps& maps) const {
+  EnergyState state;
+  const std::vector<WedgeId> none;
+  export_state(*maps.face, *maps.vertex, maps.wedge ? *maps.wedge : none, maps, true, state);
+  return state;
+}
+
+EnergyState EnergyPriority::export_global(const CollapseMesh& mesh, const IdMaps& maps,
+                                          const std::vector<uint8_t>& owned) const {
+  std::vector<VertexId> vertices;
+  for (VertexId v = 0; v < owned.size(); ++v)
+    if (owned[v]) vertices.push_back(v);
+  // The faces with three owned corners, alive or not (a collapse renames an owned corner to
+  // an owned vertex, so the set is that of the job's start); mixed faces never change.
+  std::vector<FaceId> faces;
+  std::vector<WedgeId> wedges;
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    const Triangle& t = mesh.face(f);
+    if (owned[t[0]] && owned[t[1]] && owned[t[2]]) faces.push_back(f);
+    if (scalar_.enabled() && mesh.has_wedges())
+      for (int k = 0; k < 3; ++k)
+        if (owned[t[k]]) wedges.push_back(mesh.corner_wedges(f)[k]);
+  }
+  std::sort(wedges.begin(), wedges.end());
+  wedges.erase(std::unique(wedges.begin(), wedges.end()), wedges.end());
+  EnergyState state;
+  export_state(faces, vertices, wedges, maps, false, state);
+  return state;
+}
+
+void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& state) {
+  const double diagonal = diagonal_of(mesh);
+  topology_penalty_ = diagonal * diagonal * kTopologyPenalty;
+  const bool scalar = mesh.has_wedges() && attributes_.layout.any();
+  scalar_.import_local(scalar ? attributes_.layout : AttributeLayout{},
+                       options_.attribute_weight * diagonal, state);
+  if (options_.discontinuities) {
+    curves_.import_local(mesh, state);
+  } else {
+    curves_ = SharpCurves{};
+    curves_.initialize_empty(mesh);
+  }
+  const size_t n = state.points.size();
+  points_.assign(n, Point{});
+  point_id_.resize(n);
+  sample_vertex_.assign(n, kNoId);
+  face_first_.assign(mesh.face_capacity(), kNoPoint);
+  moments_.assign(mesh.face_capacity(), PointMoments{});
+  moments_ready_.assign(mesh.face_capacity(), 0);
+  parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
+  // Backwards, each pushed at the front of its face's list: the lists keep the written order.
+  for (size_t i = n; i-- > 0;) {
+    const EnergyState::Point& p = state.points[i];
+    const auto id = uint32_t(i);
+    point_id_[i] = p.id;
+    points_[i] = {p.position, p.distance_sq, p.face, kNoPoint};
+    if (p.face != kNoId) {
+      if (p.face >= mesh.face_capacity()) throw_invalid("energy state: face out of range");
+      points_[i].next = face_first_[p.face];
+      face_first_[p.face] = id;
+    } else {
+      if (p.vertex >= mesh.vertex_capacity()) throw_invalid("energy state: vertex out of range");
+      parked_point_[p.vertex] = id;
+      sample_vertex_[i] = p.vertex;
+    }
+  }
+}
+
+void EnergyPriority::import_global(const EnergyState& state) {
+  for (FaceId f : state.faces) {
+    if (f >= face_first_.size()) throw_invalid("energy state: face out of range");
+    face_first_[f] = kNoPoint;
+    moments_ready_[f] = 0;
+  }
+  for (VertexId v : state.vertices) {
+    if (v >= parked_point_.size()) throw_invalid("energy state: vertex out of range");
+    parked_point_[v] = kNoPoint;
+  }
+  for (size_t i = state.points.size(); i-- > 0;) {
+    const EnergyState::Point& p = state.points[i];
+    if (p.id >= points_.size()) throw_invalid("energy state: point id out of range");
+    Point& point = points_[p.id];
+    point.position = p.position;
+    point.distance_sq = p.distance_sq;
+    if (p.face != kNoId) {
+      point.face = p.face;
+      point.next = face_first_[p.face];
+      face_first_[p.face] = p.id;
+    } else {
+      parked_point_[p.vertex] = p.id;
+    }
+    if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
+  }
+  if (options_.discontinuities) curves_.import_global(state);
+  scalar_.import_global(state);
+}
+
 void EnergyPriority::gather_face(FaceId f, int home) const {
   for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next) {
     star_points_.push_back(id);
@@ -97,16 +228,32 @@ const PointMoments& EnergyPriority::moments_of(FaceId f) const {
 }
 
 // The squared distances of face f's points to the plane of (q0, q1, q2); to the triangle
-// itself when it is too thin to have a plane.
-double EnergyPriority::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1,
-                                         const Vec3& q2) const {
+// itself when it is too thin to have a plane. Plus a lower bound of how far the points lie
+// outside the triangle within its plane: count x (the mean's in-plane distance)^2, since the
+// squared distance to a convex set is convex (Jensen); without it a placement that leaves
+// points far beyond the new faces' rims, though close to their planes, would look free.
+// With `star_face` (after the collapse, v the moving vertex), the mean may also lie on the
+// faces beside it in the fan, as a point may move there (project_points).
+double EnergyPriority::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2,
+                                         int star_face) const {
   const PointMoments& m = moments_of(f);
   if (m.count == 0) return 0;
   const Vec3 n = triangle_normal(q0, q1, q2);
   const double n_sq = dot(n, n);
   const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
-  if (n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0)
-    return m.plane_distance_sq(q0, scale(n, 1.0 / std::sqrt(n_sq)));
+  if (n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0) {
+    const Vec3 unit = scale(n, 1.0 / std::sqrt(n_sq));
+    const double h = dot(unit, sub(m.mean, q0));
+    double closest = project_on_triangle(m.mean, q0, q1, q2).distance_sq;
+    if (star_face >= 0)
+      for (const int beside : {star_[star_face].next, star_[star_face].previous})
+        if (beside >= 0 && closest > h * h)
+          closest = std::min(
+              closest,
+              project_on_triangle(m.mean, q0, star_[beside].p1, star_[beside].p2).distance_sq);
+    const double outside = closest - h * h;
+    return m.plane_distance_sq(q0, unit) + (outside > 0 ? m.count * outside : 0);
+  }
   double sum = 0;
   for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next)
     sum += project_on_triangle(points_[id].position, q0, q1, q2).distance_sq;
@@ -131,11 +278,12 @@ double EnergyPriority::moment_distance_before(const CollapseMesh& mesh) const {
 
 double EnergyPriority::moment_distance_after(const Vec3& v) const {
   double sum = 0;
-  for (const StarFace& f : star_) sum += plane_distance_sq(f.source, v, f.p1, f.p2);
+  for (size_t j = 0; j < star_.size(); ++j)
+    sum += plane_distance_sq(star_[j].source, v, star_[j].p1, star_[j].p2, int(j));
   for (int e = 0; e < 2; ++e)
     if (edge_faces_[e] != kNoId) {
       const StarFace& home = star_[edge_face_homes_[e]];
-      sum += plane_distance_sq(edge_faces_[e], v, home.p1, home.p2);
+      sum += plane_distance_sq(edge_faces_[e], v, home.p1, home.p2, edge_face_homes_[e]);
     }
   if (!parked_ends_.empty()) sum += project_points(parked_ends_, parked_end_homes_, v).distance_sq;
   return sum;
@@ -418,7 +566,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       if (!(denominator > 0)) return from;
       v = scale(add(add(fit.b, curve_fit.b), spring_pull), 1.0 / denominator);
     }
-    if (boundary_a && boundary_b && curves_.sample_count() == 0) {
+    if (boundary_a && boundary_b && !curves_.has_samples()) {
       // Without curve samples (discontinuities off), a boundary edge keeps its vertex on the
       // segment, so that the boundary keeps its place (the energy is isotropic in v, so the
       // constrained optimum is the projection).

@@ -37,6 +37,7 @@
 #include <utility>
 #include <vector>
 
+#include "simplify/module_state.h"
 #include "simplify/modules.h"
 #include "simplify/point_moments.h"
 #include "simplify/point_projection.h"
@@ -76,6 +77,11 @@ double spring_constant(double points_per_face);
 
 class EnergyPriority : public PriorityModule {
  public:
+  // A collapse that changes the curves' topology costs this times the squared reference
+  // diagonal more (each point costs at most one squared diagonal: any ordinary change of
+  // energy is far smaller).
+  static constexpr double kTopologyPenalty = 1e9;
+
   EnergyPriority(std::vector<uint8_t> locked, EnergyOptions options,
                  WedgeAttributes attributes = {})
       : locked_(std::move(locked)), options_(options), attributes_(std::move(attributes)) {}
@@ -84,6 +90,20 @@ class EnergyPriority : public PriorityModule {
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                 CollapseCandidate& out) const override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
+
+  // State export/import for the parallel construction (module_state.h). export_local: the
+  // state of a job's faces and vertices (maps: its local -> global ids; the points on its
+  // faces, the parked samples of its vertices, their sharp neighbours and curve samples, its
+  // wedges), in its local ids. import_local: a job's module from that state, instead of
+  // initialize() (no sampling: the points are the master's). export_global: the job's part at
+  // its end, in global ids: the faces whose three corners are owned (owned: per local vertex;
+  // dead ones with empty lists), the owned vertices and their wedges. import_global: the
+  // master overwrites the state's faces, vertices and wedges.
+  EnergyState export_local(const IdMaps& maps) const;
+  void import_local(const CollapseMesh& mesh, const EnergyState& state);
+  EnergyState export_global(const CollapseMesh& mesh, const IdMaps& maps,
+                            const std::vector<uint8_t>& owned) const;
+  void import_global(const EnergyState& state);
 
   // Observers, for tests and reports.
   size_t point_count() const { return points_.size(); }
@@ -135,7 +155,8 @@ class EnergyPriority : public PriorityModule {
                      std::vector<Projected>* where = nullptr) const;
   double scalar_change() const;
   const PointMoments& moments_of(FaceId f) const;
-  double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2) const;
+  double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2,
+                           int star_face = -1) const;
   double exact_distance_sq() const;
   double moment_distance_before(const CollapseMesh& mesh) const;
   double moment_distance_after(const Vec3& v) const;
@@ -143,6 +164,10 @@ class EnergyPriority : public PriorityModule {
   void update_attributes(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge);
   void gather_face(FaceId f, int home) const;
   void unpark(VertexId v);
+  double diagonal_of(const CollapseMesh& mesh) const;
+  void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
+                    const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
+                    EnergyState& out) const;
   double spring_energy_after(const Vec3& v) const;
   bool folds(const Vec3& v) const;
 
@@ -156,6 +181,7 @@ class EnergyPriority : public PriorityModule {
   WedgeAttributes attributes_;       // the input's; initialize copies them into scalar_
   mutable ScalarAttributes scalar_;  // its star scratch is used by the const evaluate
   double topology_penalty_ = 0;      // added to a collapse that changes the curves' topology
+  std::vector<uint32_t> point_id_;   // a job's: per point, the master's id (empty: identity)
 
   // Scratch of one evaluation (evaluate is const but, like CollapseMesh, not thread-safe).
   mutable std::vector<StarFace> star_;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "simplify/vec_math.h"
+#include "util/error.h"
 
 namespace parapm {
 
@@ -86,6 +87,48 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
 
 void QuadricPriority::collapsed(const CollapseMesh&, CollapseCandidate& done, const EdgeFaces&) {
   quadrics_[done.vs] += quadrics_[done.vt];
+}
+
+QuadricState QuadricPriority::export_local(const IdMaps& maps) const {
+  QuadricState state;
+  const std::vector<VertexId>& global = *maps.vertex;
+  state.vertices.resize(global.size());
+  state.quadrics.reserve(global.size());
+  for (size_t i = 0; i < global.size(); ++i) {
+    state.vertices[i] = VertexId(i);
+    state.quadrics.push_back(quadrics_[global[i]]);
+  }
+  return state;
+}
+
+void QuadricPriority::import_local(const CollapseMesh& mesh, const QuadricState& state) {
+  if (state.vertices.size() != state.quadrics.size())
+    throw_invalid("quadric state: vertices and quadrics disagree");
+  quadrics_.assign(mesh.vertex_capacity(), Quadric{});
+  for (size_t i = 0; i < state.vertices.size(); ++i) {
+    if (state.vertices[i] >= quadrics_.size()) throw_invalid("quadric state: vertex out of range");
+    quadrics_[state.vertices[i]] = state.quadrics[i];
+  }
+}
+
+QuadricState QuadricPriority::export_global(const IdMaps& maps,
+                                            const std::vector<uint8_t>& owned) const {
+  QuadricState state;
+  for (VertexId v = 0; v < owned.size(); ++v)
+    if (owned[v]) {
+      state.vertices.push_back((*maps.vertex)[v]);
+      state.quadrics.push_back(quadrics_[v]);
+    }
+  return state;
+}
+
+void QuadricPriority::import_global(const QuadricState& state) {
+  if (state.vertices.size() != state.quadrics.size())
+    throw_invalid("quadric state: vertices and quadrics disagree");
+  for (size_t i = 0; i < state.vertices.size(); ++i) {
+    if (state.vertices[i] >= quadrics_.size()) throw_invalid("quadric state: vertex out of range");
+    quadrics_[state.vertices[i]] = state.quadrics[i];
+  }
 }
 
 }  // namespace parapm

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "simplify/module_state.h"
 #include "simplify/modules.h"
 #include "simplify/quadric.h"
 
@@ -27,6 +28,17 @@ class QuadricPriority : public PriorityModule {
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                 CollapseCandidate& out) const override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
+
+  // State export/import for the parallel construction (module_state.h). export_local: the
+  // quadrics of a job's vertices (maps: its local -> global ids), in its local ids.
+  // import_local: a job's module from that state, instead of initialize(). export_global: the
+  // quadrics of the job's owned vertices (owned: per local vertex), in global ids.
+  // import_global: the master overwrites those vertices' quadrics.
+  QuadricState export_local(const IdMaps& maps) const;
+  void import_local(const CollapseMesh& mesh, const QuadricState& state);
+  QuadricState export_global(const IdMaps& maps, const std::vector<uint8_t>& owned) const;
+  void import_global(const QuadricState& state);
+  const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 
  private:
   std::vector<uint8_t> locked_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 #include "simplify/point_projection.h"
 #include "util/error.h"
@@ -173,6 +174,53 @@ void ScalarAttributes::apply(std::vector<WedgeId>& changed, std::vector<float>& 
         new_values.push_back(current[k]);
       }
     }
+  }
+}
+
+WedgeId ScalarAttributes::root(WedgeId w) const {
+  while (parent_[w] != w) w = parent_[w];
+  return w;
+}
+
+void ScalarAttributes::export_wedges(const std::vector<WedgeId>& wedges, const IdTranslation& to,
+                                     EnergyState& out) const {
+  if (floats_ == 0) return;
+  std::unordered_map<WedgeId, WedgeId> first;  // class root -> first written wedge of it
+  for (WedgeId w : wedges) {
+    const WedgeId written = to(w);
+    out.wedges.push_back(written);
+    out.wedge_values.insert(out.wedge_values.end(), value(w), value(w) + floats_);
+    out.wedge_class.push_back(first.try_emplace(root(w), written).first->second);
+  }
+}
+
+void ScalarAttributes::import_local(const AttributeLayout& layout, double weight,
+                                    const EnergyState& state) {
+  initialize(layout, state.wedge_values, weight);
+  if (floats_ == 0) return;
+  for (size_t i = 0; i < state.wedges.size(); ++i)
+    if (state.wedges[i] != i || state.wedge_class.at(i) > i)
+      throw_invalid("energy state: the job's wedges are not 0..n-1 with their classes");
+  for (size_t i = 0; i < state.wedges.size(); ++i) parent_[i] = state.wedge_class[i];
+  if (state.point_values.size() != state.points.size() * size_t(floats_))
+    throw_invalid("energy state: point attributes disagree with the points");
+  point_values_ = state.point_values;
+  residual_.clear();
+  for (const EnergyState::Point& p : state.points) residual_.push_back(p.residual);
+}
+
+void ScalarAttributes::import_global(const EnergyState& state) {
+  if (floats_ == 0) return;
+  if (state.wedge_values.size() != state.wedges.size() * size_t(floats_) ||
+      state.wedge_class.size() != state.wedges.size())
+    throw_invalid("energy state: wedge values or classes disagree with the wedges");
+  for (size_t i = 0; i < state.wedges.size(); ++i) {
+    const WedgeId w = state.wedges[i];
+    if (w >= parent_.size() || state.wedge_class[i] >= parent_.size())
+      throw_invalid("energy state: wedge out of range");
+    std::copy_n(state.wedge_values.begin() + ptrdiff_t(i * size_t(floats_)), floats_,
+                values_.begin() + ptrdiff_t(size_t(w) * size_t(floats_)));
+    join(w, state.wedge_class[i]);
   }
 }
 

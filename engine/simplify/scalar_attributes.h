@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "simplify/collapse_mesh.h"
+#include "simplify/module_state.h"
 
 namespace parapm {
 
@@ -38,6 +39,21 @@ class ScalarAttributes {
   void initialize(const AttributeLayout& layout, std::vector<float> wedge_values, double weight);
   bool enabled() const { return floats_ > 0; }
   const float* value(WedgeId w) const { return values_.data() + size_t(w) * size_t(floats_); }
+
+  int floats() const { return floats_; }
+  const float* point_values(uint32_t point) const {
+    return point_values_.data() + size_t(point) * size_t(floats_);
+  }
+
+  // State export/import for the parallel construction (module_state.h). export_wedges writes
+  // `wedges` (the module's ids) through `to`, with their values and classes, to out.
+  // import_local starts a job's attributes from a state whose wedges are 0..n-1 and whose
+  // points are the job's (values and residuals in state order), instead of initialize() and
+  // add_point(). import_global gives the master the state's wedge values and classes.
+  void export_wedges(const std::vector<WedgeId>& wedges, const IdTranslation& to,
+                     EnergyState& out) const;
+  void import_local(const AttributeLayout& layout, double weight, const EnergyState& state);
+  void import_global(const EnergyState& state);
 
   // The next point's attributes: those of the mesh where `position` projects on face f.
   void add_point(const CollapseMesh& mesh, FaceId f, const Vec3& position);
@@ -74,6 +90,7 @@ class ScalarAttributes {
     std::vector<WedgeId> members;      // distinct wedges of the moving corner
   };
   WedgeId find(WedgeId w);
+  WedgeId root(WedgeId w) const;  // find without path halving
   WedgeId joined_root(WedgeId root) const;
   // The group's value minimising its error (with a weak pull to its members' mean, so that
   // a group few points see stays put), clamped to the channel's range.

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
 
 #include "simplify/point_projection.h"
+#include "util/error.h"
 
 namespace parapm {
 namespace {
@@ -78,6 +80,8 @@ void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& o
     if (!neighbors_[v].empty()) add_sample(mesh.position(v), v, neighbors_[v][0]);
   for (const auto& [a, b] : edges)
     add_sample(scale(add(mesh.position(a), mesh.position(b)), 0.5), a, b);
+  total_samples_ = samples_.size();
+  sample_id_.clear();
 }
 
 void SharpCurves::initialize_empty(const CollapseMesh& mesh) {
@@ -85,6 +89,8 @@ void SharpCurves::initialize_empty(const CollapseMesh& mesh) {
   neighbors_.assign(mesh.vertex_capacity(), {});
   listed_at_.assign(mesh.vertex_capacity(), {});
   edge_count_ = 0;
+  total_samples_ = 0;
+  sample_id_.clear();
 }
 
 bool SharpCurves::is_sharp(VertexId a, VertexId b) const { return contains(neighbors_[a], b); }
@@ -155,7 +161,8 @@ void SharpCurves::unlist(VertexId v, uint32_t id) {
 }
 
 double SharpCurves::collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh) {
-  if (samples_.empty()) return 0;
+  // A job may hold sharp edges but none of their samples: the curves are updated anyway.
+  if (samples_.empty() && neighbors_[vs].empty() && neighbors_[vt].empty()) return 0;
   std::vector<uint32_t>& moved = gathered_;
   moved.assign(listed_at_[vs].begin(), listed_at_[vs].end());
   for (uint32_t id : listed_at_[vt]) {
@@ -200,6 +207,82 @@ double SharpCurves::collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh
     max_distance_sq = std::max(max_distance_sq, s.distance_sq);
   }
   return max_distance_sq;
+}
+
+void SharpCurves::export_state(const std::vector<VertexId>& vertices, const IdTranslation& to,
+                               EnergyState& out) const {
+  std::unordered_map<uint32_t, uint32_t> index;  // sample id -> position in out.samples
+  out.curve_samples_total = total_samples_;
+  out.sharp_begin.assign(1, 0);
+  out.listed_begin.assign(1, 0);
+  for (VertexId v : vertices) {
+    for (VertexId x : neighbors_[v])
+      if (const VertexId written = to(x); written != kNoId) out.sharp_neighbors.push_back(written);
+    out.sharp_begin.push_back(uint32_t(out.sharp_neighbors.size()));
+    for (uint32_t id : listed_at_[v]) {
+      const Sample& s = samples_[id];
+      const VertexId u = to(s.u), w = to(s.w);
+      if (u == kNoId || (s.w != kNoId && w == kNoId)) continue;
+      auto [it, added] = index.try_emplace(id, uint32_t(out.samples.size()));
+      if (added)
+        out.samples.push_back(
+            {sample_id_.empty() ? id : sample_id_[id], s.position, s.distance_sq, u, w});
+      out.listed.push_back(it->second);
+    }
+    out.listed_begin.push_back(uint32_t(out.listed.size()));
+  }
+}
+
+void SharpCurves::import_local(const CollapseMesh& mesh, const EnergyState& state) {
+  const size_t n = state.vertices.size();
+  if (state.sharp_begin.size() != n + 1 || state.listed_begin.size() != n + 1)
+    throw_invalid("energy state: curve lists disagree with the vertices");
+  neighbors_.assign(mesh.vertex_capacity(), {});
+  listed_at_.assign(mesh.vertex_capacity(), {});
+  samples_.clear();
+  sample_id_.clear();
+  for (const EnergyState::CurveSample& s : state.samples) {
+    if (s.u >= mesh.vertex_capacity() || (s.w != kNoId && s.w >= mesh.vertex_capacity()))
+      throw_invalid("energy state: curve sample on a vertex out of range");
+    samples_.push_back({s.position, s.distance_sq, s.u, s.w});
+    sample_id_.push_back(s.id);
+  }
+  size_t ends = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const VertexId v = state.vertices[i];
+    for (uint32_t k = state.sharp_begin[i]; k < state.sharp_begin[i + 1]; ++k) {
+      if (state.sharp_neighbors.at(k) >= mesh.vertex_capacity())
+        throw_invalid("energy state: sharp neighbour out of range");
+      neighbors_[v].push_back(state.sharp_neighbors[k]);
+    }
+    ends += neighbors_[v].size();
+    for (uint32_t k = state.listed_begin[i]; k < state.listed_begin[i + 1]; ++k) {
+      if (state.listed.at(k) >= samples_.size())
+        throw_invalid("energy state: listed sample out of range");
+      listed_at_[v].push_back(state.listed[k]);
+    }
+  }
+  edge_count_ = ends / 2;
+  total_samples_ = state.curve_samples_total;
+}
+
+void SharpCurves::import_global(const EnergyState& state) {
+  const size_t n = state.vertices.size();
+  if (state.sharp_begin.size() != n + 1 || state.listed_begin.size() != n + 1)
+    throw_invalid("energy state: curve lists disagree with the vertices");
+  for (const EnergyState::CurveSample& s : state.samples) {
+    if (s.id >= samples_.size()) throw_invalid("energy state: curve sample id out of range");
+    samples_[s.id] = {s.position, s.distance_sq, s.u, s.w};
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const VertexId v = state.vertices[i];
+    if (v >= neighbors_.size()) throw_invalid("energy state: vertex out of range");
+    neighbors_[v].assign(state.sharp_neighbors.begin() + state.sharp_begin[i],
+                         state.sharp_neighbors.begin() + state.sharp_begin[i + 1]);
+    listed_at_[v].clear();
+    for (uint32_t k = state.listed_begin[i]; k < state.listed_begin[i + 1]; ++k)
+      listed_at_[v].push_back(state.samples.at(state.listed[k]).id);
+  }
 }
 
 }  // namespace parapm

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "simplify/collapse_mesh.h"
+#include "simplify/module_state.h"
 
 namespace parapm {
 
@@ -34,6 +35,8 @@ class SharpCurves {
   void initialize_empty(const CollapseMesh& mesh);
 
   size_t sample_count() const { return samples_.size(); }
+  // Whether the whole mesh has curve samples (a job may hold none of them).
+  bool has_samples() const { return total_samples_ > 0; }
   size_t sharp_edge_count() const { return edge_count_; }
   const std::vector<VertexId>& sharp_neighbors(VertexId v) const { return neighbors_[v]; }
   bool on_curve(VertexId v) const { return !neighbors_[v].empty(); }
@@ -61,6 +64,16 @@ class SharpCurves {
   // returns the largest distance squared among the samples it moved.
   double collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh);
 
+  // State export/import for the parallel construction (module_state.h): the curves at
+  // `vertices` (the module's ids; out.vertices lists them written through `to`) go to out's
+  // sharp and listed lists, the samples listed there (with their every end translating) to
+  // out.samples. import_local builds the curves of a job's mesh from such a state (local ids)
+  // instead of initialize(); import_global overwrites the state's vertices and samples.
+  void export_state(const std::vector<VertexId>& vertices, const IdTranslation& to,
+                    EnergyState& out) const;
+  void import_local(const CollapseMesh& mesh, const EnergyState& state);
+  void import_global(const EnergyState& state);
+
   // Observers for tests: a sample's position, distance squared and the edge it is on.
   const Vec3& sample_position(size_t i) const { return samples_[i].position; }
   double sample_distance_sq(size_t i) const { return samples_[i].distance_sq; }
@@ -81,6 +94,8 @@ class SharpCurves {
   std::vector<std::vector<VertexId>> neighbors_;
   std::vector<std::vector<uint32_t>> listed_at_;  // per vertex: samples on its sharp edges
   size_t edge_count_ = 0;
+  size_t total_samples_ = 0;
+  std::vector<uint32_t> sample_id_;  // a job's: per sample, the master's id (empty: identity)
 
   // Scratch of one evaluation.
   mutable std::vector<uint32_t> gathered_;

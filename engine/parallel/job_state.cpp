@@ -1,0 +1,91 @@
+#include "parallel/job_state.h"
+
+#include "simplify/energy_priority.h"
+#include "simplify/quadric_priority.h"
+#include "util/error.h"
+
+namespace parapm {
+namespace {
+
+IdMaps maps_of(const SubsetJob& job) {
+  return {&job.global_vertex, &job.global_face, &job.global_wedge};
+}
+
+class WithoutInitialize : public PriorityModule {
+ public:
+  explicit WithoutInitialize(PriorityModule& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  void initialize(const CollapseMesh&) override {}
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
+                CollapseCandidate& out) const override {
+    return inner_.evaluate(mesh, a, b, out);
+  }
+  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
+                 const EdgeFaces& edge) override {
+    inner_.collapsed(mesh, done, edge);
+  }
+
+ private:
+  PriorityModule& inner_;
+};
+
+}  // namespace
+
+MetricState export_job_state(const PriorityModule& master, const SubsetJob& job) {
+  MetricState state;
+  state.metric = master.name();
+  if (const auto* q = dynamic_cast<const QuadricPriority*>(&master)) {
+    state.quadric = q->export_local(maps_of(job));
+  } else if (const auto* e = dynamic_cast<const EnergyPriority*>(&master)) {
+    state.energy = e->export_local(maps_of(job));
+  } else {
+    throw_internal("export_job_state: no state export for metric " + master.name());
+  }
+  return state;
+}
+
+void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job) {
+  if (job.state.metric != module.name())
+    throw_invalid("subset job " + std::to_string(job.subset) + ": its state is of metric '" +
+                  job.state.metric + "', the job's metric is " + module.name());
+  if (auto* q = dynamic_cast<QuadricPriority*>(&module)) {
+    q->import_local(mesh, job.state.quadric);
+  } else if (auto* e = dynamic_cast<EnergyPriority*>(&module)) {
+    e->import_local(mesh, job.state.energy);
+  } else {
+    throw_internal("import_job_state: no state import for metric " + module.name());
+  }
+}
+
+MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
+                                const SubsetJob& job) {
+  MetricState state;
+  state.metric = module.name();
+  if (const auto* q = dynamic_cast<const QuadricPriority*>(&module)) {
+    state.quadric = q->export_global(maps_of(job), job.owned);
+  } else if (const auto* e = dynamic_cast<const EnergyPriority*>(&module)) {
+    state.energy = e->export_global(mesh, maps_of(job), job.owned);
+  } else {
+    throw_internal("export_result_state: no state export for metric " + module.name());
+  }
+  return state;
+}
+
+void import_result_state(PriorityModule& master, const MetricState& state) {
+  if (state.metric != master.name())
+    throw_internal("import_result_state: a state of metric '" + state.metric + "' for " +
+                   master.name());
+  if (auto* q = dynamic_cast<QuadricPriority*>(&master)) {
+    q->import_global(state.quadric);
+  } else if (auto* e = dynamic_cast<EnergyPriority*>(&master)) {
+    e->import_global(state.energy);
+  } else {
+    throw_internal("import_result_state: no state import for metric " + master.name());
+  }
+}
+
+std::unique_ptr<PriorityModule> without_initialize(PriorityModule& inner) {
+  return std::make_unique<WithoutInitialize>(inner);
+}
+
+}  // namespace parapm

@@ -1,0 +1,255 @@
+// The metric state that travels with the subset jobs (engine/parallel/job_state.h,
+// simplify/module_state.h), on real meshes: export then import gives a module that costs and
+// places every edge as the original, and after a round the master's imported state is,
+// point for point, the state a replay of every merged record through collapsed() gives.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "parallel/collapse_merge.h"
+#include "parallel/job_state.h"
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_job.h"
+#include "parallel_test_support.h"
+#include "partition/partition.h"
+#include "simplify/energy_priority.h"
+#include "simplify/quadric_priority.h"
+#include "simplify/simplifier.h"
+#include "simplify/simplify.h"
+
+namespace parapm {
+namespace {
+
+SimplifyOptions options_of(const std::string& metric) {
+  SimplifyOptions options;
+  options.metric = metric;
+  options.samples_per_face = metric == "energy" ? 1 : 0;  // points on faces from the start
+  return options;
+}
+
+SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh) {
+  SubsetOptions s;
+  s.metric = options.metric;
+  s.samples_per_face = options.samples_per_face;
+  s.crease_angle_degrees = options.crease_angle_degrees;
+  s.attribute_weight = options.attribute_weight;
+  s.seed = options.seed;
+  s.reference_diagonal = bounding_box(mesh).diagonal();
+  return s;
+}
+
+// One job owning the whole live mesh (p = 1), its module imported from `master`, and every
+// edge costed by both: the same end kept, the same position and cost. `exact`: bit for bit
+// (the job's mesh lists each vertex's faces in id order; after collapses the whole mesh's
+// lists are in another order, which changes the order of the energy's sums, hence the last
+// bits).
+void expect_round_trip(const RepairedMesh& repaired, const SimplifyOptions& options,
+                       const CollapseMesh& whole, const PriorityModule& master, bool exact,
+                       const std::string& what) {
+  const Mesh& mesh = repaired.mesh;
+  const std::vector<uint32_t> one_subset(whole.vertex_capacity(), 0);
+  std::vector<SubsetJob> jobs = extract_subsets(whole, mesh.layout, mesh.wedge_values,
+                                                mesh.positions_are_float, locked_vertices(repaired),
+                                                one_subset, 1, 0, subset_options_of(options, mesh));
+  SubsetJob& job = jobs.at(0);
+  job.state = export_job_state(master, job);
+  CollapseMesh local(job.mesh);
+  std::unique_ptr<PriorityModule> imported =
+      make_priority_module(options, job.mesh, job.locked, job.options.reference_diagonal);
+  import_job_state(*imported, local, job);
+  size_t edges = 0, placed = 0;
+  double worst = 0;
+  for (VertexId a = 0; a < local.vertex_capacity(); ++a) {
+    if (!local.vertex_alive(a)) continue;
+    std::vector<VertexId> around;
+    local.neighbors(a, around);
+    for (VertexId b : around) {
+      if (b < a) continue;
+      ++edges;
+      CollapseCandidate x, y;
+      const bool ok_master = master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], x);
+      const bool ok_imported = imported->evaluate(local, a, b, y);
+      ASSERT_EQ(ok_master, ok_imported) << what << " edge " << a << " " << b;
+      if (!ok_master) continue;
+      ++placed;
+      ASSERT_EQ(x.vs, job.global_vertex[y.vs]) << what;
+      ASSERT_EQ(x.vt, job.global_vertex[y.vt]) << what;
+      if (exact) {
+        ASSERT_EQ(x.cost, y.cost) << what << " edge " << a << " " << b;
+        for (int k = 0; k < 3; ++k) ASSERT_EQ(x.position[k], y.position[k]) << what;
+        ASSERT_EQ(x.error, y.error) << what;
+      } else {
+        const double scale = std::max({std::abs(x.cost), 1e-30});
+        worst = std::max(worst, std::abs(x.cost - y.cost) / scale);
+        ASSERT_NEAR(x.cost, y.cost, 1e-6 * scale + 1e-24) << what << " edge " << a << " " << b;
+        for (int k = 0; k < 3; ++k)
+          ASSERT_NEAR(x.position[k], y.position[k], 1e-9 * job.options.reference_diagonal) << what;
+      }
+    }
+  }
+  EXPECT_GT(placed, edges / 2) << what;
+  std::printf("%-40s %6zu edges costed alike (%zu placed; worst relative cost gap %.2e)\n",
+              what.c_str(), edges, placed, worst);
+}
+
+TEST(JobState, ExportThenImportCostsEveryEdgeAlike) {
+  for (const char* name : {"pymeshlab-colored-airplane-11k.ply", "stratocaster-9k.ply"})
+    for (const char* metric : {"quadric", "energy"}) {
+      const RepairedMesh repaired = testing::repaired_test_mesh(name);
+      const SimplifyOptions options = options_of(metric);
+      const std::vector<uint8_t> locked = locked_vertices(repaired);
+      CollapseMesh whole(repaired.mesh);
+      std::unique_ptr<PriorityModule> master = make_priority_module(options, repaired.mesh, locked);
+      master->initialize(whole);
+      expect_round_trip(repaired, options, whole, *master, true,
+                        std::string(name) + " " + metric + " input");
+      // Half way down: points re-projected, parked samples moved, curves and wedge classes
+      // changed, quadrics summed.
+      std::unique_ptr<PriorityModule> continued = without_initialize(*master);
+      Simplifier simplifier(whole, *continued, standard_constraints(locked));
+      SimplifierLimits limits;
+      limits.target_faces = whole.live_faces() / 2;
+      simplifier.run(limits, {}, nullptr);
+      expect_round_trip(repaired, options, whole, *master, std::string(metric) == "quadric",
+                        std::string(name) + " " + metric + " at 50%");
+    }
+}
+
+// A round of p subsets on `whole` (the master's module `master` initialised on it), as the
+// parallel build does it: new partition of the live mesh, jobs with state, merge by cost. The
+// records replay on `whole` and on `twin` (the same mesh); `master` follows by importing the
+// jobs' returned states, `replayed` by collapsed() on every record.
+void round_both_ways(const RepairedMesh& repaired, const SimplifyOptions& options, uint32_t p,
+                     uint32_t round, CollapseMesh& whole, PriorityModule& master,
+                     CollapseMesh& twin, PriorityModule& replayed, ReplayReport& report) {
+  const Mesh& mesh = repaired.mesh;
+  Mesh live;  // the live part, compacted, for the partitioner
+  std::vector<VertexId> compact(whole.vertex_capacity(), kNoId);
+  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+    if (whole.vertex_alive(v)) {
+      compact[v] = VertexId(live.positions.size());
+      live.positions.push_back(whole.position(v));
+    }
+  for (FaceId f = 0; f < whole.face_capacity(); ++f)
+    if (whole.face_alive(f)) {
+      const Triangle& t = whole.face(f);
+      live.faces.push_back({compact[t[0]], compact[t[1]], compact[t[2]]});
+    }
+  PartitionOptions partition_options;
+  partition_options.seed = 1 + round;
+  const Partition partition = partition_mesh(live, p, partition_options);
+  std::vector<uint32_t> vertex_subset(whole.vertex_capacity(), 0);
+  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+    if (compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[compact[v]];
+  SubsetOptions subset_options = subset_options_of(options, mesh);
+  std::vector<SubsetJob> jobs =
+      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
+                      locked_vertices(repaired), vertex_subset, p, round, subset_options);
+  std::vector<std::vector<CollapseRecord>> lists;
+  std::vector<SubsetResult> results;
+  for (SubsetJob& job : jobs) {
+    job.options.target_faces = job.mesh.face_count() * 2 / 5;
+    job.state = export_job_state(master, job);
+    results.push_back(simplify_subset(job));
+    lists.push_back(results.back().records);
+  }
+  const std::vector<CollapseRecord> merged = merge_by_cost(std::move(lists));
+  ASSERT_GT(merged.size(), whole.live_faces() / 8);
+  replay_collapses(whole, merged, nullptr);
+  for (const SubsetResult& r : results) import_result_state(master, r.state);
+  report = replay_collapses(twin, merged, &replayed);
+}
+
+TEST(JobState, ImportedStateEqualsTheReplayedState) {
+  for (const char* name : {"pymeshlab-colored-airplane-11k.ply", "stratocaster-9k.ply"}) {
+    const RepairedMesh repaired = testing::repaired_test_mesh(name);
+    const std::vector<uint8_t> locked = locked_vertices(repaired);
+    for (const char* metric : {"quadric", "energy"}) {
+      const SimplifyOptions options = options_of(metric);
+      CollapseMesh whole(repaired.mesh), twin(repaired.mesh);
+      auto master = make_priority_module(options, repaired.mesh, locked);
+      auto replayed = make_priority_module(options, repaired.mesh, locked);
+      master->initialize(whole);
+      replayed->initialize(twin);
+      for (uint32_t round = 0; round < 2; ++round) {
+        ReplayReport report;
+        round_both_ways(repaired, options, 3, round, whole, *master, twin, *replayed, report);
+        if (HasFatalFailure()) return;
+        const std::string what =
+            std::string(name) + " " + metric + " round " + std::to_string(round);
+        // The jobs' points are the master's, so E_scalar's changes are computed as on the
+        // whole mesh (in round 0 the jobs' vertices list their faces as the whole mesh does).
+        if (round == 0) {
+          EXPECT_EQ(report.attribute_mismatches, 0u) << what;
+        }
+        if (auto* q = dynamic_cast<QuadricPriority*>(master.get())) {
+          auto* r = dynamic_cast<QuadricPriority*>(replayed.get());
+          size_t compared = 0;
+          for (VertexId v = 0; v < whole.vertex_capacity(); ++v) {
+            if (!whole.vertex_alive(v)) continue;
+            const Quadric &a = q->quadric(v), &b = r->quadric(v);
+            ASSERT_TRUE(a.a00 == b.a00 && a.a01 == b.a01 && a.a02 == b.a02 && a.a11 == b.a11 &&
+                        a.a12 == b.a12 && a.a22 == b.a22 && a.b0 == b.b0 && a.b1 == b.b1 &&
+                        a.b2 == b.b2 && a.c == b.c && a.weight == b.weight)
+                << what << " vertex " << v;
+            ++compared;
+          }
+          std::printf("%-44s %6zu quadrics equal\n", what.c_str(), compared);
+          continue;
+        }
+        const auto* e = dynamic_cast<EnergyPriority*>(master.get());
+        const auto* r = dynamic_cast<EnergyPriority*>(replayed.get());
+        ASSERT_EQ(e->point_count(), r->point_count());
+        size_t parked = 0, other_face = 0;
+        double sum_master = 0, sum_replayed = 0;
+        for (size_t i = 0; i < e->point_count(); ++i) {
+          ASSERT_EQ(e->point_parked_at(i), r->point_parked_at(i)) << what << " point " << i;
+          if (e->point_parked_at(i) != kNoId) {
+            ++parked;
+            continue;
+          }
+          sum_master += e->point_distance_sq(i);
+          sum_replayed += r->point_distance_sq(i);
+          if (e->point_face(i) != r->point_face(i)) {
+            ++other_face;
+            continue;
+          }
+          if (round == 0) {
+            ASSERT_EQ(e->point_distance_sq(i), r->point_distance_sq(i)) << what << " point " << i;
+          }
+        }
+        // Round 0: exactly. From the second round on, a job's mesh lists each vertex's faces
+        // in id order, the whole mesh in the order its collapses left: a point equally close
+        // to two faces (a vertex's sample, at distance 0 from all its faces) goes to the first
+        // one listed, and from then on it is re-projected with that face's star. The
+        // difference stays a few points and the energy stays the same.
+        if (round == 0) {
+          EXPECT_EQ(other_face, 0u) << what;
+        }
+        EXPECT_LE(other_face, e->point_count() / 100) << what;
+        EXPECT_NEAR(sum_master, sum_replayed, 1e-3 * sum_replayed) << what;
+        const SharpCurves &ca = e->curves(), &cb = r->curves();
+        ASSERT_EQ(ca.sample_count(), cb.sample_count());
+        for (size_t i = 0; i < ca.sample_count(); ++i) {
+          ASSERT_EQ(ca.sample_edge(i), cb.sample_edge(i)) << what << " curve sample " << i;
+          ASSERT_EQ(ca.sample_distance_sq(i), cb.sample_distance_sq(i)) << what;
+        }
+        for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+          if (whole.vertex_alive(v)) {
+            std::vector<VertexId> x = ca.sharp_neighbors(v), y = cb.sharp_neighbors(v);
+            std::sort(x.begin(), x.end());
+            std::sort(y.begin(), y.end());
+            ASSERT_EQ(x, y) << what << " vertex " << v;
+          }
+        std::printf(
+            "%-44s %6zu points (%zu parked, %zu on another face; E_dist %.6g vs %.6g), "
+            "%zu curve samples equal; %llu attribute mismatches\n",
+            what.c_str(), e->point_count(), parked, other_face, sum_master, sum_replayed,
+            ca.sample_count(), (unsigned long long)report.attribute_mismatches);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace parapm
