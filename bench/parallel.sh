@@ -15,8 +15,8 @@
 # 10%, 2% of the input faces and the base mesh, metro's RMS and Hausdorff distances of the
 # parallel level relative to the sequential level of the same face count (1.00: as good).
 # Environment: METRICS, PS, RATIO, ROUNDS, HANDOVER, THREADS (default 0), BENCH_OUT (default
-# ./bench-out-parallel), PARAPM_BUILD_DIR (default build/), METRO (default ../peers/metro,
-# else the one bench/run.sh builds in ./.peers-build).
+# ./bench-out-parallel), PARAPM_BUILD_DIR (default build/), METRO (default the one bench/run.sh
+# builds: $PEERS_BUILD/metro, PEERS_BUILD defaulting to ./.peers-build).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 [[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
@@ -25,8 +25,7 @@ ps="${PS:-2 4}"
 ratio="${RATIO:-0.01}"
 out="${BENCH_OUT:-$PWD/bench-out-parallel}"
 bin="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
-metro="${METRO:-$root/../peers/metro}"
-[[ -x "$metro" ]] || metro="$PWD/.peers-build/metro"
+metro="${METRO:-${PEERS_BUILD:-$PWD/.peers-build}/metro}"
 [[ -x "$bin" ]] || { echo "no $bin (build the parapm target)" >&2; exit 2; }
 [[ -x "$metro" ]] || { echo "no metro (set METRO, or run bench/run.sh once)" >&2; exit 2; }
 par_opts=()
