@@ -228,36 +228,67 @@ const PointMoments& EnergyPriority::moments_of(FaceId f) const {
 }
 
 // The squared distances of face f's points to the plane of (q0, q1, q2); to the triangle
-// itself when it is too thin to have a plane. Plus a lower bound of how far the points lie
-// outside the triangle within its plane: count x (the mean's in-plane distance)^2, since the
-// squared distance to a convex set is convex (Jensen); without it a placement that leaves
-// points far beyond the new faces' rims, though close to their planes, would look free.
-// With `star_face` (after the collapse, v the moving vertex), the mean may also lie on the
-// faces beside it in the fan, as a point may move there (project_points).
-double EnergyPriority::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2,
-                                         int star_face) const {
+// itself when it is too thin to have a plane.
+double EnergyPriority::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1,
+                                         const Vec3& q2) const {
   const PointMoments& m = moments_of(f);
   if (m.count == 0) return 0;
   const Vec3 n = triangle_normal(q0, q1, q2);
   const double n_sq = dot(n, n);
   const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
-  if (n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0) {
-    const Vec3 unit = scale(n, 1.0 / std::sqrt(n_sq));
-    const double h = dot(unit, sub(m.mean, q0));
-    double closest = project_on_triangle(m.mean, q0, q1, q2).distance_sq;
-    if (star_face >= 0)
-      for (const int beside : {star_[star_face].next, star_[star_face].previous})
-        if (beside >= 0 && closest > h * h)
-          closest = std::min(
-              closest,
-              project_on_triangle(m.mean, q0, star_[beside].p1, star_[beside].p2).distance_sq);
-    const double outside = closest - h * h;
-    return m.plane_distance_sq(q0, unit) + (outside > 0 ? m.count * outside : 0);
-  }
+  if (n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0)
+    return m.plane_distance_sq(q0, scale(n, 1.0 / std::sqrt(n_sq)));
   double sum = 0;
   for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next)
     sum += project_on_triangle(points_[id].position, q0, q1, q2).distance_sq;
   return sum;
+}
+
+// A lower bound of how far face f's points lie outside the triangle (q0, q1, q2) within its
+// plane, which the plane distances leave out: count x (the mean's in-plane distance)^2, since
+// the squared distance to a convex set is convex (Jensen). With `star_face` (after the
+// collapse, q0 the moving vertex) the mean may also lie on the faces beside it in the fan,
+// as a point may move there. 0 for a thin triangle (measured exactly by plane_distance_sq).
+double EnergyPriority::rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2,
+                              int star_face) const {
+  const PointMoments& m = moments_of(f);
+  if (m.count == 0) return 0;
+  const Vec3 n = triangle_normal(q0, q1, q2);
+  const double n_sq = dot(n, n);
+  const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
+  if (!(n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0)) return 0;
+  // Inside (the common case): the mean's projection is on the left of every edge.
+  const Vec3 w = sub(m.mean, q0);
+  if (dot(cross(e1, w), n) >= 0 && dot(cross(w, e2), n) >= 0 &&
+      dot(cross(sub(q2, q1), sub(m.mean, q1)), n) >= 0)
+    return 0;
+  const double h = dot(n, w);
+  const double h_sq = h * h / n_sq;
+  double closest = project_on_triangle(m.mean, q0, q1, q2).distance_sq;
+  if (star_face >= 0)
+    for (const int beside : {star_[star_face].next, star_[star_face].previous})
+      if (beside >= 0 && closest > h_sq)
+        closest = std::min(
+            closest,
+            project_on_triangle(m.mean, q0, star_[beside].p1, star_[beside].p2).distance_sq);
+  return closest > h_sq ? m.count * (closest - h_sq) : 0;
+}
+
+// The change of the rim bound (rim_sq) over the star when the moving vertex goes to v. Added
+// to the cost at the chosen placement only: the placements are compared on the planes.
+double EnergyPriority::moment_rim_change(const CollapseMesh& mesh, const Vec3& v) const {
+  double change = 0;
+  for (size_t j = 0; j < star_.size(); ++j)
+    change += rim_sq(star_[j].source, v, star_[j].p1, star_[j].p2, int(j)) -
+              rim_sq(star_[j].source, star_[j].before, star_[j].p1, star_[j].p2);
+  for (int e = 0; e < 2; ++e)
+    if (const FaceId f = edge_faces_[e]; f != kNoId) {
+      const StarFace& home = star_[edge_face_homes_[e]];
+      const Triangle& t = mesh.face(f);
+      change += rim_sq(f, v, home.p1, home.p2, edge_face_homes_[e]) -
+                rim_sq(f, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+    }
+  return change;
 }
 
 // E_dist of a star too rich in points to project each one, in O(faces of the star): each
@@ -278,12 +309,11 @@ double EnergyPriority::moment_distance_before(const CollapseMesh& mesh) const {
 
 double EnergyPriority::moment_distance_after(const Vec3& v) const {
   double sum = 0;
-  for (size_t j = 0; j < star_.size(); ++j)
-    sum += plane_distance_sq(star_[j].source, v, star_[j].p1, star_[j].p2, int(j));
+  for (const StarFace& f : star_) sum += plane_distance_sq(f.source, v, f.p1, f.p2);
   for (int e = 0; e < 2; ++e)
     if (edge_faces_[e] != kNoId) {
       const StarFace& home = star_[edge_face_homes_[e]];
-      sum += plane_distance_sq(edge_faces_[e], v, home.p1, home.p2, edge_face_homes_[e]);
+      sum += plane_distance_sq(edge_faces_[e], v, home.p1, home.p2);
     }
   if (!parked_ends_.empty()) sum += project_points(parked_ends_, parked_end_homes_, v).distance_sq;
   return sum;
@@ -604,6 +634,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   out.cost = chosen->energy - distance_before - curve_before - kappa * spring_before;
   out.error = std::sqrt(chosen->max_distance_sq);
   if (keep_projections) projected_.swap(placement_projections_[chosen->index]);
+  if (by_moments) out.cost += moment_rim_change(mesh, chosen->v);
   // E_scalar wants every point's projection at the chosen placement.
   if (scalar_.enabled() && by_moments)
     project_points(star_points_, star_homes_, chosen->v, &projected_);

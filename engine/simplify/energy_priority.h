@@ -155,8 +155,9 @@ class EnergyPriority : public PriorityModule {
                      std::vector<Projected>* where = nullptr) const;
   double scalar_change() const;
   const PointMoments& moments_of(FaceId f) const;
-  double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2,
-                           int star_face = -1) const;
+  double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2) const;
+  double rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2, int star_face = -1) const;
+  double moment_rim_change(const CollapseMesh& mesh, const Vec3& v) const;
   double exact_distance_sq() const;
   double moment_distance_before(const CollapseMesh& mesh) const;
   double moment_distance_after(const Vec3& v) const;
