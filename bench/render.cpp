@@ -16,6 +16,7 @@
 #include "io/mesh_io.h"
 #include "mesh/mesh.h"
 #include "png_writer.h"
+#include "simplify/vec_math.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -30,14 +31,9 @@ struct Camera {
 };
 
 Vec3 normalized(const Vec3& v) {
-  const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  return l > 0 ? Vec3{v[0] / l, v[1] / l, v[2] / l} : v;
+  const double l = length(v);
+  return l > 0 ? scale(v, 1 / l) : v;
 }
-Vec3 cross3(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot3(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 minus(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 
 Camera frame(const Mesh& mesh, double azimuth_deg, double elevation_deg, int size) {
   const Box box = bounding_box(mesh);
@@ -46,13 +42,13 @@ Camera frame(const Mesh& mesh, double azimuth_deg, double elevation_deg, int siz
   for (int k = 0; k < 3; ++k) c.centre[k] = 0.5 * (box.min[k] + box.max[k]);
   const double az = azimuth_deg * M_PI / 180, el = elevation_deg * M_PI / 180;
   c.toward = {std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
-  c.right = normalized(cross3({0, 1, 0}, c.toward));
-  c.up = cross3(c.toward, c.right);
+  c.right = normalized(cross({0, 1, 0}, c.toward));
+  c.up = cross(c.toward, c.right);
   // Fit the mesh's silhouette box, not its bounding sphere, to the tile.
   double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
   for (const Vec3& p : mesh.positions) {
-    const Vec3 d = minus(p, c.centre);
-    const double s[2] = {dot3(d, c.right), dot3(d, c.up)};
+    const Vec3 d = sub(p, c.centre);
+    const double s[2] = {dot(d, c.right), dot(d, c.up)};
     for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], s[k]), hi[k] = std::max(hi[k], s[k]);
   }
   if (mesh.positions.empty()) return c;
@@ -88,18 +84,18 @@ void draw(const Mesh& mesh, const Camera& cam, int x0, int width, std::vector<do
   const Vec3 light = normalized({cam.toward[0] + 0.3, cam.toward[1] + 0.5, cam.toward[2]});
   std::vector<std::array<double, 3>> screen(mesh.vertex_count());
   for (VertexId v = 0; v < mesh.vertex_count(); ++v) {
-    const Vec3 d = minus(mesh.positions[v], cam.centre);
-    screen[v] = {x0 + 0.5 * cam.size + cam.scale * dot3(d, cam.right),
-                 0.5 * cam.size - cam.scale * dot3(d, cam.up), dot3(d, cam.toward)};
+    const Vec3 d = sub(mesh.positions[v], cam.centre);
+    screen[v] = {x0 + 0.5 * cam.size + cam.scale * dot(d, cam.right),
+                 0.5 * cam.size - cam.scale * dot(d, cam.up), dot(d, cam.toward)};
   }
   for (FaceId f = 0; f < mesh.face_count(); ++f) {
     const Triangle& t = mesh.faces[f];
     const auto &a = screen[t[0]], &b = screen[t[1]], &c = screen[t[2]];
     const double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
     if (area == 0) continue;
-    const Vec3 n = normalized(cross3(minus(mesh.positions[t[1]], mesh.positions[t[0]]),
-                                     minus(mesh.positions[t[2]], mesh.positions[t[0]])));
-    const double light_factor = 0.35 + 0.65 * std::abs(dot3(n, light));
+    const Vec3 n = normalized(cross(sub(mesh.positions[t[1]], mesh.positions[t[0]]),
+                                    sub(mesh.positions[t[2]], mesh.positions[t[0]])));
+    const double light_factor = 0.35 + 0.65 * std::abs(dot(n, light));
     std::array<Rgb, 3> corner{};
     for (int k = 0; k < 3; ++k)
       corner[k] =

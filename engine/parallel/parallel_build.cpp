@@ -198,13 +198,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   st.setup_seconds = seconds_since(t);
   st.critical_path_seconds = st.setup_seconds;
 
-  SubsetOptions subset_options;
-  subset_options.metric = options.metric;
-  subset_options.samples_per_face = options.samples_per_face;
-  subset_options.crease_angle_degrees = options.crease_angle_degrees;
-  subset_options.attribute_weight = options.attribute_weight;
-  subset_options.seed = options.seed;
-  subset_options.reference_diagonal = bounding_box(mesh).diagonal();
+  SubsetOptions subset_options = subset_options_of(options, mesh);
   // Jobs leave the energy's penalised collapses (changing the curves' topology) to the final
   // pass, which takes them last, as the sequential build does.
   if (options.metric == "energy")

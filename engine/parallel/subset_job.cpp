@@ -146,4 +146,15 @@ void validate_subset_job(const SubsetJob& job) {
   }
 }
 
+SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh) {
+  SubsetOptions s;
+  s.metric = options.metric;
+  s.samples_per_face = options.samples_per_face;
+  s.crease_angle_degrees = options.crease_angle_degrees;
+  s.attribute_weight = options.attribute_weight;
+  s.seed = options.seed;
+  s.reference_diagonal = bounding_box(mesh).diagonal();
+  return s;
+}
+
 }  // namespace parapm

@@ -22,6 +22,7 @@
 #include "mesh/mesh.h"
 #include "simplify/collapse_mesh.h"
 #include "simplify/module_state.h"
+#include "simplify/simplify.h"
 
 namespace parapm {
 
@@ -45,6 +46,10 @@ struct SubsetOptions {
   // first, would not have come to that yet.
   double max_cost = 0;
 };
+
+// The subset options a simplification with `options` gives its jobs, measured against the
+// whole `mesh` (its bounding-box diagonal); target_faces and max_cost are left to the caller.
+SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh);
 
 struct SubsetJob {
   uint32_t round = 0;                   // 0-based

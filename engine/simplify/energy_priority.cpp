@@ -23,6 +23,13 @@ double half_edges_sq(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 0.5 * (dot(ab, ab) + dot(bc, bc) + dot(ca, ca));
 }
 
+// Whether triangle (q0, q1, q2), of normal n (|n|^2 = n_sq), is wide enough to have a plane:
+// a thinner one is measured exactly, point by point.
+bool has_plane(double n_sq, const Vec3& q0, const Vec3& q1, const Vec3& q2) {
+  const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
+  return n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0;
+}
+
 Vec3 rounded(Vec3 v, bool to_float) {
   if (to_float)
     for (double& c : v) c = round_to_float(c);
@@ -235,9 +242,7 @@ double EnergyPriority::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q
   if (m.count == 0) return 0;
   const Vec3 n = triangle_normal(q0, q1, q2);
   const double n_sq = dot(n, n);
-  const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
-  if (n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0)
-    return m.plane_distance_sq(q0, scale(n, 1.0 / std::sqrt(n_sq)));
+  if (has_plane(n_sq, q0, q1, q2)) return m.plane_distance_sq(q0, scale(n, 1.0 / std::sqrt(n_sq)));
   double sum = 0;
   for (uint32_t id = face_first_[f]; id != kNoPoint; id = points_[id].next)
     sum += project_on_triangle(points_[id].position, q0, q1, q2).distance_sq;
@@ -255,9 +260,9 @@ double EnergyPriority::rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Ve
   if (m.count == 0) return 0;
   const Vec3 n = triangle_normal(q0, q1, q2);
   const double n_sq = dot(n, n);
-  const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
-  if (!(n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0)) return 0;
+  if (!has_plane(n_sq, q0, q1, q2)) return 0;
   // Inside (the common case): the mean's projection is on the left of every edge.
+  const Vec3 e1 = sub(q1, q0), e2 = sub(q2, q0);
   const Vec3 w = sub(m.mean, q0);
   if (dot(cross(e1, w), n) >= 0 && dot(cross(w, e2), n) >= 0 &&
       dot(cross(sub(q2, q1), sub(m.mean, q1)), n) >= 0)

@@ -27,17 +27,6 @@ SimplifyOptions options_of(const std::string& metric) {
   return options;
 }
 
-SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh) {
-  SubsetOptions s;
-  s.metric = options.metric;
-  s.samples_per_face = options.samples_per_face;
-  s.crease_angle_degrees = options.crease_angle_degrees;
-  s.attribute_weight = options.attribute_weight;
-  s.seed = options.seed;
-  s.reference_diagonal = bounding_box(mesh).diagonal();
-  return s;
-}
-
 // One job owning the whole live mesh (p = 1), its module imported from `master`, and every
 // edge costed by both: the same end kept, the same position and cost. `exact`: bit for bit
 // (the job's mesh lists each vertex's faces in id order; after collapses the whole mesh's
