@@ -1,5 +1,5 @@
 // parapm: the command-line tool. Local commands work on files in-process; the service
-// commands (submit, watch, get, ...) arrive with the coordinator.
+// commands (up, submit, jobs, watch, get, level, stream, cancel) talk to a coordinator.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
@@ -16,8 +16,9 @@ int main(int argc, char** argv) {
 
   CLI::App app{
       "parapm: builds Progressive Meshes (a base mesh plus vertex splits) from triangle meshes, "
-      "and cuts them into levels of detail.\n"
-      "Exit status: 0 success, 1 'check' found a difference, 2 an error (one line on stderr)."};
+      "and cuts them into levels of detail, in-process or through a ParaPM coordinator.\n"
+      "Exit status: 0 success, 1 'check' found a difference or a job failed or was cancelled, "
+      "2 an error (one line on stderr), 3 the coordinator could not be reached."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "parapm 0.1.0");
   std::string log_level = "info";
@@ -29,6 +30,13 @@ int main(int argc, char** argv) {
   parapm::cli::add_info_command(app, exit_code);
   parapm::cli::add_check_command(app, exit_code);
   parapm::cli::add_partition_command(app, exit_code);
+#ifdef PARAPM_WITH_SERVICE
+  parapm::cli::add_up_command(app, exit_code);
+  parapm::cli::add_submit_command(app, exit_code);
+  parapm::cli::add_jobs_commands(app, exit_code);
+  parapm::cli::add_fetch_commands(app, exit_code);
+  parapm::cli::add_stream_command(app, exit_code);
+#endif
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
 
   try {
@@ -38,7 +46,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   } catch (const parapm::Error& e) {
     std::fprintf(stderr, "parapm: %s\n", e.what());
-    return 2;
+    return e.code() == parapm::ErrorCode::kIo &&
+                   std::string(e.what()).find("UNAVAILABLE") != std::string::npos
+               ? 3
+               : 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "parapm: internal error: %s\n", e.what());
     return 2;

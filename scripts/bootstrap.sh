@@ -8,7 +8,7 @@ build="${PARAPM_BUILD_DIR:-$root/build}"
 
 pkgs=(cmake ninja-build g++ ccache libeigen3-dev libspdlog-dev libfmt-dev libcli11-dev
       nlohmann-json3-dev zlib1g-dev libgrpc++-dev libprotobuf-dev protobuf-compiler
-      protobuf-compiler-grpc libsqlite3-dev libgtest-dev libgmock-dev)
+      protobuf-compiler-grpc libsqlite3-dev libssl-dev libgtest-dev libgmock-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# The embedded default: builds if needed, turns the bundled mesh into a Progressive Mesh,
-# checks that it rebuilds the input exactly, writes levels of detail at 50%, 10% and 2% of
-# the faces, and prints a summary table. Outputs go to out/ (or $PARAPM_OUT).
+# The embedded default: builds if needed, starts the service on this machine (`parapm up`: a
+# coordinator and two workers on loopback, data in out/service-data), submits the bundled
+# mesh (`parapm submit`: upload, parallel build on the workers, download), checks that the
+# Progressive Mesh rebuilds the input exactly, writes levels of detail at 50%, 10% and 2% of
+# the faces, prints the job's events and a summary table, and stops the service.
+# Outputs go to out/ (or $PARAPM_OUT).
 # Usage: scripts/demo.sh [MESH]   (default: the bundled tests/data/pymeshlab-bunny-textured-10k.obj)
-# Runs in-process for now; the service issue moves it onto the coordinator and workers.
+# Environment: PARAPM_DEMO_PORT (default 50051), PARAPM_DEMO_WORKERS (default 2).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 mesh="${1:-$root/tests/data/pymeshlab-bunny-textured-10k.obj}"
@@ -14,9 +17,25 @@ mkdir -p "$out"
 name="$(basename "$mesh")"; name="${name%.gz}"; name="${name%.*}"
 jget() { sed -nE "s/.*\"$2\":(\"?)([^,\"}]*)\1.*/\2/p" <<< "$1"; }
 
+# The service, in the background for the length of the demo.
+port="${PARAPM_DEMO_PORT:-50051}"
+server=(--server "127.0.0.1:$port")
+rm -f "$out/service-data/coordinator.port"
+"$bin" up --workers "${PARAPM_DEMO_WORKERS:-2}" --data "$out/service-data" \
+  --listen "127.0.0.1:$port" --log-level warn 2> "$out/service.log" &
+up_pid=$!
+trap 'kill -INT $up_pid 2> /dev/null; wait $up_pid 2> /dev/null || true' EXIT
+for _ in $(seq 100); do
+  [[ -s "$out/service-data/coordinator.port" ]] && break
+  kill -0 $up_pid 2> /dev/null || { cat "$out/service.log" >&2; echo "demo: the service did not start (port $port busy? set PARAPM_DEMO_PORT)" >&2; exit 2; }
+  sleep 0.1
+done
+sleep 0.5  # the workers register
+
 pm="$out/$name.pm"
-summary="$("$bin" --log-level warn simplify "$mesh" -o "$pm" --json)"
-in_faces="$(jget "$summary" in_faces)"
+job="$("$bin" --log-level warn submit "$mesh" -o "$pm" --json "${server[@]}")"
+job_id="$(jget "$job" job_id)"
+in_faces="$(jget "$job" input_faces)"
 "$bin" --log-level warn check "$pm" --against "$mesh" > /dev/null \
   && lossless="yes (parapm check)" || lossless="NO"
 
@@ -25,10 +44,11 @@ for dir in "${PEERS_BUILD:-}" "$root/.peers-build"; do
   [[ -n "$dir" && -x "$dir/metro" ]] && metro="$dir/metro" && break
 done
 
-printf '\nParaPM demo: %s\n' "$mesh"
-printf 'Progressive Mesh %s: %s vertex splits over a %s-face base mesh, built in %.3f s; lossless: %s\n' \
-  "$pm" "$(jget "$summary" vsplits)" "$(jget "$summary" base_faces)" "$(jget "$summary" seconds)" "$lossless"
-printf '.pm %s bytes, binary PLY %s bytes\n\n' "$(jget "$summary" pm_bytes)" "$(jget "$summary" binary_ply_bytes)"
+printf '\nParaPM demo: %s, through the service at 127.0.0.1:%s (log: %s)\n\n' "$mesh" "$port" "$out/service.log"
+"$bin" watch "$job_id" "${server[@]}" | grep -vE 'progress|queued|started on' | sed 's/^/  /'
+printf '\nProgressive Mesh %s (job %s): %s vertex splits over a %s-face base mesh, built in %.3f s; lossless: %s\n' \
+  "$pm" "$job_id" "$(jget "$job" vsplits)" "$(jget "$job" base_faces)" "$(jget "$job" seconds)" "$lossless"
+printf '.pm %s bytes\n\n' "$(jget "$job" pm_bytes)"
 header="%-8s %10s %10s %12s %14s"
 [[ -n "$metro" ]] && header+=" %14s %14s"
 printf "$header\n" level faces_in faces_out seconds bound/diag ${metro:+rms/diag hausdorff/diag}

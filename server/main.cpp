@@ -1,17 +1,125 @@
-// parapm-coordinator: placeholder until the service issue lands. It parses its command line so that
-// scripts can already call --help, and says plainly that the daemon does not exist yet.
+// parapm-coordinator: the ParaPM service. Accepts uploads, queues jobs, partitions each mesh
+// and sends its subsets to the registered workers, merges their records into the PM, stores
+// it (SQLite + content-addressed blobs under --data) and serves it whole, by level or as a
+// vsplit stream. Stops cleanly on SIGINT / SIGTERM; a restart resumes unfinished jobs.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <thread>
 
-#include "parapm.grpc.pb.h"
+#include <spdlog/spdlog.h>
+
+#include "coordination_service.h"
+#include "coordinator.h"
+#include "daemon.h"
+#include "mesh_service.h"
+#include "rpc_server.h"
+
+namespace {
+
+struct CoordinatorArgs {
+  std::string listen = "127.0.0.1:50051";
+  std::string data = "parapm-data";
+  uint64_t max_upload_mb = 2048;
+  uint32_t parallelism = 4;
+  unsigned max_running_jobs = 2;
+  unsigned local_threads = 0;
+  unsigned heartbeat_ms = 1000;
+  std::string token_file;
+  parapm::rpc::TlsFiles tls;
+  bool worker_tls = false;
+  std::string port_file;
+  std::string log_level = "info";
+};
+
+int run(const CoordinatorArgs& args) {
+  using namespace parapm;
+  rpc::set_up_logging("coordinator", args.log_level);
+  const std::string token = rpc::token_for_listening(args.token_file, args.listen);
+  service::CoordinatorConfig config;
+  config.data_dir = args.data;
+  config.max_upload_bytes = args.max_upload_mb << 20;
+  config.default_parallelism = args.parallelism;
+  config.max_running_jobs = args.max_running_jobs;
+  config.local_threads = args.local_threads;
+  config.heartbeat = std::chrono::milliseconds(args.heartbeat_ms);
+  config.worker_token = token;
+  config.worker_credentials = rpc::channel_credentials(args.worker_tls, args.tls);
+  std::filesystem::create_directories(config.data_dir);
+  service::Coordinator coordinator(config);
+  service::MeshService mesh_service(coordinator, rpc::TokenCheck(token));
+  service::CoordinationService coordination(coordinator.workers(), rpc::TokenCheck(token));
+  rpc::ServerSetup setup;
+  setup.listen = args.listen;
+  setup.tls = args.tls;
+  setup.max_receive_bytes = 16 << 20;  // clients send chunks of at most 4 MiB
+  rpc::StartedServer server = rpc::start_server(setup, {&mesh_service, &coordination});
+  const std::string address = rpc::reachable_address(args.listen, server.port);
+  spdlog::info("listening on {} (data in {}, default p = {}, {} jobs at once{})", address,
+               args.data, args.parallelism, args.max_running_jobs,
+               token.empty() ? "" : ", token required");
+  if (!args.port_file.empty()) {
+    // Written once listening, atomically: a script polling for the file gets a usable port.
+    const std::string temp = args.port_file + ".tmp";
+    if (FILE* f = std::fopen(temp.c_str(), "w")) {
+      std::fprintf(f, "%d\n", server.port);
+      std::fclose(f);
+      std::filesystem::rename(temp, args.port_file);
+    }
+  }
+  const std::string signal = rpc::wait_for_shutdown_signal();
+  spdlog::info("{}: stopping (running jobs re-run at the next start)", signal);
+  server.server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  return 0;  // ~Coordinator stops the schedulers
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
+  parapm::rpc::block_shutdown_signals();
+  CoordinatorArgs args;
   CLI::App app{
-      "parapm-coordinator: not implemented yet (the service issue builds it); use 'parapm "
-      "simplify' in-process"};
+      "parapm-coordinator: the ParaPM service. Clients upload meshes and submit jobs (parapm "
+      "submit); workers (parapm-worker) register and simplify the subsets it sends them; it "
+      "merges, stores and serves the Progressive Meshes."};
+  app.add_option("--listen", args.listen, "address to serve on, host:port (port 0: any free)")
+      ->capture_default_str();
+  app.add_option("--data", args.data, "folder for the database and blobs (created if absent)")
+      ->capture_default_str();
+  app.add_option("--max-upload-mb", args.max_upload_mb, "largest upload accepted, MiB")
+      ->check(CLI::Range(uint64_t(1), uint64_t(1) << 20))
+      ->capture_default_str();
+  app.add_option("--parallelism", args.parallelism,
+                 "subsets p of a job that does not say (the PM depends on p, not on the workers)")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  app.add_option("--max-running-jobs", args.max_running_jobs, "jobs built at once; others queue")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  app.add_option("--local-threads", args.local_threads,
+                 "run subsets in the coordinator on this many threads while no worker is "
+                 "registered (0: wait for a worker)")
+      ->capture_default_str();
+  app.add_option("--heartbeat-ms", args.heartbeat_ms,
+                 "beat interval asked of workers; 3 missed beats and a worker is dead")
+      ->check(CLI::Range(100, 60000))
+      ->capture_default_str();
+  app.add_option("--token-file", args.token_file,
+                 "bearer token required on every call and sent to workers (else PARAPM_TOKEN; "
+                 "required when listening beyond loopback)");
+  app.add_option("--tls-cert", args.tls.cert_file, "PEM certificate: serve over TLS");
+  app.add_option("--tls-key", args.tls.key_file, "PEM private key of --tls-cert");
+  app.add_flag("--worker-tls", args.worker_tls, "call workers over TLS");
+  app.add_option("--tls-ca", args.tls.ca_file,
+                 "PEM roots that sign the workers' certificates (default: the system's)");
+  app.add_option("--port-file", args.port_file,
+                 "write the port listened on to this file once serving (for scripts, with port 0)");
+  app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  std::fprintf(
-      stderr,
-      "parapm-coordinator: the gRPC service is not implemented yet; use 'parapm simplify'\n");
-  return 2;
+  try {
+    return run(args);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "parapm-coordinator: %s\n", e.what());
+    return 2;
+  }
 }

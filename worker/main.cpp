@@ -1,16 +1,105 @@
-// parapm-worker: placeholder until the service issue lands. It parses its command line so that
-// scripts can already call --help, and says plainly that the daemon does not exist yet.
+// parapm-worker: a worker daemon. It serves WorkerService (subset jobs from the coordinator,
+// run with the engine's simplify_subset) and registers with the coordinator, beating at the
+// interval the coordinator asks for. Stops cleanly on SIGINT / SIGTERM.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <thread>
 
-#include "parapm.grpc.pb.h"
+#include <spdlog/spdlog.h>
+
+#include "coordinator_link.h"
+#include "daemon.h"
+#include "rpc_server.h"
+#include "subset_service.h"
+
+namespace {
+
+struct WorkerArgs {
+  std::string coordinator = "127.0.0.1:50051";
+  std::string listen = "127.0.0.1:0";
+  std::string advertise;
+  unsigned threads = 0;
+  double capacity = 1;
+  std::string name;
+  std::string token_file;
+  parapm::rpc::TlsFiles tls;
+  bool coordinator_tls = false;
+  std::string log_level = "info";
+};
+
+int run(const WorkerArgs& args) {
+  using namespace parapm;
+  rpc::set_up_logging("worker", args.log_level);
+  const std::string token = rpc::token_for_listening(args.token_file, args.listen);
+  const unsigned threads = args.threads ? args.threads : std::thread::hardware_concurrency();
+  worker::SubsetService service(rpc::TokenCheck(token), threads);
+  rpc::ServerSetup setup;
+  setup.listen = args.listen;
+  setup.tls = args.tls;
+  rpc::StartedServer server = rpc::start_server(setup, {&service});
+  const std::string address =
+      args.advertise.empty() ? rpc::reachable_address(args.listen, server.port) : args.advertise;
+  spdlog::info("listening on {} ({} subset slots); coordinator {}", address, threads,
+               args.coordinator);
+
+  worker::LinkOptions link;
+  link.coordinator = args.coordinator;
+  link.credentials = rpc::channel_credentials(args.coordinator_tls, args.tls);
+  link.token = token;
+  link.info.set_address(address);
+  link.info.set_threads(threads);
+  link.info.set_capacity(args.capacity);
+  link.info.set_name(args.name.empty() ? address : args.name);
+  {
+    worker::CoordinatorLink coordinator(link, [&] { return service.running(); });
+    const std::string signal = rpc::wait_for_shutdown_signal();
+    spdlog::info("{}: stopping (running subsets are cancelled)", signal);
+  }
+  // Calls in flight see their context cancelled; the engine stops at its next check.
+  server.server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  spdlog::info("stopped");
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
+  parapm::rpc::block_shutdown_signals();
+  WorkerArgs args;
   CLI::App app{
-      "parapm-worker: not implemented yet (the service issue builds it); use 'parapm simplify' "
-      "in-process"};
+      "parapm-worker: simplifies subsets of meshes for a ParaPM coordinator. It listens for the "
+      "coordinator's calls, registers with it and beats; start as many as you have machines "
+      "(or cores)."};
+  app.add_option("--coordinator", args.coordinator, "the coordinator's address host:port")
+      ->capture_default_str();
+  app.add_option("--listen", args.listen,
+                 "where to listen for the coordinator's calls (port 0: any free port)")
+      ->capture_default_str();
+  app.add_option("--advertise", args.advertise,
+                 "the address the coordinator should call (default: the listening address; "
+                 "set it behind NAT or in a container)");
+  app.add_option("--threads", args.threads, "subsets run at once (0: one per hardware thread)")
+      ->capture_default_str();
+  app.add_option("--capacity", args.capacity,
+                 "relative speed of this machine; the coordinator gives faster workers more work")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--name", args.name, "name in the coordinator's events and logs");
+  app.add_option("--token-file", args.token_file,
+                 "bearer token for every call, both ways (else PARAPM_TOKEN; required when "
+                 "listening beyond loopback)");
+  app.add_option("--tls-cert", args.tls.cert_file, "PEM certificate: serve over TLS");
+  app.add_option("--tls-key", args.tls.key_file, "PEM private key of --tls-cert");
+  app.add_flag("--coordinator-tls", args.coordinator_tls, "reach the coordinator over TLS");
+  app.add_option("--tls-ca", args.tls.ca_file,
+                 "PEM roots that sign the coordinator's certificate (default: the system's)");
+  app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  std::fprintf(stderr,
-               "parapm-worker: the gRPC service is not implemented yet; use 'parapm simplify'\n");
-  return 2;
+  try {
+    return run(args);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "parapm-worker: %s\n", e.what());
+    return 2;
+  }
 }

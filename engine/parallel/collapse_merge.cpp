@@ -1,5 +1,6 @@
 #include "parallel/collapse_merge.h"
 
+#include <array>
 #include <queue>
 #include <string>
 #include <utility>
@@ -37,22 +38,63 @@ std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord
   return merged;
 }
 
+namespace {
+
+// The corner wedges a collapse of the present mesh records (Simplifier::perform): fl's
+// corners from vs, fr's from vt; kNoId for a missing face or a mesh without wedges.
+std::array<WedgeId, 6> corner_wedges_of(const CollapseMesh& mesh, const CollapseRecord& r) {
+  std::array<WedgeId, 6> out{kNoId, kNoId, kNoId, kNoId, kNoId, kNoId};
+  if (!mesh.has_wedges()) return out;
+  auto corners = [&](FaceId f, VertexId first, int slot) {
+    if (f == kNoId) return;
+    const int k = corner_of(mesh.face(f), first);
+    const auto& w = mesh.corner_wedges(f);
+    for (int i = 0; i < 3; ++i) out[slot + i] = w[(k + i) % 3];
+  };
+  corners(r.fl, r.vs, 0);
+  corners(r.fr, r.vt, 3);
+  return out;
+}
+
+// Whether w is the wedge of a corner at v (a collapse changes only wedges around vs, which
+// after it holds the corners of vs and vt).
+bool is_corner_wedge_at(const CollapseMesh& mesh, VertexId v, WedgeId w) {
+  for (FaceId f : mesh.faces_of(v))
+    if (mesh.corner_wedges(f)[corner_of(mesh.face(f), v)] == w) return true;
+  return false;
+}
+
+}  // namespace
+
 ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseRecord>& records,
                               PriorityModule* priority) {
   ReplayReport report;
   for (size_t i = 0; i < records.size(); ++i) {
     const CollapseRecord& r = records[i];
     auto fail = [&](const std::string& what) {
-      throw_internal("replay: collapse " + std::to_string(i) + " (" + std::to_string(r.vs) + ", " +
-                     std::to_string(r.vt) + ") " + what);
+      throw_invalid("replay: collapse " + std::to_string(i) + " (" + std::to_string(r.vs) + ", " +
+                    std::to_string(r.vt) + ") " + what);
     };
-    if (r.vs >= mesh.vertex_capacity() || r.vt >= mesh.vertex_capacity() ||
+    // Records may come from a worker over the network: everything the collapse and the PM
+    // builder index is checked against the present mesh before the mesh changes.
+    if (r.vs >= mesh.vertex_capacity() || r.vt >= mesh.vertex_capacity() || r.vs == r.vt ||
         !mesh.vertex_alive(r.vs) || !mesh.vertex_alive(r.vt))
       fail("names a vertex that is not in the mesh");
     const EdgeFaces edge = mesh.edge_faces(r.vs, r.vt);
-    if (edge.left != r.fl || edge.right != r.fr || edge.left_apex != r.vl ||
-        edge.right_apex != r.vr)
+    if ((edge.left == kNoId && edge.right == kNoId) || edge.left != r.fl || edge.right != r.fr ||
+        edge.left_apex != r.vl || edge.right_apex != r.vr)
       fail("does not find the faces its subset saw");
+    // A collapse breaking the link condition would leave a non-manifold mesh.
+    bool link = true;
+    mesh.for_each_common_neighbor(r.vs, r.vt, [&](VertexId common) {
+      if (common != edge.left_apex && common != edge.right_apex) link = false;
+    });
+    if (!link) fail("breaks the link condition");
+    if (r.corner_wedges != corner_wedges_of(mesh, r)) fail("names other corner wedges");
+    for (WedgeId w : r.changed_wedges)
+      if (!mesh.has_wedges() ||
+          !(is_corner_wedge_at(mesh, r.vs, w) || is_corner_wedge_at(mesh, r.vt, w)))
+        fail("changes a wedge not around its vertices");
     mesh.collapse(r.vs, r.vt, r.position, edge);
     if (priority) {
       CollapseCandidate done;

@@ -26,10 +26,11 @@ struct ReplayReport {
 };
 
 // Performs `records` on `mesh` in order, checking that each is an edge of the present mesh
-// with the faces and apexes the record names (else Error(kInternal): the subset rule was
-// broken). When `priority` is given (initialised on `mesh` before the first record), it is
-// told of every collapse, so that its state follows the mesh (the final pass continues
-// with it); the records' own wedge changes and errors are kept.
+// with the faces and apexes the record names (else Error(kInvalidInput): the subset rule was
+// broken, or the records did not come from a job of this mesh). When `priority` is given
+// (initialised on `mesh` before the first record), it is told of every collapse, so that its state
+// follows the mesh (the final pass continues with it); the records' own wedge changes and errors
+// are kept.
 ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseRecord>& records,
                               PriorityModule* priority);
 

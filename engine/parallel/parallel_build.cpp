@@ -166,9 +166,20 @@ class BandPriority : public PriorityModule {
 
 }  // namespace
 
+std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
+                                                const CancelToken* cancel) {
+  std::vector<SubsetResult> results(jobs.size());
+  run_jobs(jobs.size(), threads_, [&](size_t i) {
+    results[i] = simplify_subset(jobs[i], {}, cancel);
+    jobs[i] = SubsetJob{};  // its memory is not needed any more
+  });
+  return results;
+}
+
 ProgressiveMesh build_progressive_mesh_parallel(
     const RepairedMesh& repaired, const SimplifyOptions& options, const ParallelOptions& parallel,
-    ParallelStats* stats, const ProgressCallback& progress, const CancelToken* cancel) {
+    ParallelStats* stats, const ProgressCallback& progress, const CancelToken* cancel,
+    SubsetRunner* runner, const ParallelEvents& events) {
   const auto start = std::chrono::steady_clock::now();
   const double master_cpu_start = thread_cpu_seconds();
   check_simplify_options(options);
@@ -180,6 +191,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
   st.subsets = parallel.subsets;
   st.rounds = parallel.rounds;
   st.threads = pool_threads(parallel.threads, parallel.subsets);
+  ThreadPoolRunner pool(parallel.threads);
+  if (!runner) runner = &pool;
 
   const uint64_t input_faces = mesh.face_count();
   const uint64_t target = target_face_count(input_faces, options);
@@ -227,6 +240,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     std::vector<uint64_t> assigned;
     partition_live(whole, parallel.subsets, partition_options, vertex_subset, assigned);
     rs.partition_seconds = seconds_since(t);
+    if (events.partitioned) events.partitioned(round, parallel.subsets, rs.faces_before);
 
     t = std::chrono::steady_clock::now();
     // The jobs' meshes carry the input's wedge values; the metric's current ones (E_scalar)
@@ -256,13 +270,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
     rs.extract_seconds = seconds_since(t);
 
     t = std::chrono::steady_clock::now();
-    std::vector<SubsetResult> results(jobs.size());
-    run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
-      results[i] = simplify_subset(jobs[i], {}, cancel);
-      jobs[i] = SubsetJob{};  // its memory is not needed any more
-    });
+    std::vector<SubsetResult> results = runner->run(jobs, cancel);
+    jobs.clear();
     rs.subsets_seconds = seconds_since(t);
     if (cancel) cancel->check();
+    if (results.size() != parallel.subsets)
+      throw Error(ErrorCode::kInternal, "the subset runner returned " +
+                                            std::to_string(results.size()) + " results for " +
+                                            std::to_string(parallel.subsets) + " jobs");
 
     t = std::chrono::steady_clock::now();
     std::vector<std::vector<CollapseRecord>> lists;
@@ -321,6 +336,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
         round, parallel.subsets, rs.faces_before, rs.faces_after, rs.goal_faces,
         rs.partition_seconds, rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds,
         rs.merge_seconds, replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
+    if (events.merged) events.merged(rs);
     st.round_stats.push_back(std::move(rs));
     if (progress) progress(input_faces - whole.live_faces(), input_faces - target);
   }
@@ -343,6 +359,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
   st.final_pass_collapses = final_records.size();
   st.final_pass_seconds = seconds_since(t);
   st.stop_reason = final_pass.stats().stop_reason;
+  if (events.final_pass_done)
+    events.final_pass_done(st.final_pass_collapses, st.final_pass_seconds);
   records.insert(records.end(), std::make_move_iterator(final_records.begin()),
                  std::make_move_iterator(final_records.end()));
 

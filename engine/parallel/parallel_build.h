@@ -7,10 +7,13 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "mesh/repair.h"
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_job.h"
 #include "pm/progressive_mesh.h"
 #include "simplify/simplify.h"
 #include "util/progress.h"
@@ -86,16 +89,47 @@ struct ParallelStats {
   double critical_path_seconds = 0;
 };
 
+// Where a round's subset jobs run. The in-process build runs them on a thread pool; the
+// coordinator sends them to worker daemons. Whatever runs them, results[i] must be
+// simplify_subset(jobs[i])'s (exactly: the build stays deterministic only then).
+class SubsetRunner {
+ public:
+  virtual ~SubsetRunner() = default;
+  // May move from `jobs`. Throws Error(kCancelled / kDeadlineExceeded) when `cancel` fires,
+  // another Error when a job cannot be run anywhere.
+  virtual std::vector<SubsetResult> run(std::vector<SubsetJob>& jobs,
+                                        const CancelToken* cancel) = 0;
+};
+
+// Runs the jobs with simplify_subset on a pool of `threads` threads (0: one per subset, up to
+// the hardware's).
+class ThreadPoolRunner : public SubsetRunner {
+ public:
+  explicit ThreadPoolRunner(unsigned threads) : threads_(threads) {}
+  std::vector<SubsetResult> run(std::vector<SubsetJob>& jobs, const CancelToken* cancel) override;
+
+ private:
+  unsigned threads_;
+};
+
+// What a build tells an observer as it goes (for a job's event stream); all optional, called
+// on the building thread.
+struct ParallelEvents {
+  std::function<void(uint32_t round, uint32_t subsets, uint64_t faces)> partitioned;
+  std::function<void(const RoundStats& round)> merged;  // after the merge and band pass
+  std::function<void(uint64_t collapses, double seconds)> final_pass_done;
+};
+
 // Same contract as build_progressive_mesh (simplify.h), whose options it takes; the result is
 // a valid, lossless PM reaching the same target. Deterministic: the same input, options, p
-// and rounds give the same PM whatever the thread count and timing. Throws
+// and rounds give the same PM whatever the thread count, timing and `runner` (null: a
+// ThreadPoolRunner of parallel.threads). Throws
 // Error(kInvalidInput) for bad options (p outside [1, 256] or above the vertex count, rounds
 // outside [1, 64], handover_ratio outside (0, 1]).
-ProgressiveMesh build_progressive_mesh_parallel(const RepairedMesh& repaired,
-                                                const SimplifyOptions& options,
-                                                const ParallelOptions& parallel,
-                                                ParallelStats* stats = nullptr,
-                                                const ProgressCallback& progress = {},
-                                                const CancelToken* cancel = nullptr);
+ProgressiveMesh build_progressive_mesh_parallel(
+    const RepairedMesh& repaired, const SimplifyOptions& options, const ParallelOptions& parallel,
+    ParallelStats* stats = nullptr, const ProgressCallback& progress = {},
+    const CancelToken* cancel = nullptr, SubsetRunner* runner = nullptr,
+    const ParallelEvents& events = {});
 
 }  // namespace parapm

@@ -86,6 +86,11 @@ class PmReader {
   // Reads split splits_read(); false once the header's count has been read.
   bool next_split(PmSplitRecord& record);
   size_t splits_read() const { return splits_read_; }
+  // Bytes consumed so far: after read_base(), where the splits begin; after next_split(),
+  // where the next one begins (a server cuts a stream of records at these offsets).
+  uint64_t offset() const;
+  // True when the stream has no more bytes (a partial stream cut after a split ends here).
+  bool at_end();
   // After the last split: copies, orders, the final checksum and the end of the data.
   PmTail read_tail();
   // Positions at level splits_read().
@@ -114,6 +119,9 @@ void write_pm_file(const ProgressiveMesh& pm, const std::string& path);
 size_t pm_encoded_size(const ProgressiveMesh& pm);
 
 ProgressiveMesh read_pm(std::istream& in, const std::string& name = "pm stream");
+// Appends a split read by PmReader to `pm` (whose base came from the same reader): a client of
+// a vsplit stream holds a PM of the levels it has so far (level_of_detail works up to them).
+void append_split(ProgressiveMesh& pm, const PmSplitRecord& record);
 ProgressiveMesh read_pm_file(const std::string& path);
 
 // Bounding box of every position at every level: the base positions, vs_after and vt_after of

@@ -38,6 +38,10 @@ PmReader::PmReader(std::istream& in, std::string name, Input input)
 
 PmReader::~PmReader() = default;
 
+uint64_t PmReader::offset() const { return in_->offset(); }
+
+bool PmReader::at_end() { return in_->at_end(); }
+
 std::optional<uint64_t> PmReader::stream_size() const { return in_->total_size(); }
 
 void PmReader::read_header() {
@@ -342,6 +346,21 @@ PmTail PmReader::read_tail() {
   return tail;
 }
 
+void append_split(ProgressiveMesh& pm, const PmSplitRecord& record) {
+  VertexSplit s = record.split;
+  s.wedge_changes_begin = uint32_t(pm.wedge_changes.size());
+  const uint32_t values_base = uint32_t(pm.wedge_change_values.size());
+  for (WedgeChange change : record.wedge_changes) {
+    change.values_offset += values_base;
+    pm.wedge_changes.push_back(change);
+  }
+  pm.wedge_change_values.insert(pm.wedge_change_values.end(), record.wedge_change_values.begin(),
+                                record.wedge_change_values.end());
+  pm.new_wedge_values.insert(pm.new_wedge_values.end(), record.new_wedge_values.begin(),
+                             record.new_wedge_values.end());
+  pm.splits.push_back(s);
+}
+
 ProgressiveMesh read_pm(std::istream& stream, const std::string& name) {
   PmReader reader(stream, name);
   const PmHeader& h = reader.header();
@@ -356,20 +375,7 @@ ProgressiveMesh read_pm(std::istream& stream, const std::string& name) {
   pm.splits.reserve(total ? size_t(std::min<uint64_t>(h.splits, *total / fmt::kMinSplitBytes))
                           : size_t(std::min<uint64_t>(h.splits, 4096)));
   PmSplitRecord record;
-  while (reader.next_split(record)) {
-    VertexSplit s = record.split;
-    s.wedge_changes_begin = uint32_t(pm.wedge_changes.size());
-    const uint32_t values_base = uint32_t(pm.wedge_change_values.size());
-    for (WedgeChange change : record.wedge_changes) {
-      change.values_offset += values_base;
-      pm.wedge_changes.push_back(change);
-    }
-    pm.wedge_change_values.insert(pm.wedge_change_values.end(), record.wedge_change_values.begin(),
-                                  record.wedge_change_values.end());
-    pm.new_wedge_values.insert(pm.new_wedge_values.end(), record.new_wedge_values.begin(),
-                               record.new_wedge_values.end());
-    pm.splits.push_back(s);
-  }
+  while (reader.next_split(record)) append_split(pm, record);
   PmTail tail = reader.read_tail();
   pm.vertex_copies = std::move(tail.vertex_copies);
   pm.input_vertex_order = std::move(tail.input_vertex_order);

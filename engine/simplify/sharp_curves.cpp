@@ -272,11 +272,16 @@ void SharpCurves::import_global(const EnergyState& state) {
     throw_invalid("energy state: curve lists disagree with the vertices");
   for (const EnergyState::CurveSample& s : state.samples) {
     if (s.id >= samples_.size()) throw_invalid("energy state: curve sample id out of range");
+    if (s.u >= neighbors_.size() || (s.w != kNoId && s.w >= neighbors_.size()))
+      throw_invalid("energy state: curve sample on a vertex out of range");
     samples_[s.id] = {s.position, s.distance_sq, s.u, s.w};
   }
   for (size_t i = 0; i < n; ++i) {
     const VertexId v = state.vertices[i];
     if (v >= neighbors_.size()) throw_invalid("energy state: vertex out of range");
+    for (uint32_t k = state.sharp_begin[i]; k < state.sharp_begin[i + 1]; ++k)
+      if (state.sharp_neighbors.at(k) >= neighbors_.size())
+        throw_invalid("energy state: sharp neighbour out of range");
     neighbors_[v].assign(state.sharp_neighbors.begin() + state.sharp_begin[i],
                          state.sharp_neighbors.begin() + state.sharp_begin[i + 1]);
     listed_at_[v].clear();

@@ -91,6 +91,8 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   heap_.reserve(mesh_.face_capacity() * 3);
   for (FaceId f = 0; f < mesh_.face_capacity(); ++f) {
     if (!mesh_.face_alive(f)) continue;
+    // The first costing of every edge takes a while with the energy: stay cancellable.
+    if (cancel && (f & 1023) == 0) cancel->check();
     const Triangle& t = mesh_.face(f);
     for (int k = 0; k < 3; ++k) {
       const VertexId a = t[k], b = t[(k + 1) % 3];
@@ -164,8 +166,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     }
 
     if ((records.size() & 1023) == 0) {
-      if (cancel) cancel->check();
+      // Progress first: a caller may cancel from its callback (a worker polling its call).
       if (progress) progress(start_faces - mesh_.live_faces(), total);
+      if (cancel) cancel->check();
     }
   }
   stats_.collapses = records.size();

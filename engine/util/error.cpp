@@ -16,6 +16,8 @@ const char* error_code_name(ErrorCode code) {
       return "not found";
     case ErrorCode::kIo:
       return "i/o error";
+    case ErrorCode::kFailedPrecondition:
+      return "failed precondition";
     case ErrorCode::kInternal:
       return "internal error";
   }

@@ -10,13 +10,14 @@
 namespace parapm {
 
 enum class ErrorCode {
-  kInvalidInput,       // the data is malformed or violates a documented rule
-  kResourceExhausted,  // a size limit was hit (declared counts, upload size, memory budget)
-  kCancelled,          // the caller's cancellation token fired
-  kDeadlineExceeded,   // the caller's deadline passed
-  kNotFound,           // a file or object that was named does not exist
-  kIo,                 // the operating system failed to read or write
-  kInternal,           // a bug: an invariant of the engine does not hold
+  kInvalidInput,        // the data is malformed or violates a documented rule
+  kResourceExhausted,   // a size limit was hit (declared counts, upload size, memory budget)
+  kCancelled,           // the caller's cancellation token fired
+  kDeadlineExceeded,    // the caller's deadline passed
+  kNotFound,            // a file or object that was named does not exist
+  kIo,                  // the operating system failed to read or write
+  kFailedPrecondition,  // the object is not in the state the call needs (a job not done yet)
+  kInternal,            // a bug: an invariant of the engine does not hold
 };
 
 const char* error_code_name(ErrorCode code);

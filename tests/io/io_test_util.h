@@ -16,6 +16,7 @@
 
 #include "io/mesh_io.h"
 #include "util/error.h"
+#include "test_support.h"
 
 namespace parapm::testing {
 
@@ -24,25 +25,6 @@ inline Mesh read_text(const std::string& bytes, const std::string& name,
   return read_mesh_from_memory(bytes, name, report, limits);
 }
 
-// Runs `f`, which must throw parapm::Error with `code` and a message containing every one of
-// `parts`. Returns the message.
-template <class F>
-std::string expect_error(F&& f, ErrorCode code, std::initializer_list<std::string> parts) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(error_code_name(e.code()), std::string(error_code_name(code))) << e.what();
-    for (const std::string& part : parts)
-      EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
-          << "message: " << e.what() << "\nexpected to contain: " << part;
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "threw a non-parapm exception: " << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "did not throw";
-  return "";
-}
 
 // Builds binary data in either byte order.
 class Bytes {

@@ -2,11 +2,17 @@
 // every mesh of ../shared/meshes when that folder is present (it is in CI).
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
+#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "util/error.h"
 
 namespace parapm::testing {
 
@@ -32,6 +38,26 @@ inline std::vector<std::filesystem::path> shared_meshes() {
   }
   std::sort(files.begin(), files.end());
   return files;
+}
+
+// Runs f, expects an Error with `code` whose message contains every one of `parts`.
+// Returns the message.
+template <class F>
+std::string expect_error(F&& f, ErrorCode code, std::initializer_list<std::string> parts) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(error_code_name(e.code()), std::string(error_code_name(code))) << e.what();
+    for (const std::string& part : parts)
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
+          << "message: " << e.what() << "\nexpected to contain: " << part;
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "threw a non-parapm exception: " << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "did not throw";
+  return "";
 }
 
 }  // namespace parapm::testing

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# bench/service.sh MESH... : the service end to end against the in-process parallel build.
+#
+# Starts `parapm up` (a coordinator and WORKERS workers, default 2, of WORKER_THREADS threads,
+# default 1, on loopback, fresh data folder), then for every MESH: `parapm submit MESH
+# --parallel P --metric METRIC -o X.pm --json` (upload, job, download) and `parapm simplify
+# MESH --parallel P --metric METRIC -o Y.pm` (read, build, write, in-process on min(P, cores)
+# threads), and prints one TSV row: mesh, p, in-process wall s, service wall s (client: upload
+# to end of download), its parts (upload, wait, download), the transport inside the job
+# (coordinator reading the upload, encoding jobs, subset calls' time beyond the workers' own
+# summed over calls, storing the PM), transport / service wall, and whether both .pm files are
+# byte-identical (they must be).
+# Environment: P (default 2), METRIC (default energy), WORKERS, WORKER_THREADS, PORT (default
+# 50151), BENCH_OUT (default ./bench-out-service), PARAPM_BUILD_DIR (default build/).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+[[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
+p="${P:-2}"
+metric="${METRIC:-energy}"
+workers="${WORKERS:-2}"
+port="${PORT:-50151}"
+out="${BENCH_OUT:-$PWD/bench-out-service}"
+bin="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
+[[ -x "$bin" ]] || { echo "no $bin (build parapm, parapm-coordinator, parapm-worker)" >&2; exit 2; }
+command -v jq > /dev/null || { echo "bench/service.sh needs jq" >&2; exit 2; }
+rm -rf "$out/data"
+mkdir -p "$out"
+"$bin" up --workers "$workers" --worker-threads "${WORKER_THREADS:-1}" --data "$out/data" \
+  --listen "127.0.0.1:$port" --log-level warn 2> "$out/up.log" &
+up_pid=$!
+trap 'kill -INT $up_pid 2> /dev/null; wait $up_pid 2> /dev/null || true' EXIT
+for _ in $(seq 100); do [[ -s "$out/data/coordinator.port" ]] && break; sleep 0.1; done
+sleep 1  # the workers register
+server=(--server "127.0.0.1:$port")
+printf "mesh\tp\tinprocess_s\tservice_s\tupload_s\twait_s\tdownload_s\tread_s\tencode_s\tcall_overhead_s\tstore_s\tjob_MB\tresult_MB\ttransport_share\tidentical\n"
+for mesh in "$@"; do
+  name="$(basename "$mesh")"; name="${name%%.*}"
+  svc="$("$bin" --log-level warn submit "$mesh" --parallel "$p" --metric "$metric" \
+    -o "$out/$name-service.pm" --json "${server[@]}")"
+  job="$(jq -r .job_id <<< "$svc")"
+  fin="$("$bin" watch "$job" --json "${server[@]}" | jq -c 'select(.finished) | .finished')"
+  t0=$(date +%s.%N)
+  "$bin" --log-level warn simplify "$mesh" --parallel "$p" --metric "$metric" \
+    -o "$out/$name-local.pm" > /dev/null
+  t1=$(date +%s.%N)
+  same=no; cmp -s "$out/$name-service.pm" "$out/$name-local.pm" && same=yes
+  jq -r --argjson fin "$fin" --arg mesh "$name" --arg p "$p" --arg local "$(echo "$t1 - $t0" | bc)" \
+    --arg same "$same" '
+    ($fin.transport // {}) as $t
+    | [($t.read_seconds // 0), ($t.encode_seconds // 0), ($t.call_overhead_seconds // 0),
+       ($t.store_seconds // 0)] as $parts
+    | (.client.upload_seconds + .client.download_seconds + ($parts | add)) as $moved
+    | [$mesh, $p, ($local | tonumber | . * 1000 | round / 1000),
+       (.client.total_seconds * 1000 | round / 1000),
+       (.client.upload_seconds * 1000 | round / 1000), (.client.wait_seconds * 1000 | round / 1000),
+       (.client.download_seconds * 1000 | round / 1000),
+       ($parts[] | . * 1000 | round / 1000),
+       ((($t.job_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
+       ((($t.result_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
+       ($moved / .client.total_seconds * 1000 | round / 1000), $same] | @tsv' <<< "$svc"
+done

@@ -1,0 +1,158 @@
+// parapm submit IN [options] [--wait] [-o OUT.pm]: uploads a mesh to the coordinator and
+// submits a job; with --wait (implied by -o) follows it with a progress bar to its end and
+// downloads the PM.
+#include <spdlog/spdlog.h>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "service_client.h"
+#include "service_json.h"
+
+namespace parapm::cli {
+namespace {
+
+struct SubmitArgs {
+  ConnectionArgs connection;
+  std::string input;
+  std::string output;
+  uint64_t faces = 0;
+  double ratio = 0;
+  std::string metric = "quadric";
+  uint32_t parallel = 0;
+  uint32_t rounds = 0;
+  uint64_t seed = 1;
+  double samples_per_face = 0;
+  double crease_angle = 60;
+  double attribute_weight = 0.01;
+  double handover = 0;
+  bool keep_order = false;
+  bool wait = false;
+  bool json = false;
+};
+
+int run_submit(SubmitArgs& args) {
+  ServiceClient client(args.connection);
+  const auto start = std::chrono::steady_clock::now();
+  parapm::v1::UploadReply uploaded;
+  {
+    ProgressBar bar("upload");
+    uploaded = client.upload(args.input, bar.callback());
+  }
+  const double upload_seconds = seconds_since(start);
+  spdlog::info("uploaded {}: mesh {} ({} vertices, {} faces{}{})", args.input, uploaded.mesh_id(),
+               uploaded.vertices(), uploaded.faces(),
+               uploaded.repairs().empty() ? "" : "; repaired: ", uploaded.repairs());
+
+  parapm::v1::SubmitRequest request;
+  request.set_mesh_id(uploaded.mesh_id());
+  parapm::v1::JobOptions& o = *request.mutable_options();
+  if (args.faces) o.set_target_faces(args.faces);
+  if (args.ratio > 0) o.set_target_ratio(args.ratio);
+  o.set_metric(args.metric == "energy" ? parapm::v1::METRIC_ENERGY : parapm::v1::METRIC_QUADRIC);
+  o.set_parallelism(args.parallel);
+  o.set_rounds(args.rounds);
+  o.set_seed(args.seed);
+  o.set_samples_per_face(args.samples_per_face);
+  o.set_crease_angle_degrees(args.crease_angle);
+  o.set_attribute_weight(args.attribute_weight > 0 ? args.attribute_weight : -1);
+  o.set_handover_ratio(args.handover);
+  o.set_keep_order(args.keep_order);
+  parapm::v1::Job job;
+  {
+    auto context = client.context();
+    check_status(client.stub().Submit(context.get(), request, &job), "submit", client.server());
+  }
+  spdlog::info("job {} submitted", job.job_id());
+  if (!args.wait && args.output.empty()) {
+    if (args.json)
+      print_json(job_json(job));
+    else
+      std::printf("%s\n", job.job_id().c_str());
+    return 0;
+  }
+  const auto wait_start = std::chrono::steady_clock::now();
+  {
+    ProgressBar bar("job " + job.job_id());
+    ProgressCallback draw = bar.callback();
+    job = client.watch(job.job_id(), [&](const parapm::v1::JobEvent& event) {
+      if (event.has_progress()) {
+        if (draw) draw(event.progress().done(), event.progress().total());
+      } else {
+        spdlog::debug("job {}: {}", job.job_id(), describe_event(event));
+      }
+    });
+  }
+  if (job.state() != parapm::v1::DONE) {
+    std::fprintf(stderr, "parapm: job %s %s%s%s\n", job.job_id().c_str(),
+                 job_state_name(job.state()), job.failure_reason().empty() ? "" : ": ",
+                 job.failure_reason().c_str());
+    if (args.json) print_json(job_json(job));
+    return 1;
+  }
+  const double wait_seconds = seconds_since(wait_start);
+  const auto download_start = std::chrono::steady_clock::now();
+  uint64_t bytes = 0;
+  if (!args.output.empty()) bytes = client.download(job.job_id(), args.output);
+  if (args.json) {
+    nlohmann::json out = job_json(job);
+    // The client's view of the time: upload, waiting for the job, download.
+    out["client"] = {{"upload_seconds", upload_seconds},
+                     {"wait_seconds", wait_seconds},
+                     {"download_seconds", seconds_since(download_start)},
+                     {"total_seconds", seconds_since(start)}};
+    if (!args.output.empty()) out["output"] = {{"path", args.output}, {"bytes", bytes}};
+    print_json(out);
+  } else {
+    std::printf("job %s done: %llu -> %llu faces, %llu vsplits in %.3f s%s%s\n",
+                job.job_id().c_str(), (unsigned long long)job.input_faces(),
+                (unsigned long long)job.base_faces(), (unsigned long long)job.vsplits(),
+                job.seconds(), args.output.empty() ? "" : "; wrote ", args.output.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_submit_command(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<SubmitArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "submit",
+      "upload a mesh to the coordinator and build its Progressive Mesh there; --wait follows "
+      "the job, -o downloads the .pm (same bytes as 'parapm simplify --parallel P')");
+  cmd->add_option("input", args->input, "mesh file (OBJ, PLY, OFF, STL; optionally .gz)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "write the .pm here when done (implies --wait)");
+  auto* faces = cmd->add_option("--faces", args->faces, "target base mesh faces");
+  cmd->add_option("--ratio", args->ratio, "target base mesh faces as a ratio of the input")
+      ->check(CLI::Range(0.0, 1.0))
+      ->excludes(faces);
+  cmd->add_option("--metric", args->metric, "quadric or energy")
+      ->check(CLI::IsMember({"quadric", "energy"}))
+      ->capture_default_str();
+  cmd->add_option("--parallel", args->parallel,
+                  "subsets p (default: the coordinator's --parallelism)")
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--rounds", args->rounds, "parallel rounds (default 3)")
+      ->check(CLI::Range(1, 64));
+  cmd->add_option("--handover-ratio", args->handover,
+                  "the rounds go down to this fraction of the input faces (default 0.1)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--seed", args->seed, "seed of the randomised steps")->capture_default_str();
+  cmd->add_option("--samples-per-face", args->samples_per_face, "energy: extra sample points")
+      ->check(CLI::Range(0.0, 64.0));
+  cmd->add_option("--crease-angle", args->crease_angle, "energy: crease angle, degrees")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  cmd->add_option("--attribute-weight", args->attribute_weight,
+                  "energy: weight of attributes against geometry (0: not optimised)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--keep-order", args->keep_order, "store the input's vertex and face order");
+  cmd->add_flag("--wait", args->wait, "follow the job to its end with a progress bar");
+  cmd->add_flag("--json", args->json, "print the job as one JSON object");
+  add_connection_options(cmd, args->connection);
+  cmd->callback([args, &exit_code] { exit_code = run_submit(*args); });
+}
+
+}  // namespace parapm::cli

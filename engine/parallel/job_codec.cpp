@@ -1,0 +1,789 @@
+// The binary codec of the parallel build's messages; job_codec.h documents the layout.
+//
+// What the decoded state must look like, and why (the imports index arrays with its ids):
+//  - QuadricPriority::import_local/global: vertices in range (ids+ below the bound).
+//  - EnergyPriority::import_local: point faces and parked vertices in range. import_global
+//    (the master, from a summary) checks the state's face and vertex lists, and relinks each
+//    point under its face: a point must name a listed face or vertex (guaranteed here by
+//    writing points under them), and point ids must be distinct (a repeated id links a point
+//    to itself: an endless list).
+//  - SharpCurves::import_local indexes per vertex with the state's vertices, its begin
+//    arrays and listed indices (built here from counts, indices below the sample count); a
+//    vertex listed as its own sharp neighbour makes SharpCurves::collapsed() modify the list
+//    it iterates.
+//  - ScalarAttributes::import_local sizes its wedges from the state's values: a job whose
+//    module runs E_scalar needs the state of exactly its W wedges (0..W-1) with its layout's
+//    floats, else the simplifier reads wedges past the end.
+#include "parallel/job_codec.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <istream>
+#include <sstream>
+#include <streambuf>
+
+#include "pm/byte_io.h"
+#include "simplify/scalar_attributes.h"
+#include "util/error.h"
+
+namespace parapm {
+namespace {
+
+constexpr uint8_t kVersion = 1;
+constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
+constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
+constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
+constexpr size_t kMaxStopReason = 4096;
+
+// Mesh flags (job header).
+constexpr uint8_t kPositionsAreFloat = 1, kNormals = 2, kTexcoords = 4, kColors = 8,
+                  kCornerWedges = 16, kPositionsAsF32 = 32;
+// Per-vertex flags.
+constexpr uint8_t kOwned = 1, kLocked = 2;
+// Record flags.
+constexpr uint8_t kRecordPositionsAsF32 = 1;
+// Energy state flags.
+constexpr uint8_t kResiduals = 1;
+
+// The fewest bytes an element can take, for ByteReader::check_fits: a count that cannot fit
+// in what remains is refused before anything is reserved.
+constexpr uint64_t kMinVertexBytes = 12 + 1 + 1;  // f32 position, flags, global id
+constexpr uint64_t kMinFaceBytes = 3 + 1;         // corners, global id
+constexpr uint64_t kMinWedgeBytes = 1 + 1;        // its vertex, global id
+// A record: flags, vs vt, vl fl vr fr, 9 f32, 6 corner wedges, cost, error, change count.
+constexpr uint64_t kMinRecordBytes = 1 + 2 + 4 + 36 + 6 + 8 + 4 + 1;
+constexpr uint64_t kMinSampleBytes = 1 + 24 + 8 + 1 + 1;  // id, position, distance, u, w
+constexpr uint64_t kQuadricBytes = 11 * 8;
+
+// ---- Reading from a view ----------------------------------------------------------------
+
+// A read-only stream over bytes the caller owns: nothing is copied, and it is seekable, so
+// that ByteReader knows the size and check_fits can refuse counts before allocating.
+class ViewBuffer : public std::streambuf {
+ public:
+  explicit ViewBuffer(std::string_view bytes) {
+    // The get area is declared char*, but a streambuf only reads through it.
+    char* begin = const_cast<char*>(bytes.data());
+    setg(begin, begin, begin + bytes.size());
+  }
+
+ protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir,
+                   std::ios_base::openmode which) override {
+    if (which & std::ios_base::out) return pos_type(off_type(-1));
+    const off_type size = egptr() - eback();
+    const off_type base = dir == std::ios_base::beg   ? 0
+                          : dir == std::ios_base::cur ? gptr() - eback()
+                                                      : size;
+    const off_type target = base + off;
+    if (target < 0 || target > size) return pos_type(off_type(-1));
+    setg(eback(), eback() + target, egptr());
+    return pos_type(target);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+};
+
+struct ViewReader {
+  ViewReader(std::string_view bytes, const char* name)
+      : buffer(bytes), stream(&buffer), in(stream, name) {}
+  ViewBuffer buffer;
+  std::istream stream;
+  ByteReader in;
+};
+
+void read_magic(ByteReader& in, const char (&magic)[4], const char* kind) {
+  in.set_context("header");
+  char got[4];
+  in.bytes(got, 4);
+  if (std::memcmp(got, magic, 4) != 0) in.fail_at(0, std::string("not a ") + kind + " message");
+  const uint8_t version = in.u8();
+  if (version != kVersion)
+    in.fail_at(4, "version " + std::to_string(version) + ", expected " + std::to_string(kVersion));
+}
+
+void expect_end(ByteReader& in) {
+  in.set_context("end");
+  if (!in.at_end()) in.fail("trailing bytes after the message");
+}
+
+// A count, refused unless `limit` allows it and `min_bytes` per element can still follow.
+uint64_t read_count(ByteReader& in, uint64_t min_bytes, const char* what,
+                    uint64_t limit = kNoId - 1) {
+  const uint64_t start = in.offset();
+  const uint64_t n = in.varint64();
+  in.check_fits(n, min_bytes, what);
+  if (n > limit) in.fail_at(start, std::string("too many ") + what + ": " + std::to_string(n));
+  return n;
+}
+
+// n strictly increasing ids below `bound` (<= kNoId, so never kNoId), as first id then gaps.
+void read_increasing(ByteReader& in, uint64_t n, uint64_t bound, std::vector<uint32_t>& ids) {
+  ids.clear();
+  ids.reserve(n);
+  uint64_t next = 0;  // the least id the next one may take
+  for (uint64_t i = 0; i < n; ++i) {
+    const uint64_t start = in.offset();
+    const uint64_t gap = in.varint64();
+    if (next >= bound || gap >= bound - next)
+      in.fail_at(start,
+                 "id " + std::to_string(i) + " out of range (" + std::to_string(bound) + ")");
+    ids.push_back(uint32_t(next + gap));
+    next = next + gap + 1;
+  }
+}
+
+// An id below `bound`, or kNoId (written as id + 1, so that kNoId is 0).
+uint32_t read_id_or_none(ByteReader& in, uint64_t bound, const char* what) {
+  const uint64_t start = in.offset();
+  const uint32_t id = in.varint32() - 1u;
+  if (id != kNoId && id >= bound) in.fail_at(start, std::string(what) + " out of range");
+  return id;
+}
+
+uint32_t read_id(ByteReader& in, uint64_t bound, const char* what) {
+  const uint64_t start = in.offset();
+  const uint32_t id = in.varint32();
+  if (id >= bound)
+    in.fail_at(start, std::string(what) + " " + std::to_string(id) + " out of range");
+  return id;
+}
+
+Vec3 read_position(ByteReader& in, bool as_f32) {
+  const uint64_t start = in.offset();
+  Vec3 p;
+  for (double& c : p) c = as_f32 ? double(in.f32()) : in.f64();
+  for (double c : p)
+    if (!std::isfinite(c)) in.fail_at(start, "position is not finite");
+  return p;
+}
+
+double read_not_nan(ByteReader& in, const char* what) {
+  const double x = in.f64();
+  if (std::isnan(x)) in.fail(std::string(what) + " is NaN");
+  return x;
+}
+
+std::string read_metric(ByteReader& in) {
+  const uint64_t start = in.offset();
+  switch (in.u8()) {
+    case 0:
+      return "";
+    case 1:
+      return "quadric";
+    case 2:
+      return "energy";
+    default:
+      in.fail_at(start, "unknown metric");
+  }
+}
+
+// ---- Writing ----------------------------------------------------------------------------
+
+[[noreturn]] void cannot_encode(const std::string& what) {
+  throw_invalid("cannot encode: " + what);
+}
+
+std::string finish(ByteWriter& out, std::ostringstream& stream) {
+  out.flush();
+  return std::move(stream).str();
+}
+
+void write_increasing(ByteWriter& out, const std::vector<uint32_t>& ids, const char* what) {
+  uint64_t next = 0;
+  for (uint32_t id : ids) {
+    if (id < next || id == kNoId) cannot_encode(std::string(what) + " ids are not increasing");
+    out.varint(id - next);
+    next = uint64_t(id) + 1;
+  }
+}
+
+bool is_float(const Vec3& p) {
+  for (double c : p)
+    if (std::bit_cast<uint64_t>(round_to_float(c)) != std::bit_cast<uint64_t>(c)) return false;
+  return true;
+}
+
+void write_position(ByteWriter& out, const Vec3& p, bool as_f32) {
+  for (double c : p) as_f32 ? out.f32(float(c)) : out.f64(c);
+}
+
+uint8_t metric_code(const std::string& metric) {
+  if (metric.empty()) return 0;
+  if (metric == "quadric") return 1;
+  if (metric == "energy") return 2;
+  cannot_encode("unknown metric '" + metric + "'");
+}
+
+// ---- Metric state ------------------------------------------------------------------------
+
+// What a state's ids may reach: the job's local mesh, or (a summary, global ids) anything.
+struct StateBounds {
+  uint64_t vertices = kNoId;
+  uint64_t faces = kNoId;
+  uint64_t wedges = kNoId;
+};
+
+bool is_empty(const QuadricState& s) { return s.vertices.empty() && s.quadrics.empty(); }
+
+bool is_empty(const EnergyState& s) {
+  return s.faces.empty() && s.vertices.empty() && s.points.empty() && s.point_values.empty() &&
+         s.sharp_begin.empty() && s.sharp_neighbors.empty() && s.listed_begin.empty() &&
+         s.listed.empty() && s.samples.empty() && s.curve_samples_total == 0 && s.wedges.empty() &&
+         s.wedge_values.empty() && s.wedge_class.empty();
+}
+
+void write_quadric(ByteWriter& out, const QuadricState& s) {
+  if (s.vertices.size() != s.quadrics.size()) cannot_encode("quadric state sizes disagree");
+  out.varint(s.vertices.size());
+  write_increasing(out, s.vertices, "quadric state vertex");
+  for (const Quadric& q : s.quadrics)
+    for (double x : {q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.b0, q.b1, q.b2, q.c, q.weight})
+      out.f64(x);
+}
+
+void read_quadric(ByteReader& in, const StateBounds& bounds, QuadricState& s) {
+  in.set_context("quadric state");
+  const uint64_t n = read_count(in, 1 + kQuadricBytes, "quadric vertices");
+  read_increasing(in, n, bounds.vertices, s.vertices);
+  s.quadrics.resize(n);
+  for (Quadric& q : s.quadrics)
+    for (double* x :
+         {&q.a00, &q.a01, &q.a02, &q.a11, &q.a12, &q.a22, &q.b0, &q.b1, &q.b2, &q.c, &q.weight})
+      *x = in.f64();
+}
+
+// The floats per point and per wedge of an energy state (one number: both are the module's
+// floats per wedge), or refuses a state that has two.
+int energy_floats(const EnergyState& s) {
+  size_t k = 0;
+  if (!s.points.empty()) {
+    k = s.point_values.size() / s.points.size();
+  } else if (!s.wedges.empty()) {
+    k = s.wedge_values.size() / s.wedges.size();
+  }
+  if (k > size_t(ScalarAttributes::kMaxFloats) || s.point_values.size() != s.points.size() * k ||
+      s.wedge_values.size() != s.wedges.size() * k || s.wedge_class.size() != s.wedges.size())
+    cannot_encode("energy state attribute sizes disagree");
+  return int(k);
+}
+
+void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool residuals) {
+  const EnergyState::Point& p = s.points[i];
+  out.varint(p.id);
+  write_position(out, p.position, false);
+  out.f64(p.distance_sq);
+  if (residuals) out.f64(p.residual);
+  for (int j = 0; j < k; ++j) out.f32(s.point_values[i * size_t(k) + size_t(j)]);
+}
+
+// Each vertex's span of a begin array (size vertices + 1, from 0 to the list's end).
+void check_spans(const std::vector<uint32_t>& begin, size_t vertices, size_t list,
+                 const char* what) {
+  if (begin.size() != vertices + 1 || begin.front() != 0 || begin.back() != list)
+    cannot_encode(std::string("energy state ") + what + " spans disagree");
+  for (size_t i = 0; i < vertices; ++i)
+    if (begin[i] > begin[i + 1]) cannot_encode(std::string("energy state ") + what + " spans");
+}
+
+void write_energy(ByteWriter& out, const EnergyState& s) {
+  const int k = energy_floats(s);
+  bool residuals = false;
+  for (const EnergyState::Point& p : s.points)
+    residuals |= std::bit_cast<uint64_t>(p.residual) != 0;
+  out.varint(s.faces.size());
+  write_increasing(out, s.faces, "energy state face");
+  out.varint(s.vertices.size());
+  write_increasing(out, s.vertices, "energy state vertex");
+  out.u8(uint8_t(k));
+  out.u8(residuals ? kResiduals : 0);
+  // Points in export order: each face's, then each vertex's parked one.
+  size_t next = 0;
+  for (FaceId f : s.faces) {
+    size_t end = next;
+    while (end < s.points.size() && s.points[end].face == f && s.points[end].vertex == kNoId) ++end;
+    out.varint(end - next);
+    for (; next < end; ++next) write_point(out, s, next, k, residuals);
+  }
+  const size_t face_points = next;
+  for (VertexId v : s.vertices)
+    if (next < s.points.size() && s.points[next].face == kNoId && s.points[next].vertex == v)
+      ++next;
+  if (next != s.points.size()) cannot_encode("energy state points are not in export order");
+
+  out.varint(s.samples.size());
+  for (const EnergyState::CurveSample& c : s.samples) {
+    if (c.u == kNoId) cannot_encode("energy state curve sample on no vertex");
+    out.varint(c.id);
+    write_position(out, c.position, false);
+    out.f64(c.distance_sq);
+    out.varint(c.u);
+    out.varint(uint32_t(c.w + 1u));
+  }
+  check_spans(s.sharp_begin, s.vertices.size(), s.sharp_neighbors.size(), "sharp");
+  check_spans(s.listed_begin, s.vertices.size(), s.listed.size(), "listed");
+  next = face_points;
+  for (size_t i = 0; i < s.vertices.size(); ++i) {
+    const bool parked = next < s.points.size() && s.points[next].vertex == s.vertices[i];
+    out.u8(parked ? 1 : 0);
+    if (parked) write_point(out, s, next++, k, residuals);
+    out.varint(s.sharp_begin[i + 1] - s.sharp_begin[i]);
+    for (uint32_t j = s.sharp_begin[i]; j < s.sharp_begin[i + 1]; ++j)
+      out.varint(s.sharp_neighbors[j]);
+    out.varint(s.listed_begin[i + 1] - s.listed_begin[i]);
+    for (uint32_t j = s.listed_begin[i]; j < s.listed_begin[i + 1]; ++j) out.varint(s.listed[j]);
+  }
+  out.varint(s.curve_samples_total);
+
+  out.varint(s.wedges.size());
+  write_increasing(out, s.wedges, "energy state wedge");
+  for (float x : s.wedge_values) out.f32(x);
+  for (size_t i = 0; i < s.wedges.size(); ++i) {
+    // The class's wedge is the first of the class in the list (ScalarAttributes).
+    const auto first = s.wedges.begin();
+    const auto it = std::lower_bound(first, first + ptrdiff_t(i) + 1, s.wedge_class[i]);
+    if (it == first + ptrdiff_t(i) + 1 || *it != s.wedge_class[i])
+      cannot_encode("energy state wedge class not among the earlier wedges");
+    out.varint(uint64_t(i - size_t(it - first)));
+  }
+}
+
+void read_point(ByteReader& in, int k, bool residuals, FaceId face, VertexId vertex,
+                EnergyState& s) {
+  EnergyState::Point p;
+  p.id = in.varint32();
+  p.face = face;
+  p.vertex = vertex;
+  p.position = read_position(in, false);
+  p.distance_sq = in.f64();
+  p.residual = residuals ? in.f64() : 0.0;
+  for (int j = 0; j < k; ++j) s.point_values.push_back(in.f32());
+  s.points.push_back(p);
+}
+
+void read_energy(ByteReader& in, const StateBounds& bounds, EnergyState& s) {
+  in.set_context("energy state");
+  read_increasing(in, read_count(in, 2, "energy faces"), bounds.faces, s.faces);
+  read_increasing(in, read_count(in, 4, "energy vertices"), bounds.vertices, s.vertices);
+  const int k = in.u8();
+  if (k > ScalarAttributes::kMaxFloats) in.fail("too many floats per point: " + std::to_string(k));
+  const uint8_t flags = in.u8();
+  if (flags & ~kResiduals) in.fail("unknown energy state flags");
+  const bool residuals = flags & kResiduals;
+  const uint64_t point_bytes = 1 + 24 + 8 + (residuals ? 8 : 0) + 4 * uint64_t(k);
+
+  for (size_t i = 0; i < s.faces.size(); ++i) {
+    in.set_context("energy face", i);
+    const uint64_t n = read_count(in, point_bytes, "points");
+    for (uint64_t j = 0; j < n; ++j) read_point(in, k, residuals, s.faces[i], kNoId, s);
+  }
+  in.set_context("curve samples");
+  s.samples.resize(read_count(in, kMinSampleBytes, "curve samples"));
+  for (EnergyState::CurveSample& c : s.samples) {
+    c.id = in.varint32();
+    c.position = read_position(in, false);
+    c.distance_sq = in.f64();
+    c.u = read_id(in, bounds.vertices, "curve sample vertex");
+    c.w = read_id_or_none(in, bounds.vertices, "curve sample vertex");
+  }
+  s.sharp_begin.assign(1, 0);
+  s.listed_begin.assign(1, 0);
+  for (size_t i = 0; i < s.vertices.size(); ++i) {
+    in.set_context("energy vertex", i);
+    const VertexId v = s.vertices[i];
+    const uint8_t parked = in.u8();
+    if (parked > 1) in.fail("bad parked flag");
+    if (parked) read_point(in, k, residuals, kNoId, v, s);
+    const uint64_t sharp = read_count(in, 1, "sharp neighbours");
+    for (uint64_t j = 0; j < sharp; ++j) {
+      const VertexId x = read_id(in, bounds.vertices, "sharp neighbour");
+      if (x == v) in.fail("a vertex is its own sharp neighbour");
+      s.sharp_neighbors.push_back(x);
+    }
+    s.sharp_begin.push_back(uint32_t(s.sharp_neighbors.size()));
+    const uint64_t listed = read_count(in, 1, "listed samples");
+    for (uint64_t j = 0; j < listed; ++j)
+      s.listed.push_back(read_id(in, s.samples.size(), "listed sample"));
+    s.listed_begin.push_back(uint32_t(s.listed.size()));
+  }
+  in.set_context("energy state");
+  s.curve_samples_total = in.varint64();
+
+  // Distinct point ids: the master links each point into its face's list by id.
+  std::vector<uint32_t> ids(s.points.size());
+  for (size_t i = 0; i < ids.size(); ++i) ids[i] = s.points[i].id;
+  std::sort(ids.begin(), ids.end());
+  if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) in.fail("a point id is repeated");
+
+  in.set_context("energy wedges");
+  const uint64_t n = read_count(in, 2 + 4 * uint64_t(k), "energy wedges");
+  read_increasing(in, n, bounds.wedges, s.wedges);
+  s.wedge_values.resize(n * uint64_t(k));
+  for (float& x : s.wedge_values) x = in.f32();
+  s.wedge_class.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint64_t start = in.offset();
+    const uint64_t back = in.varint64();
+    if (back > i) in.fail_at(start, "wedge class before the first wedge");
+    s.wedge_class[i] = s.wedges[i - back];
+  }
+}
+
+void write_state(ByteWriter& out, const MetricState& s) {
+  const uint8_t code = metric_code(s.metric);
+  out.u8(code);
+  if ((code != 1 && !is_empty(s.quadric)) || (code != 2 && !is_empty(s.energy)))
+    cannot_encode("a state holds another metric's part");
+  if (code == 1) write_quadric(out, s.quadric);
+  if (code == 2) write_energy(out, s.energy);
+}
+
+void read_state(ByteReader& in, const StateBounds& bounds, MetricState& s) {
+  in.set_context("state");
+  s = MetricState{};
+  s.metric = read_metric(in);
+  if (s.metric == "quadric") read_quadric(in, bounds, s.quadric);
+  if (s.metric == "energy") read_energy(in, bounds, s.energy);
+}
+
+// ---- Job --------------------------------------------------------------------------------
+
+void write_options(ByteWriter& out, const SubsetOptions& o) {
+  out.u8(metric_code(o.metric));
+  out.f64(o.samples_per_face);
+  out.f64(o.crease_angle_degrees);
+  out.f64(o.attribute_weight);
+  out.u64(o.seed);
+  out.f64(o.reference_diagonal);
+  out.varint(o.target_faces);
+  out.f64(o.max_cost);
+}
+
+void read_options(ByteReader& in, SubsetOptions& o) {
+  in.set_context("options");
+  o.metric = read_metric(in);
+  if (o.metric.empty()) in.fail("a job needs a metric");
+  o.samples_per_face = read_not_nan(in, "samples per face");
+  o.crease_angle_degrees = read_not_nan(in, "crease angle");
+  o.attribute_weight = read_not_nan(in, "attribute weight");
+  o.seed = in.u64();
+  o.reference_diagonal = in.f64();
+  if (!(std::isfinite(o.reference_diagonal) && o.reference_diagonal >= 0))
+    in.fail("the reference diagonal must be finite and >= 0");
+  o.target_faces = in.varint64();
+  o.max_cost = read_not_nan(in, "max cost");
+}
+
+// Whether the job's energy module will run E_scalar, so that its state must carry the
+// wedges (as EnergyPriority::import_local decides: corner wedges, attributes, and a positive
+// weight times the reference diagonal, or the job's own when there is none).
+bool runs_scalar_attributes(const SubsetJob& job) {
+  const Mesh& m = job.mesh;
+  if (job.options.metric != "energy" || !m.layout.any() || m.face_wedges.empty()) return false;
+  const double diagonal = job.options.reference_diagonal > 0 ? job.options.reference_diagonal
+                                                             : bounding_box(m).diagonal();
+  return job.options.attribute_weight * diagonal > 0;
+}
+
+// The state against the job: its metric, and the wedges E_scalar will index.
+void check_job_state(ByteReader& in, const SubsetJob& job) {
+  const MetricState& s = job.state;
+  if (s.empty()) return;
+  if (s.metric != job.options.metric) in.fail("the state's metric is not the job's");
+  if (s.metric != "energy") return;
+  const EnergyState& e = s.energy;
+  if (e.wedges.empty() && e.point_values.empty()) {
+    if (runs_scalar_attributes(job)) in.fail("the state lacks the wedges' attributes");
+    return;
+  }
+  const size_t k = !e.points.empty() ? e.point_values.size() / e.points.size()
+                                     : e.wedge_values.size() / e.wedges.size();
+  // Strictly increasing ids below W, W of them: exactly 0..W-1.
+  if (e.wedges.size() != job.mesh.wedge_count() || k != size_t(job.mesh.layout.floats_per_wedge()))
+    in.fail("the state's wedges are not the job's");
+}
+
+void write_job(ByteWriter& out, const SubsetJob& job) {
+  const Mesh& m = job.mesh;
+  const size_t floats = size_t(m.layout.floats_per_wedge());
+  if (job.global_vertex.size() != m.vertex_count() || job.owned.size() != m.vertex_count() ||
+      job.locked.size() != m.vertex_count() || job.global_face.size() != m.face_count() ||
+      job.global_wedge.size() != m.wedge_count() ||
+      m.wedge_values.size() != m.wedge_count() * floats ||
+      (!m.face_wedges.empty() && m.face_wedges.size() != m.face_count()))
+    cannot_encode("job sizes disagree");
+  out.bytes(kJobMagic, 4);
+  out.u8(kVersion);
+  out.varint(job.round);
+  out.varint(job.subset);
+  out.varint(m.vertex_count());
+  out.varint(m.face_count());
+  out.varint(m.wedge_count());
+  write_options(out, job.options);
+
+  bool as_f32 = true;
+  for (const Vec3& p : m.positions) as_f32 = as_f32 && is_float(p);
+  out.u8(uint8_t((m.positions_are_float ? kPositionsAreFloat : 0) |
+                 (m.layout.normals ? kNormals : 0) | (m.layout.texcoords ? kTexcoords : 0) |
+                 (m.layout.colors ? kColors : 0) | (m.face_wedges.empty() ? 0 : kCornerWedges) |
+                 (as_f32 ? kPositionsAsF32 : 0)));
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    if (job.owned[v] > 1 || job.locked[v] > 1) cannot_encode("owned or locked flags not 0/1");
+    write_position(out, m.positions[v], as_f32);
+    out.u8(uint8_t((job.owned[v] ? kOwned : 0) | (job.locked[v] ? kLocked : 0)));
+  }
+  write_increasing(out, job.global_vertex, "global vertex");
+  for (const Triangle& t : m.faces)
+    for (VertexId v : t) out.varint(v);
+  write_increasing(out, job.global_face, "global face");
+  for (VertexId v : m.wedge_vertex) out.varint(v);
+  for (float x : m.wedge_values) out.f32(x);
+  for (const auto& w : m.face_wedges)
+    for (WedgeId id : w) out.varint(id);
+  write_increasing(out, job.global_wedge, "global wedge");
+  out.varint(job.owned_faces);
+  write_state(out, job.state);
+}
+
+void read_job(ByteReader& in, SubsetJob& job) {
+  read_magic(in, kJobMagic, "subset job");
+  job.round = in.varint32();
+  job.subset = in.varint32();
+  in.set_context("sizes");
+  // Counts first, each checked (and then together) against the bytes that follow.
+  const uint64_t vertices = read_count(in, kMinVertexBytes, "vertices");
+  const uint64_t faces = read_count(in, kMinFaceBytes, "faces");
+  const uint64_t wedges = read_count(in, kMinWedgeBytes, "wedges");
+  in.check_fits(1, vertices * kMinVertexBytes + faces * kMinFaceBytes + wedges * kMinWedgeBytes,
+                "meshes of these sizes");
+  read_options(in, job.options);
+
+  in.set_context("mesh flags");
+  Mesh& m = job.mesh;
+  const uint8_t flags = in.u8();
+  if (flags &
+      ~(kPositionsAreFloat | kNormals | kTexcoords | kColors | kCornerWedges | kPositionsAsF32))
+    in.fail("unknown mesh flags");
+  m.positions_are_float = flags & kPositionsAreFloat;
+  m.layout.normals = flags & kNormals;
+  m.layout.texcoords = flags & kTexcoords;
+  m.layout.colors = flags & kColors;
+  const bool as_f32 = flags & kPositionsAsF32;
+  const size_t floats = size_t(m.layout.floats_per_wedge());
+  in.check_fits(wedges, kMinWedgeBytes + 4 * floats, "wedges with their values");
+
+  m.positions.resize(vertices);
+  job.owned.resize(vertices);
+  job.locked.resize(vertices);
+  for (size_t v = 0; v < vertices; ++v) {
+    in.set_context("vertex", v);
+    m.positions[v] = read_position(in, as_f32);
+    const uint8_t f = in.u8();
+    if (f & ~(kOwned | kLocked)) in.fail("unknown vertex flags");
+    job.owned[v] = f & kOwned ? 1 : 0;
+    job.locked[v] = f & kLocked ? 1 : 0;
+  }
+  in.set_context("global vertex ids");
+  read_increasing(in, vertices, kNoId, job.global_vertex);
+  m.faces.resize(faces);
+  for (size_t f = 0; f < faces; ++f) {
+    in.set_context("face", f);
+    Triangle& t = m.faces[f];
+    for (VertexId& v : t) v = read_id(in, vertices, "corner");
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) in.fail("a corner is repeated");
+  }
+  in.set_context("global face ids");
+  read_increasing(in, faces, kNoId, job.global_face);
+  m.wedge_vertex.resize(wedges);
+  for (size_t w = 0; w < wedges; ++w) {
+    in.set_context("wedge", w);
+    m.wedge_vertex[w] = read_id(in, vertices, "wedge vertex");
+  }
+  in.set_context("wedge values");
+  m.wedge_values.resize(wedges * floats);
+  for (float& x : m.wedge_values) x = in.f32();
+  if (flags & kCornerWedges) {
+    m.face_wedges.resize(faces);
+    for (size_t f = 0; f < faces; ++f) {
+      in.set_context("corner wedges", f);
+      for (int k = 0; k < 3; ++k) {
+        const WedgeId w = m.face_wedges[f][k] = read_id(in, wedges, "corner wedge");
+        // The simplifier takes a corner's wedge to be its vertex's (repair.h rule 1).
+        if (m.wedge_vertex[w] != m.faces[f][k]) in.fail("a corner's wedge is another vertex's");
+      }
+    }
+  }
+  in.set_context("global wedge ids");
+  read_increasing(in, wedges, kNoId, job.global_wedge);
+  in.set_context("owned faces");
+  job.owned_faces = in.varint64();
+  if (job.owned_faces > faces) in.fail("more owned faces than faces");
+
+  read_state(in, StateBounds{vertices, faces, wedges}, job.state);
+  in.set_context("state");
+  check_job_state(in, job);
+  expect_end(in);
+}
+
+// ---- Records ------------------------------------------------------------------------------
+
+void write_record(ByteWriter& out, const CollapseRecord& r, size_t k) {
+  if (r.changed_values.size() != r.changed_wedges.size() * k)
+    cannot_encode("records with different floats per changed wedge");
+  const bool as_f32 = is_float(r.vs_position) && is_float(r.vt_position) && is_float(r.position);
+  out.u8(as_f32 ? kRecordPositionsAsF32 : 0);
+  out.varint(r.vs);
+  out.varint(r.vt);
+  for (uint32_t id : {r.vl, r.fl, r.vr, r.fr}) out.varint(uint32_t(id + 1u));
+  for (const Vec3* p : {&r.vs_position, &r.vt_position, &r.position})
+    write_position(out, *p, as_f32);
+  for (WedgeId w : r.corner_wedges) out.varint(uint32_t(w + 1u));
+  out.f64(r.cost);
+  out.f32(r.error);
+  out.varint(r.changed_wedges.size());
+  for (WedgeId w : r.changed_wedges) out.varint(w);
+  for (float x : r.changed_values) out.f32(x);
+}
+
+void read_record(ByteReader& in, size_t k, CollapseRecord& r) {
+  const uint8_t flags = in.u8();
+  if (flags & ~kRecordPositionsAsF32) in.fail("unknown record flags");
+  r.vs = read_id(in, kNoId, "vs");
+  r.vt = read_id(in, kNoId, "vt");
+  if (r.vs == r.vt) in.fail("vs and vt are one vertex");
+  r.vl = read_id_or_none(in, kNoId, "vl");
+  r.fl = read_id_or_none(in, kNoId, "fl");
+  r.vr = read_id_or_none(in, kNoId, "vr");
+  r.fr = read_id_or_none(in, kNoId, "fr");
+  for (Vec3* p : {&r.vs_position, &r.vt_position, &r.position})
+    *p = read_position(in, flags & kRecordPositionsAsF32);
+  for (WedgeId& w : r.corner_wedges) w = read_id_or_none(in, kNoId, "corner wedge");
+  r.cost = read_not_nan(in, "cost");
+  r.error = in.f32();
+  if (std::isnan(r.error)) in.fail("error is NaN");
+  const uint64_t n = read_count(in, 1 + 4 * uint64_t(k), "changed wedges");
+  r.changed_wedges.resize(n);
+  for (WedgeId& w : r.changed_wedges) w = read_id(in, kNoId, "changed wedge");
+  r.changed_values.resize(n * k);
+  for (float& x : r.changed_values) x = in.f32();
+}
+
+// ---- Summary ------------------------------------------------------------------------------
+
+void write_summary(ByteWriter& out, const SubsetResult& r) {
+  out.bytes(kSummaryMagic, 4);
+  out.u8(kVersion);
+  out.varint(r.round);
+  out.varint(r.subset);
+  write_state(out, r.state);
+  out.varint(r.faces);
+  out.varint(r.owned_faces);
+  out.varint(r.free_vertices);
+  const SimplifierStats& s = r.stats;
+  for (uint64_t x : {s.collapses, s.rejected, s.stale, s.reevaluated, s.evaluations}) out.varint(x);
+  if (s.stop_reason.size() > kMaxStopReason) cannot_encode("stop reason too long");
+  out.varint(s.stop_reason.size());
+  out.bytes(s.stop_reason.data(), s.stop_reason.size());
+  out.f64(r.wall_seconds);
+  out.f64(r.cpu_seconds);
+}
+
+void read_summary(ByteReader& in, SubsetResult& r) {
+  read_magic(in, kSummaryMagic, "subset summary");
+  r.round = in.varint32();
+  r.subset = in.varint32();
+  read_state(in, StateBounds{}, r.state);
+  in.set_context("counts");
+  r.faces = in.varint64();
+  r.owned_faces = in.varint64();
+  r.free_vertices = in.varint64();
+  SimplifierStats& s = r.stats;
+  for (uint64_t* x : {&s.collapses, &s.rejected, &s.stale, &s.reevaluated, &s.evaluations})
+    *x = in.varint64();
+  in.set_context("stop reason");
+  s.stop_reason.resize(read_count(in, 1, "stop reason bytes", kMaxStopReason));
+  in.bytes(s.stop_reason.data(), s.stop_reason.size());
+  in.set_context("timings");
+  r.wall_seconds = read_not_nan(in, "wall seconds");
+  r.cpu_seconds = read_not_nan(in, "cpu seconds");
+  expect_end(in);
+}
+
+}  // namespace
+
+std::string encode_subset_job(const SubsetJob& job) {
+  std::ostringstream stream;
+  ByteWriter out(&stream);
+  write_job(out, job);
+  return finish(out, stream);
+}
+
+SubsetJob decode_subset_job(std::string_view bytes) {
+  ViewReader reader(bytes, "subset job");
+  SubsetJob job;
+  read_job(reader.in, job);
+  validate_subset_job(job);
+  return job;
+}
+
+std::string encode_collapse_records(const CollapseRecord* records, size_t count) {
+  // One floats-per-wedge for the batch: the first record with changes tells it.
+  size_t k = 0;
+  for (size_t i = 0; i < count; ++i)
+    if (!records[i].changed_wedges.empty()) {
+      k = records[i].changed_values.size() / records[i].changed_wedges.size();
+      break;
+    }
+  if (k > size_t(ScalarAttributes::kMaxFloats)) cannot_encode("too many floats per wedge");
+  std::ostringstream stream;
+  ByteWriter out(&stream);
+  out.bytes(kRecordsMagic, 4);
+  out.u8(kVersion);
+  out.varint(count);
+  out.u8(uint8_t(k));
+  for (size_t i = 0; i < count; ++i) write_record(out, records[i], k);
+  return finish(out, stream);
+}
+
+void decode_collapse_records(std::string_view bytes, std::vector<CollapseRecord>& append_to) {
+  const size_t before = append_to.size();
+  try {
+    ViewReader reader(bytes, "collapse records");
+    ByteReader& in = reader.in;
+    read_magic(in, kRecordsMagic, "collapse records");
+    in.set_context("count");
+    const uint64_t n = read_count(in, kMinRecordBytes, "records");
+    const int k = in.u8();
+    if (k > ScalarAttributes::kMaxFloats)
+      in.fail("too many floats per wedge: " + std::to_string(k));
+    append_to.reserve(before + n);
+    for (uint64_t i = 0; i < n; ++i) {
+      in.set_context("record", i);
+      read_record(in, size_t(k), append_to.emplace_back());
+    }
+    expect_end(in);
+  } catch (...) {
+    append_to.resize(before);  // all of the batch or nothing
+    throw;
+  }
+}
+
+std::string encode_subset_summary(const SubsetResult& result) {
+  std::ostringstream stream;
+  ByteWriter out(&stream);
+  write_summary(out, result);
+  return finish(out, stream);
+}
+
+void decode_subset_summary(std::string_view bytes, SubsetResult& result) {
+  ViewReader reader(bytes, "subset summary");
+  SubsetResult decoded;
+  read_summary(reader.in, decoded);
+  decoded.records = std::move(result.records);
+  result = std::move(decoded);
+}
+
+}  // namespace parapm

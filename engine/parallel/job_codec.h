@@ -1,0 +1,77 @@
+// Binary codec of the parallel build's messages (subset_job.h, simplify_subset.h), so that a
+// job can travel to a worker daemon and its results back as opaque bytes: the protocol layer
+// never sees a mesh. Exact: every double and float travels as its bits, so that a PM built
+// from decoded results is byte-identical to the in-process one.
+//
+// Layout (little-endian, byte_io.h; "v" is a LEB128 varint, "id+1" a varint of the id plus
+// one modulo 2^32 so that kNoId costs one byte, "ids+" strictly increasing ids as the first
+// id then each gap minus one). Every message starts with a 4-byte magic naming its kind and a
+// version byte, so that one kind is never decoded as another.
+//
+//   job     "PPJB" 1 | round v, subset v | V v, F v, W v (counts first: checked before
+//           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
+//           samples_per_face f64, crease_angle f64, attribute_weight f64, seed u64,
+//           reference_diagonal f64, target_faces v, max_cost f64 | mesh flags u8 (1
+//           positions_are_float, 2 normals, 4 texcoords, 8 colours, 16 corner wedges, 32
+//           positions stored as f32: set when every coordinate is exactly a float) | per
+//           vertex: position (3 f32 or 3 f64), owned | locked << 1 u8 | global_vertex ids+ |
+//           per face: 3 corners v | global_face ids+ | per wedge: wedge_vertex v, then all
+//           values f32, then (flag 16) per face 3 wedges v | global_wedge ids+ |
+//           owned_faces v | state.
+//   state   metric u8, then the metric's part (the other part must be empty):
+//           quadric: n v, vertices ids+, n x 11 f64 (a00 a01 a02 a11 a12 a22 b0 b1 b2 c w).
+//           energy: faces n v + ids+, vertices n v + ids+, k u8 (floats per point and per
+//           wedge, 0..9), flags u8 (1: residuals present) | per face: its point count v, then
+//           its points | curve samples: n v, per sample id v, position 3 f64, distance_sq
+//           f64, u v, w id+1 | per vertex: parked u8 (0/1) [point], sharp count v and
+//           neighbours v, listed count v and sample indices v | curve_samples_total v |
+//           wedges n v + ids+, n x k f32 values, per wedge (its index - the index of its
+//           class's wedge) v. A point: id v, position 3 f64, distance_sq f64, [residual f64],
+//           k f32; its face or vertex is the one it is written under (export order).
+//   records "PPCR" 1 | n v | k u8 (floats per changed wedge) | per record: flags u8 (1:
+//           positions as f32), vs v, vt v, vl fl vr fr id+1, vs_position vt_position position
+//           (3 f32 or 3 f64 each), corner_wedges 6 x id+1, cost f64, error f32, changed n v,
+//           n ids v, n x k f32.
+//   summary "PPSS" 1 | round v, subset v | state | faces v, owned_faces v, free_vertices v |
+//           collapses rejected stale reevaluated evaluations v, stop_reason (length v <= 4096,
+//           bytes) | wall_seconds f64, cpu_seconds f64.
+//
+// Decoding is written for hostile input (a network peer): every count is checked against the
+// bytes that remain before anything is reserved, every id against what it indexes, positions
+// must be finite, strings bounded, and trailing bytes are refused. A failure is
+// Error(kInvalidInput) "subset job: byte N (section): what" (or "collapse records", "subset
+// summary"). A decoded state has the shape the modules' imports rely on (see job_codec.cpp):
+// strictly increasing ids, points under their face or vertex, distinct point ids, no vertex
+// its own sharp neighbour, sample indices in range, wedge classes among the earlier wedges.
+//
+// Encoding throws Error(kInvalidInput) for what the layout cannot carry exactly: an unknown
+// metric, ids not increasing, a state not in export order (module_state.h).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_job.h"
+#include "simplify/simplifier.h"
+
+namespace parapm {
+
+std::string encode_subset_job(const SubsetJob& job);
+// Also runs validate_subset_job and checks the state against the job's mesh (ids in range,
+// the attribute state E_scalar will need), so that simplify_subset can import it safely.
+SubsetJob decode_subset_job(std::string_view bytes);
+
+// One batch of records (a worker streams several); ids are the whole mesh's, checked by
+// replay_collapses (collapse_merge.h) against the coordinator's mesh.
+std::string encode_collapse_records(const CollapseRecord* records, size_t count);
+void decode_collapse_records(std::string_view bytes, std::vector<CollapseRecord>& append_to);
+
+// Everything of a result but its records: round, subset, state, counts, stats and timings.
+std::string encode_subset_summary(const SubsetResult& result);
+// Fills all of `result` but its records (left as they are).
+void decode_subset_summary(std::string_view bytes, SubsetResult& result);
+
+}  // namespace parapm

@@ -1,0 +1,128 @@
+// The coordinator's core, free of gRPC types (the MeshService and Coordination bridges call
+// it): uploads become validated meshes in the blob store, submissions become jobs in SQLite,
+// a scheduler runs queued jobs (the engine's parallel build, its subsets sent to workers by
+// RemoteRunner), and every step of a job is an event, stored and woken up for watchers.
+//
+// Durability: a mesh's or PM's blob is written and fsync'd before the row naming it; a job's
+// row changes state before its event is appended. On start, jobs left queued or running by a
+// previous process are queued again and re-run from their mesh (the build is deterministic,
+// so the PM is the one the first run would have made).
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "parapm.pb.h"
+#include "pm_library.h"
+#include "remote_runner.h"
+#include "storage/blob_store.h"
+#include "storage/job_store.h"
+#include "util/progress.h"
+#include "worker_registry.h"
+
+namespace parapm::service {
+
+struct CoordinatorConfig {
+  std::filesystem::path data_dir;
+  uint64_t max_upload_bytes = uint64_t(2) << 30;
+  uint32_t default_parallelism = 4;
+  unsigned max_running_jobs = 2;
+  // Subsets run in the coordinator when no worker is registered (0: wait for workers).
+  unsigned local_threads = 0;
+  std::chrono::milliseconds heartbeat{1000};
+  std::string worker_token;  // sent on calls to workers
+  std::shared_ptr<grpc::ChannelCredentials> worker_credentials;
+};
+
+// An upload in progress: bytes gathered up to the size limit.
+class Upload {
+ public:
+  Upload(std::string file_name, uint64_t max_bytes);
+  // Throws Error(kResourceExhausted) past the limit.
+  void add(std::string_view bytes);
+  const std::string& file_name() const { return file_name_; }
+  uint64_t size() const { return bytes_.size(); }
+
+ private:
+  friend class Coordinator;
+  std::string file_name_;
+  uint64_t max_bytes_;
+  std::string bytes_;
+};
+
+struct UploadResult {
+  MeshRecord mesh;
+  std::string repairs;  // "" when the repair step changed nothing
+};
+
+class Coordinator {
+ public:
+  explicit Coordinator(CoordinatorConfig config);
+  ~Coordinator();  // stops the scheduler; running jobs are cancelled and stay "running" in
+                   // the database, to be re-run by the next start
+  Coordinator(const Coordinator&) = delete;
+  Coordinator& operator=(const Coordinator&) = delete;
+
+  WorkerRegistry& workers() { return registry_; }
+  const CoordinatorConfig& config() const { return config_; }
+
+  Upload begin_upload(const std::string& file_name) const;
+  // Parses and repairs the mesh (Error(kInvalidInput) with the parser's message when it is
+  // not one), stores its bytes. The same bytes again give the same mesh.
+  UploadResult finish_upload(Upload upload);
+
+  // Throws kNotFound for an unknown mesh, kInvalidInput for bad options.
+  parapm::v1::Job submit(const std::string& mesh_id, const parapm::v1::JobOptions& options);
+  parapm::v1::Job job(const std::string& job_id);  // kNotFound
+  std::vector<parapm::v1::Job> jobs(size_t limit);
+  // Queued: cancelled at once. Running: its build stops at its next check (workers' calls
+  // are cancelled). Finished: unchanged. Returns the job as it is after the call.
+  parapm::v1::Job cancel(const std::string& job_id);
+
+  // Events with seq > after_seq; waits up to `wait` for one when there is none yet.
+  std::vector<parapm::v1::JobEvent> events(const std::string& job_id, uint64_t after_seq,
+                                           std::chrono::milliseconds wait);
+
+  // A done job's PM (kFailedPrecondition when not done).
+  std::filesystem::path pm_path(const std::string& job_id);
+  std::shared_ptr<const LoadedPm> pm(const std::string& job_id);
+
+ private:
+  struct Running {
+    CancelToken cancel;
+    uint64_t progress_done = 0, progress_total = 0;
+  };
+
+  void scheduler_loop();
+  void run_job(const std::string& job_id);
+  void execute(JobRecord& record, Running& running, parapm::v1::JobEvent::Transport& transport);
+  void emit(const std::string& job_id, parapm::v1::JobEvent event);
+  parapm::v1::Job to_proto(const JobRecord& record);
+  JobRecord load_job(const std::string& job_id);
+
+  CoordinatorConfig config_;
+  BlobStore blobs_;
+  JobStore store_;
+  WorkerRegistry registry_;
+  WorkerChannels channels_;
+  PmLibrary library_;
+
+  std::mutex upload_mutex_;  // the sha256 lookup and the insert of a new mesh
+  std::mutex mutex_;
+  std::condition_variable queue_changed_;
+  std::condition_variable events_changed_;
+  std::deque<std::string> queue_;
+  std::map<std::string, std::shared_ptr<Running>> running_;
+  bool stopping_ = false;
+  std::vector<std::thread> schedulers_;
+};
+
+}  // namespace parapm::service

@@ -1,0 +1,74 @@
+#include "job_options.h"
+
+#include <cmath>
+#include <string>
+
+#include "util/error.h"
+
+namespace parapm::service {
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw_invalid("job options: " + message);
+}
+
+}  // namespace
+
+JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_parallelism) {
+  JobSpec spec;
+  SimplifyOptions& s = spec.simplify;
+  ParallelOptions& p = spec.parallel;
+  switch (options.target_case()) {
+    case parapm::v1::JobOptions::kTargetFaces:
+      s.target_faces = options.target_faces();
+      break;
+    case parapm::v1::JobOptions::kTargetRatio:
+      require(std::isfinite(options.target_ratio()) && options.target_ratio() > 0 &&
+                  options.target_ratio() <= 1,
+              "target_ratio must be in (0, 1], got " + std::to_string(options.target_ratio()));
+      s.target_ratio = options.target_ratio();
+      break;
+    case parapm::v1::JobOptions::TARGET_NOT_SET:
+      break;
+  }
+  switch (options.metric()) {
+    case parapm::v1::METRIC_UNSPECIFIED:
+    case parapm::v1::METRIC_QUADRIC:
+      s.metric = "quadric";
+      break;
+    case parapm::v1::METRIC_ENERGY:
+      s.metric = "energy";
+      break;
+    default:
+      require(false, "unknown metric " + std::to_string(int(options.metric())));
+  }
+  require(std::isfinite(options.samples_per_face()) && options.samples_per_face() >= 0 &&
+              options.samples_per_face() <= 64,
+          "samples_per_face must be in [0, 64]");
+  s.samples_per_face = options.samples_per_face();
+  require(std::isfinite(options.crease_angle_degrees()) && options.crease_angle_degrees() >= 0 &&
+              options.crease_angle_degrees() <= 180,
+          "crease_angle_degrees must be in [0, 180] (0: 60)");
+  if (options.crease_angle_degrees() > 0) s.crease_angle_degrees = options.crease_angle_degrees();
+  require(std::isfinite(options.attribute_weight()), "attribute_weight must be finite");
+  if (options.attribute_weight() < 0)
+    s.attribute_weight = 0;
+  else if (options.attribute_weight() > 0)
+    s.attribute_weight = options.attribute_weight();
+  s.seed = options.seed() ? options.seed() : 1;
+  s.keep_order = options.keep_order();
+  check_simplify_options(s);
+
+  p.subsets = options.parallelism() ? options.parallelism() : default_parallelism;
+  require(p.subsets >= 1 && p.subsets <= 256,
+          "parallelism must be in [1, 256], got " + std::to_string(p.subsets));
+  if (options.rounds()) p.rounds = options.rounds();
+  require(p.rounds >= 1 && p.rounds <= 64,
+          "rounds must be in [1, 64], got " + std::to_string(p.rounds));
+  if (options.handover_ratio() != 0) p.handover_ratio = options.handover_ratio();
+  require(std::isfinite(p.handover_ratio) && p.handover_ratio > 0 && p.handover_ratio <= 1,
+          "handover_ratio must be in (0, 1]");
+  return spec;
+}
+
+}  // namespace parapm::service

@@ -1,0 +1,225 @@
+#include "mesh_service.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <spdlog/spdlog.h>
+
+#include "io/mesh_io.h"
+#include "pm/levels.h"
+#include "rpc_server.h"
+#include "storage/ids.h"
+#include "util/error.h"
+
+namespace parapm::service {
+namespace {
+
+constexpr size_t kChunkBytes = 1 << 20;
+const grpc::Status kClientGone(grpc::StatusCode::CANCELLED, "the client went away");
+
+void require_id(const std::string& id, const char* what) {
+  if (id.empty() || id.size() > 64) throw_invalid(std::string(what) + " must be given");
+}
+
+// Sends `bytes` in chunks; false when the client went away.
+bool send_chunks(grpc::ServerWriter<parapm::v1::Chunk>* writer, const std::string& bytes) {
+  parapm::v1::Chunk chunk;
+  chunk.set_total(bytes.size());
+  for (size_t at = 0; at < bytes.size() || at == 0; at += kChunkBytes) {
+    chunk.set_offset(at);
+    chunk.set_data(bytes.substr(at, kChunkBytes));
+    if (!writer->Write(chunk)) return false;
+    if (bytes.empty()) break;
+  }
+  return true;
+}
+
+bool terminal(const parapm::v1::JobEvent& event) {
+  return event.has_finished() || event.has_failed() || event.has_cancelled();
+}
+
+}  // namespace
+
+grpc::Status MeshService::Upload(grpc::ServerContext* context,
+                                 grpc::ServerReader<parapm::v1::UploadChunk>* reader,
+                                 parapm::v1::UploadReply* reply) {
+  return rpc::serve(auth_, context, [&] {
+    parapm::v1::UploadChunk chunk;
+    if (!reader->Read(&chunk)) throw_invalid("the upload has no chunk (send the file name first)");
+    service::Upload upload = coordinator_.begin_upload(chunk.file_name());
+    do {
+      upload.add(chunk.data());
+    } while (reader->Read(&chunk));
+    if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "upload cut off");
+    const UploadResult result = coordinator_.finish_upload(std::move(upload));
+    reply->set_mesh_id(result.mesh.mesh_id);
+    reply->set_content_sha256(result.mesh.sha256);
+    reply->set_bytes(result.mesh.bytes);
+    reply->set_vertices(result.mesh.vertices);
+    reply->set_faces(result.mesh.faces);
+    reply->set_repairs(result.repairs);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::Submit(grpc::ServerContext* context,
+                                 const parapm::v1::SubmitRequest* request, parapm::v1::Job* reply) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->mesh_id(), "mesh_id");
+    *reply = coordinator_.submit(request->mesh_id(), request->options());
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::Watch(grpc::ServerContext* context,
+                                const parapm::v1::WatchRequest* request,
+                                grpc::ServerWriter<parapm::v1::JobEvent>* writer) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->job_id(), "job_id");
+    uint64_t after = request->after_seq();
+    while (!context->IsCancelled()) {
+      for (const parapm::v1::JobEvent& event :
+           coordinator_.events(request->job_id(), after, std::chrono::milliseconds(500))) {
+        if (!writer->Write(event)) return kClientGone;
+        after = event.seq();
+        if (terminal(event)) return grpc::Status::OK;
+      }
+      // A job finished before this watch's `after_seq`: nothing more will come.
+      const parapm::v1::Job job = coordinator_.job(request->job_id());
+      if (job.state() == parapm::v1::DONE || job.state() == parapm::v1::FAILED ||
+          job.state() == parapm::v1::CANCELLED) {
+        if (coordinator_.events(request->job_id(), after, std::chrono::milliseconds(0)).empty())
+          return grpc::Status::OK;
+      }
+    }
+    return grpc::Status(grpc::StatusCode::CANCELLED, "watch cancelled");
+  });
+}
+
+grpc::Status MeshService::GetJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                                 parapm::v1::Job* reply) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->job_id(), "job_id");
+    *reply = coordinator_.job(request->job_id());
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::ListJobs(grpc::ServerContext* context,
+                                   const parapm::v1::ListJobsRequest* request,
+                                   parapm::v1::ListJobsReply* reply) {
+  return rpc::serve(auth_, context, [&] {
+    const size_t limit = request->limit() ? std::min<uint32_t>(request->limit(), 10000) : 100;
+    for (parapm::v1::Job& job : coordinator_.jobs(limit)) *reply->add_jobs() = std::move(job);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::CancelJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                                    parapm::v1::Job* reply) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->job_id(), "job_id");
+    *reply = coordinator_.cancel(request->job_id());
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::Download(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                                   grpc::ServerWriter<parapm::v1::Chunk>* writer) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->job_id(), "job_id");
+    const std::filesystem::path path = coordinator_.pm_path(request->job_id());
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(ErrorCode::kIo, "cannot open the PM of job " + request->job_id());
+    const uint64_t total = std::filesystem::file_size(path);
+    parapm::v1::Chunk chunk;
+    chunk.set_total(total);
+    std::string buffer(kChunkBytes, '\0');
+    for (uint64_t at = 0; at < total;) {
+      in.read(buffer.data(), std::streamsize(std::min<uint64_t>(kChunkBytes, total - at)));
+      const auto got = uint64_t(in.gcount());
+      if (got == 0) throw Error(ErrorCode::kIo, "the PM of job " + request->job_id() + " is short");
+      chunk.set_offset(at);
+      chunk.set_data(buffer.data(), got);
+      if (!writer->Write(chunk)) return kClientGone;
+      at += got;
+    }
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::GetLevel(grpc::ServerContext* context,
+                                   const parapm::v1::LevelRequest* request,
+                                   grpc::ServerWriter<parapm::v1::Chunk>* writer) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->job_id(), "job_id");
+    const std::string format = request->format().empty() ? "obj" : request->format();
+    if (format != "obj" && format != "ply") throw_invalid("format must be \"obj\" or \"ply\"");
+    if (request->cut_case() == parapm::v1::LevelRequest::CUT_NOT_SET)
+      throw_invalid("give max_faces or max_error");
+    if (request->cut_case() == parapm::v1::LevelRequest::kMaxError &&
+        !std::isfinite(request->max_error()))
+      throw_invalid("max_error must be finite");
+    const auto loaded = coordinator_.pm(request->job_id());
+    const size_t level = request->cut_case() == parapm::v1::LevelRequest::kMaxFaces
+                             ? level_for_faces(loaded->pm, request->max_faces())
+                             : level_for_error(loaded->pm, request->max_error());
+    const Mesh mesh = level_of_detail(loaded->pm, level);
+    // The writers write files: one in the data folder's temp space, removed at once.
+    const std::filesystem::path temp =
+        coordinator_.config().data_dir / "blobs" / "tmp" / (new_id("level-") + "." + format);
+    std::string bytes;
+    try {
+      write_mesh(mesh, temp.string());
+      std::ifstream in(temp, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    } catch (...) {
+      std::filesystem::remove(temp);
+      throw;
+    }
+    std::filesystem::remove(temp);
+    if (!send_chunks(writer, bytes)) return kClientGone;
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::StreamPM(grpc::ServerContext* context,
+                                   const parapm::v1::StreamRequest* request,
+                                   grpc::ServerWriter<parapm::v1::PmStreamMessage>* writer) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->job_id(), "job_id");
+    const auto loaded = coordinator_.pm(request->job_id());
+    const uint64_t n = loaded->pm.splits.size();
+    uint64_t end = n;
+    if (request->until_case() == parapm::v1::StreamRequest::kMaxFaces)
+      end = level_for_faces(loaded->pm, request->max_faces());
+    else if (request->until_case() == parapm::v1::StreamRequest::kMaxError) {
+      if (!std::isfinite(request->max_error())) throw_invalid("max_error must be finite");
+      end = level_for_error(loaded->pm, request->max_error());
+    }
+    if (request->from_vsplit() > n)
+      throw_invalid("from_vsplit " + std::to_string(request->from_vsplit()) + " is past the PM's " +
+                    std::to_string(n) + " vsplits");
+    const uint32_t batch =
+        request->batch_vsplits() ? std::min(request->batch_vsplits(), 1u << 20) : 4096u;
+    parapm::v1::PmStreamMessage message;
+    message.set_total_vsplits(n);
+    if (request->from_vsplit() == 0) {
+      message.set_header_and_base(read_file_range(loaded->path, 0, loaded->splits_begin));
+      message.set_first_vsplit(0);
+      message.set_count(0);
+      if (!writer->Write(message)) return kClientGone;
+    }
+    for (uint64_t first = request->from_vsplit(); first < end; first += batch) {
+      const uint64_t last = std::min<uint64_t>(end, first + batch);
+      message.set_vsplit_batch(
+          read_file_range(loaded->path, loaded->split_begin[first], loaded->split_begin[last]));
+      message.set_first_vsplit(first);
+      message.set_count(uint32_t(last - first));
+      if (!writer->Write(message)) return kClientGone;
+    }
+    return grpc::Status::OK;
+  });
+}
+
+}  // namespace parapm::service

@@ -1,0 +1,41 @@
+// MeshService bridge: converts requests, calls the Coordinator, converts results and errors
+// (rpc::serve). Streams stop cleanly when a write fails (the client went away).
+#pragma once
+
+#include "coordinator.h"
+#include "parapm.grpc.pb.h"
+#include "rpc_security.h"
+
+namespace parapm::service {
+
+class MeshService final : public parapm::v1::MeshService::Service {
+ public:
+  MeshService(Coordinator& coordinator, rpc::TokenCheck auth)
+      : coordinator_(coordinator), auth_(std::move(auth)) {}
+
+  grpc::Status Upload(grpc::ServerContext* context,
+                      grpc::ServerReader<parapm::v1::UploadChunk>* reader,
+                      parapm::v1::UploadReply* reply) override;
+  grpc::Status Submit(grpc::ServerContext* context, const parapm::v1::SubmitRequest* request,
+                      parapm::v1::Job* reply) override;
+  grpc::Status Watch(grpc::ServerContext* context, const parapm::v1::WatchRequest* request,
+                     grpc::ServerWriter<parapm::v1::JobEvent>* writer) override;
+  grpc::Status GetJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                      parapm::v1::Job* reply) override;
+  grpc::Status ListJobs(grpc::ServerContext* context, const parapm::v1::ListJobsRequest* request,
+                        parapm::v1::ListJobsReply* reply) override;
+  grpc::Status CancelJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                         parapm::v1::Job* reply) override;
+  grpc::Status Download(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                        grpc::ServerWriter<parapm::v1::Chunk>* writer) override;
+  grpc::Status GetLevel(grpc::ServerContext* context, const parapm::v1::LevelRequest* request,
+                        grpc::ServerWriter<parapm::v1::Chunk>* writer) override;
+  grpc::Status StreamPM(grpc::ServerContext* context, const parapm::v1::StreamRequest* request,
+                        grpc::ServerWriter<parapm::v1::PmStreamMessage>* writer) override;
+
+ private:
+  Coordinator& coordinator_;
+  rpc::TokenCheck auth_;
+};
+
+}  // namespace parapm::service

@@ -1,0 +1,70 @@
+// The coordinator's durable state: meshes, jobs and job events in one SQLite file,
+// DIR/parapm.db. Everything a restart needs is here, so a restarted coordinator loses nothing:
+// it re-queues the jobs that were queued or running (jobs_with_status) and clients resume
+// their event streams by seq.
+//
+// Durability: WAL journal with synchronous=NORMAL. A committed row survives a process crash;
+// a power cut may lose the last few commits, never corrupt the file. Blobs are fsynced by
+// BlobStore::Writer::commit(); callers commit a blob before they write the row that names it,
+// so a row never refers to a missing blob.
+//
+// Thread safety: every member may be called from any thread; one mutex serialises them over
+// one connection (the coordinator calls it from many gRPC threads, and each call is short).
+// Errors: parapm::Error; kNotFound for a row that names a missing mesh or job or an update of
+// a missing job, kInvalidInput for a duplicate id or an unstorable value, kIo for the rest.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <initializer_list>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "storage/ids.h"
+#include "storage/records.h"
+
+namespace parapm::service {
+
+namespace sqlite {
+class Database;
+}
+
+class JobStore {
+ public:
+  // Opens or creates the file and brings its schema up to date. Throws kIo for a file that
+  // is not a SQLite database, is corrupt, or was written by a newer build.
+  explicit JobStore(const std::filesystem::path& db_file);
+  ~JobStore();
+  JobStore(const JobStore&) = delete;
+  JobStore& operator=(const JobStore&) = delete;
+
+  void add_mesh(const MeshRecord& mesh);
+  std::optional<MeshRecord> find_mesh(const std::string& mesh_id) const;
+  // The oldest mesh with these bytes, to answer a repeated upload without storing it again.
+  std::optional<MeshRecord> find_mesh_by_sha256(const std::string& sha) const;
+
+  void add_job(const JobRecord& job);  // kNotFound when job.mesh_id is not a stored mesh
+  std::optional<JobRecord> find_job(const std::string& job_id) const;
+  void update_job(const JobRecord& job);  // by job_id, every column; kNotFound when absent
+  // Newest first: created_unix_ms descending, ties by job_id ascending. At most `limit`.
+  std::vector<JobRecord> list_jobs(size_t limit) const;
+  // Oldest first (created_unix_ms, then job_id): the order a restart re-queues them in.
+  std::vector<JobRecord> jobs_with_status(std::initializer_list<JobStatus> statuses) const;
+
+  // Stores an event and returns its seq: 1 for a job's first event, then +1 each time, even
+  // across restarts and concurrent callers. kNotFound when the job does not exist.
+  uint64_t append_event(const std::string& job_id, int64_t unix_ms, std::string_view payload);
+  // The job's events with seq > after_seq, ascending (after_seq 0: all of them).
+  std::vector<EventRecord> events(const std::string& job_id, uint64_t after_seq) const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::unique_ptr<sqlite::Database> db_;  // guarded by mutex_
+};
+
+}  // namespace parapm::service

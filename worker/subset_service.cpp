@@ -1,0 +1,137 @@
+#include "subset_service.h"
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "parallel/job_codec.h"
+#include "parallel/simplify_subset.h"
+#include "rpc_server.h"
+#include "util/error.h"
+#include "util/progress.h"
+
+namespace parapm::worker {
+namespace {
+
+// Records per stream message: ~1.5 MB at the records' usual size, well under the limits and
+// large enough that the per-message overhead does not count.
+constexpr size_t kRecordsPerBatch = 16384;
+constexpr auto kProgressInterval = std::chrono::milliseconds(250);
+constexpr auto kCancelPoll = std::chrono::milliseconds(20);
+
+}  // namespace
+
+SubsetService::SubsetService(rpc::TokenCheck auth, unsigned slots)
+    : auth_(std::move(auth)), slots_(std::max(1u, slots)) {}
+
+bool SubsetService::acquire_slot(grpc::ServerContext* context) {
+  std::unique_lock lock(mutex_);
+  while (busy_ >= slots_) {
+    if (context->IsCancelled()) return false;
+    slot_freed_.wait_for(lock, std::chrono::milliseconds(100));
+  }
+  ++busy_;
+  ++running_;
+  return true;
+}
+
+void SubsetService::release_slot() {
+  {
+    std::lock_guard lock(mutex_);
+    --busy_;
+    --running_;
+  }
+  slot_freed_.notify_one();
+}
+
+grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
+                                           const parapm::v1::SubsetRequest* request,
+                                           grpc::ServerWriter<parapm::v1::SubsetProgress>* writer) {
+  return rpc::serve(auth_, context, [&]() -> grpc::Status {
+    const auto start = std::chrono::steady_clock::now();
+    const SubsetJob job = decode_subset_job(request->job());
+    const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +
+                             " subset " + std::to_string(job.subset);
+    if (!acquire_slot(context)) return {grpc::StatusCode::CANCELLED, "cancelled while queued"};
+    struct SlotGuard {
+      SubsetService* service;
+      ~SlotGuard() { service->release_slot(); }
+    } guard{this};
+
+    CancelToken cancel;
+    if (context->deadline() != std::chrono::system_clock::time_point::max()) {
+      const auto left = context->deadline() - std::chrono::system_clock::now();
+      cancel.set_deadline(std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(left));
+    }
+    // The call's cancellation (the coordinator cancelled the job, or went away) reaches the
+    // engine within kCancelPoll, whatever the engine is doing.
+    std::atomic<bool> finished{false};
+    std::thread watcher([&] {
+      while (!finished.load()) {
+        if (context->IsCancelled()) {
+          cancel.cancel();
+          return;
+        }
+        std::this_thread::sleep_for(kCancelPoll);
+      }
+    });
+    struct WatcherGuard {
+      std::atomic<bool>& finished;
+      std::thread& watcher;
+      ~WatcherGuard() {
+        finished = true;
+        watcher.join();
+      }
+    } watcher_guard{finished, watcher};
+    auto last_progress = std::chrono::steady_clock::now();
+    bool peer_gone = false;
+    // Called every 1024 collapses: now and then, reports.
+    auto progress = [&](uint64_t done, uint64_t total) {
+      if (peer_gone) {
+        cancel.cancel();
+        return;
+      }
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_progress < kProgressInterval) return;
+      last_progress = now;
+      parapm::v1::SubsetProgress message;
+      message.mutable_progress()->set_collapses(done);
+      message.mutable_progress()->set_faces_to_remove(total);
+      if (!writer->Write(message)) peer_gone = true;
+    };
+    spdlog::info("{}: started, {} faces", name, job.mesh.face_count());
+    SubsetResult result;
+    try {
+      result = simplify_subset(job, progress, &cancel);
+    } catch (const Error& e) {
+      if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded)
+        spdlog::info(
+            "{}: stopped ({}) after {:.3f} s", name, e.what(),
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      else
+        spdlog::warn("{}: failed: {}", name, e.what());
+      throw;
+    }
+
+    // The records, then the summary; a failed write means the coordinator is gone.
+    parapm::v1::SubsetProgress message;
+    for (size_t i = 0; i < result.records.size(); i += kRecordsPerBatch) {
+      const size_t count = std::min(kRecordsPerBatch, result.records.size() - i);
+      message.set_record_batch(encode_collapse_records(result.records.data() + i, count));
+      if (!writer->Write(message))
+        return grpc::Status(grpc::StatusCode::CANCELLED, "the coordinator went away");
+    }
+    message.set_summary(encode_subset_summary(result));
+    if (!writer->Write(message))
+      return grpc::Status(grpc::StatusCode::CANCELLED, "the coordinator went away");
+    spdlog::info("{}: {} collapses in {:.3f} s ({:.3f} s CPU), {}", name, result.records.size(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                 result.cpu_seconds, result.stats.stop_reason);
+    return grpc::Status::OK;
+  });
+}
+
+}  // namespace parapm::worker

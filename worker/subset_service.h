@@ -1,0 +1,40 @@
+// The worker's WorkerService: runs one subset job per call with the engine's simplify_subset,
+// the very function of the in-process build, and streams its result back: progress while it
+// runs, then the collapse records in batches, then the summary (state, stats, times). The
+// call's deadline and cancellation reach the engine through a CancelToken.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+
+#include "parapm.grpc.pb.h"
+#include "rpc_security.h"
+
+namespace parapm::worker {
+
+class SubsetService final : public parapm::v1::WorkerService::Service {
+ public:
+  // At most `slots` subsets run at once; further calls wait for a slot (cancellable).
+  SubsetService(rpc::TokenCheck auth, unsigned slots);
+
+  grpc::Status SimplifySubset(grpc::ServerContext* context,
+                              const parapm::v1::SubsetRequest* request,
+                              grpc::ServerWriter<parapm::v1::SubsetProgress>* writer) override;
+
+  unsigned running() const { return running_.load(); }
+
+ private:
+  // Waits for a free slot; false when the call was cancelled meanwhile.
+  bool acquire_slot(grpc::ServerContext* context);
+  void release_slot();
+
+  rpc::TokenCheck auth_;
+  unsigned slots_;
+  std::atomic<unsigned> running_{0};
+  std::mutex mutex_;
+  std::condition_variable slot_freed_;
+  unsigned busy_ = 0;
+};
+
+}  // namespace parapm::worker
