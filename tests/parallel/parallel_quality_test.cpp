@@ -1,0 +1,102 @@
+// Quality of the parallel PM against the sequential PM of the same metric: at 50%, 10% and 2%
+// of the input faces and at the sequential base's size, the surface distance of the parallel
+// level to the input (RMS and Hausdorff, both directions, engine/measure) over the sequential
+// level's. Real meshes, all also in ../shared/meshes: a CAD part, a scanned vessel, the
+// textured bunny; p = 2, 4, 8, 16 with quadrics, p = 2, 4 with the energy. Every figure is
+// printed.
+//
+// What is asserted, per mesh and metric, as regression guards at today's figures with a
+// margin: the median RMS ratio over the (p, level) cells within 10% (2026-11-21: 1.00-1.02 on
+// the CAD part and the vessel, 1.06 on the bunny), the worst cells under RMS 1.35 and
+// Hausdorff 2.6. Issue 5's target, every cell within 5% (RMS) and 10%
+// (Hausdorff), is NOT met on these small meshes (at p = 16 the bunny's subsets hold 600
+// faces; worst cells 2026-11-21: RMS 1.29, Hausdorff 2.49); it is on the 203k dragon
+// (docs/BENCHMARKS.md, bench/parallel.sh with metro).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "measure/surface_distance.h"
+#include "mesh/repaired_input.h"
+#include "parallel/parallel_build.h"
+#include "parallel_test_support.h"
+#include "pm/levels.h"
+#include "simplify/simplify.h"
+
+namespace parapm::testing {
+namespace {
+
+constexpr uint64_t kSamples = 20000;
+
+struct Ratios {
+  std::vector<double> rms;
+  double worst_rms = 0, worst_hausdorff = 0;
+  double median_rms() {
+    std::sort(rms.begin(), rms.end());
+    return rms[rms.size() / 2];
+  }
+};
+
+void expect_near_sequential(Ratios r, const std::string& name) {
+  EXPECT_LE(r.median_rms(), 1.10) << name;
+  EXPECT_LE(r.worst_rms, 1.35) << name;
+  EXPECT_LE(r.worst_hausdorff, 2.6) << name;
+}
+
+// Per level, parallel over sequential; prints every figure.
+Ratios compare(const std::string& name, const RepairedMesh& repaired,
+               const SimplifyOptions& options, const std::vector<uint32_t>& ps) {
+  const Mesh input = repaired_input(repaired);
+  const ProgressiveMesh sequential = build_progressive_mesh(repaired, options);
+  const uint64_t faces = repaired.mesh.face_count();
+  const std::vector<std::pair<const char*, uint64_t>> levels = {
+      {"50%", faces / 2},
+      {"10%", faces / 10},
+      {"2%", faces / 50},
+      {"base", sequential.base.face_count()}};
+  std::vector<SurfaceDistance> seq;
+  for (const auto& [label, count] : levels)
+    seq.push_back(surface_distance(
+        input, level_of_detail(sequential, level_for_faces(sequential, count)), kSamples));
+  Ratios worst;
+  for (uint32_t p : ps) {
+    ParallelOptions parallel;
+    parallel.subsets = p;
+    const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, parallel);
+    std::printf("%-28s %-7s p=%-2u", name.c_str(), options.metric.c_str(), p);
+    for (size_t i = 0; i < levels.size(); ++i) {
+      const Mesh level = level_of_detail(pm, level_for_faces(pm, levels[i].second));
+      const SurfaceDistance d = surface_distance(input, level, kSamples);
+      const double rms = d.rms / seq[i].rms, hausdorff = d.hausdorff / seq[i].hausdorff;
+      std::printf("  %s rms %.3f haus %.3f", levels[i].first, rms, hausdorff);
+      worst.rms.push_back(rms);
+      worst.worst_rms = std::max(worst.worst_rms, rms);
+      worst.worst_hausdorff = std::max(worst.worst_hausdorff, hausdorff);
+    }
+    std::printf("\n");
+  }
+  return worst;
+}
+
+TEST(ParallelQuality, QuadricLevelsMatchTheSequentialOnes) {
+  for (const char* name :
+       {"cad-cycloidal-43k.ply", "gmsh-aneurysm-20k.stl.gz", "pymeshlab-bunny-textured-10k.obj"}) {
+    SimplifyOptions options;
+    options.target_ratio = 0.01;
+    expect_near_sequential(compare(name, repaired_test_mesh(name), options, {2, 4, 8, 16}), name);
+  }
+}
+
+TEST(ParallelQuality, EnergyLevelsMatchTheSequentialOnes) {
+  for (const char* name : {"gmsh-aneurysm-20k.stl.gz", "pymeshlab-bunny-textured-10k.obj"}) {
+    SimplifyOptions options;
+    options.metric = "energy";
+    options.target_ratio = 0.01;
+    expect_near_sequential(compare(name, repaired_test_mesh(name), options, {2, 4}), name);
+  }
+}
+
+}  // namespace
+}  // namespace parapm::testing
