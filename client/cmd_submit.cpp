@@ -141,8 +141,10 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--seed", args->seed, "seed of the randomised steps")->capture_default_str();
   cmd->add_option("--samples-per-face", args->samples_per_face, "energy: extra sample points")
       ->check(CLI::Range(0.0, 64.0));
-  cmd->add_option("--crease-angle", args->crease_angle, "energy: crease angle, degrees")
-      ->check(CLI::Range(0.0, 180.0))
+  // Above 0: the API reads 0 as "the default" (60).
+  cmd->add_option("--crease-angle", args->crease_angle,
+                  "energy: crease angle, degrees, in (0, 180]")
+      ->check(CLI::Range(1e-6, 180.0))
       ->capture_default_str();
   cmd->add_option("--attribute-weight", args->attribute_weight,
                   "energy: weight of attributes against geometry (0: not optimised)")
