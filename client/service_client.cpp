@@ -15,7 +15,6 @@ namespace {
 
 constexpr size_t kUploadChunkBytes = 1 << 20;
 
-
 }  // namespace
 
 void add_connection_options(CLI::App* command, ConnectionArgs& args) {

@@ -15,8 +15,8 @@
 #include <string>
 
 #include "io/mesh_io.h"
-#include "util/error.h"
 #include "test_support.h"
+#include "util/error.h"
 
 namespace parapm::testing {
 
@@ -24,7 +24,6 @@ inline Mesh read_text(const std::string& bytes, const std::string& name,
                       ReadReport* report = nullptr, const ReadLimits& limits = {}) {
   return read_mesh_from_memory(bytes, name, report, limits);
 }
-
 
 // Builds binary data in either byte order.
 class Bytes {

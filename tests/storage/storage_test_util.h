@@ -11,8 +11,8 @@
 #include <string>
 
 #include "storage/ids.h"
-#include "util/error.h"
 #include "test_support.h"
+#include "util/error.h"
 
 namespace parapm::testing {
 
@@ -46,6 +46,5 @@ inline std::string read_file(const std::filesystem::path& path) {
 inline void write_file(const std::filesystem::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
-
 
 }  // namespace parapm::testing
