@@ -38,10 +38,6 @@ void ProgressBar::finish() {
   finished_ = true;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 LoadedMesh load_and_repair(const std::string& path, const RepairOptions& options) {
   LoadedMesh loaded;
   auto start = std::chrono::steady_clock::now();

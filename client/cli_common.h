@@ -9,6 +9,7 @@
 
 #include "io/mesh_io.h"
 #include "mesh/repair.h"
+#include "util/clock.h"
 #include "util/progress.h"
 
 namespace parapm::cli {
@@ -45,8 +46,6 @@ nlohmann::json repair_report_json(const RepairReport& report);
 
 // Prints a JSON object on stdout, one line.
 void print_json(const nlohmann::json& object);
-
-double seconds_since(std::chrono::steady_clock::time_point start);
 
 }  // namespace parapm::cli
 

@@ -1,7 +1,5 @@
 // parapm get JOB -o OUT.pm / parapm level JOB (--faces N | --error E) -o OUT.obj|ply: fetch a
 // finished job's Progressive Mesh, or one level of detail cut from it by the coordinator.
-#include <fstream>
-
 #include "cli_common.h"
 #include "commands.h"
 #include "service_client.h"
@@ -44,21 +42,7 @@ int run_level(const FetchArgs& args) {
   request.set_format(ext.substr(1));
   auto context = client.context(0);
   auto reader = client.stub().GetLevel(context.get(), request);
-  const std::filesystem::path temp = args.output + ".part";
-  std::ofstream file(temp, std::ios::binary | std::ios::trunc);
-  if (!file) throw Error(ErrorCode::kIo, args.output + ": cannot write");
-  parapm::v1::Chunk chunk;
-  uint64_t bytes = 0;
-  while (reader->Read(&chunk)) {
-    file.write(chunk.data().data(), std::streamsize(chunk.data().size()));
-    bytes += chunk.data().size();
-  }
-  file.close();
-  const grpc::Status status = reader->Finish();
-  if (!status.ok()) std::filesystem::remove(temp);
-  check_status(status, "level of " + args.job_id, client.server());
-  if (!file) throw Error(ErrorCode::kIo, args.output + ": write failed");
-  std::filesystem::rename(temp, out);
+  const uint64_t bytes = client.receive_file(*reader, out, "level of " + args.job_id);
   if (args.json)
     print_json({{"job_id", args.job_id}, {"path", args.output}, {"bytes", bytes}});
   else

@@ -115,32 +115,37 @@ parapm::v1::Job ServiceClient::watch(
   return job;
 }
 
-uint64_t ServiceClient::download(const std::string& job_id, const std::filesystem::path& out) {
+uint64_t ServiceClient::receive_file(grpc::ClientReader<parapm::v1::Chunk>& reader,
+                                     const std::filesystem::path& out, const std::string& what) {
   const std::filesystem::path temp = out.string() + ".part";
   uint64_t written = 0;
   {
     std::ofstream file(temp, std::ios::binary | std::ios::trunc);
     if (!file) throw Error(ErrorCode::kIo, out.string() + ": cannot write");
-    auto context = this->context(0);
-    parapm::v1::JobRef ref;
-    ref.set_job_id(job_id);
-    auto reader = stub_->Download(context.get(), ref);
     parapm::v1::Chunk chunk;
-    while (reader->Read(&chunk)) {
+    while (reader.Read(&chunk)) {
       file.write(chunk.data().data(), std::streamsize(chunk.data().size()));
       written += chunk.data().size();
     }
-    const grpc::Status status = reader->Finish();
+    const grpc::Status status = reader.Finish();
     if (!status.ok()) {
       file.close();
       std::filesystem::remove(temp);
-      check_status(status, "download " + job_id, server_);
+      check_status(status, what, server_);
     }
     file.flush();
     if (!file) throw Error(ErrorCode::kIo, out.string() + ": write failed (disk full?)");
   }
   std::filesystem::rename(temp, out);
   return written;
+}
+
+uint64_t ServiceClient::download(const std::string& job_id, const std::filesystem::path& out) {
+  auto context = this->context(0);
+  parapm::v1::JobRef ref;
+  ref.set_job_id(job_id);
+  auto reader = stub_->Download(context.get(), ref);
+  return receive_file(*reader, out, "download " + job_id);
 }
 
 const char* job_state_name(parapm::v1::JobState state) {

@@ -44,6 +44,9 @@ class ServiceClient {
                         const std::function<void(const parapm::v1::JobEvent&)>& on_event);
   // Writes the job's .pm to `out` (a temp file renamed at the end: never a partial file).
   uint64_t download(const std::string& job_id, const std::filesystem::path& out);
+  // Writes a stream of chunks to `out` the same way; `what` names the call in errors.
+  uint64_t receive_file(grpc::ClientReader<parapm::v1::Chunk>& reader,
+                        const std::filesystem::path& out, const std::string& what);
 
  private:
   std::string server_;

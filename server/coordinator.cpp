@@ -11,6 +11,7 @@
 #include "parallel/parallel_build.h"
 #include "pm/pm_file.h"
 #include "storage/ids.h"
+#include "util/clock.h"
 #include "util/error.h"
 
 namespace parapm::service {
@@ -45,10 +46,6 @@ std::string repairs_text(const RepairReport& r) {
   item(r.nonmanifold_edges, "non-manifold edges cut");
   item(r.vertex_copies_added, "vertex copies made at non-manifold vertices");
   return text.str();
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
@@ -264,17 +261,21 @@ std::vector<parapm::v1::JobEvent> Coordinator::events(const std::string& job_id,
   return fetch();
 }
 
-std::filesystem::path Coordinator::pm_path(const std::string& job_id) {
-  const JobRecord record = load_job(job_id);
+JobRecord Coordinator::done_job(const std::string& job_id) {
+  JobRecord record = load_job(job_id);
   if (record.status != JobStatus::kDone)
     throw Error(ErrorCode::kFailedPrecondition,
                 "job " + job_id + " is " + to_string(record.status) + ", not done: no PM yet");
-  return blobs_.path_of(record.pm_sha256);
+  return record;
+}
+
+std::filesystem::path Coordinator::pm_path(const std::string& job_id) {
+  return blobs_.path_of(done_job(job_id).pm_sha256);
 }
 
 std::shared_ptr<const LoadedPm> Coordinator::pm(const std::string& job_id) {
-  const std::filesystem::path path = pm_path(job_id);
-  return library_.get(load_job(job_id).pm_sha256, path);
+  const JobRecord record = done_job(job_id);
+  return library_.get(record.pm_sha256, blobs_.path_of(record.pm_sha256));
 }
 
 void Coordinator::scheduler_loop() {

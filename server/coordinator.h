@@ -106,7 +106,8 @@ class Coordinator {
   void execute(JobRecord& record, Running& running, parapm::v1::JobEvent::Transport& transport);
   void emit(const std::string& job_id, parapm::v1::JobEvent event);
   parapm::v1::Job to_proto(const JobRecord& record);
-  JobRecord load_job(const std::string& job_id);
+  JobRecord load_job(const std::string& job_id);  // kNotFound
+  JobRecord done_job(const std::string& job_id);  // kFailedPrecondition unless done
 
   CoordinatorConfig config_;
   BlobStore blobs_;

@@ -78,13 +78,15 @@ grpc::Status MeshService::Watch(grpc::ServerContext* context,
     require_id(request->job_id(), "job_id");
     uint64_t after = request->after_seq();
     while (!context->IsCancelled()) {
-      for (const parapm::v1::JobEvent& event :
-           coordinator_.events(request->job_id(), after, std::chrono::milliseconds(500))) {
+      const std::vector<parapm::v1::JobEvent> events =
+          coordinator_.events(request->job_id(), after, std::chrono::milliseconds(500));
+      for (const parapm::v1::JobEvent& event : events) {
         if (!writer->Write(event)) return kClientGone;
         after = event.seq();
         if (terminal(event)) return grpc::Status::OK;
       }
-      // A job finished before this watch's `after_seq`: nothing more will come.
+      if (!events.empty()) continue;
+      // Quiet: a job that finished before this watch's `after_seq` sends nothing more.
       const parapm::v1::Job job = coordinator_.job(request->job_id());
       if (job.state() == parapm::v1::DONE || job.state() == parapm::v1::FAILED ||
           job.state() == parapm::v1::CANCELLED) {

@@ -14,6 +14,7 @@
 #include "parapm.grpc.pb.h"
 #include "rpc_security.h"
 #include "rpc_status.h"
+#include "util/clock.h"
 #include "util/error.h"
 
 namespace parapm::service {
@@ -71,8 +72,7 @@ void call_worker(Flight& flight, parapm::v1::WorkerService::Stub& stub,
     }
   }
   flight.status = reader->Finish();
-  flight.call_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  flight.call_seconds = seconds_since(start);
   if (!broken.empty())
     flight.status = {grpc::StatusCode::DATA_LOSS, "the worker's reply does not decode: " + broken};
   else if (flight.status.ok() && !summary)
@@ -104,8 +104,7 @@ std::vector<SubsetResult> RemoteRunner::run(std::vector<SubsetJob>& jobs,
     requests[i].set_job(encode_subset_job(jobs[i]));
     transport_.job_bytes += requests[i].job().size();
   }
-  transport_.encode_seconds +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - encode_start).count();
+  transport_.encode_seconds += seconds_since(encode_start);
   std::deque<size_t> pending;
   for (size_t i = 0; i < n; ++i) pending.push_back(i);
   std::vector<uint32_t> attempts(n, 0);

@@ -9,6 +9,7 @@
 #include "parallel/job_codec.h"
 #include "parallel/simplify_subset.h"
 #include "rpc_server.h"
+#include "util/clock.h"
 #include "util/error.h"
 #include "util/progress.h"
 
@@ -108,9 +109,7 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
       result = simplify_subset(job, progress, &cancel);
     } catch (const Error& e) {
       if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded)
-        spdlog::info(
-            "{}: stopped ({}) after {:.3f} s", name, e.what(),
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        spdlog::info("{}: stopped ({}) after {:.3f} s", name, e.what(), seconds_since(start));
       else
         spdlog::warn("{}: failed: {}", name, e.what());
       throw;
@@ -128,8 +127,7 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
     if (!writer->Write(message))
       return grpc::Status(grpc::StatusCode::CANCELLED, "the coordinator went away");
     spdlog::info("{}: {} collapses in {:.3f} s ({:.3f} s CPU), {}", name, result.records.size(),
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                 result.cpu_seconds, result.stats.stop_reason);
+                 seconds_since(start), result.cpu_seconds, result.stats.stop_reason);
     return grpc::Status::OK;
   });
 }

@@ -18,14 +18,11 @@
 #include "simplify/pm_builder.h"
 #include "simplify/simplifier.h"
 #include "simplify/surface_samples.h"
+#include "util/clock.h"
 #include "util/error.h"
 
 namespace parapm {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Partitions the live part of `mesh` (a compact copy: the partitioner wants a plain mesh) into
 // p subsets; vertex_subset gets, per vertex of `mesh`, its subset (0 for dead vertices), and

@@ -10,6 +10,7 @@
 #include "parallel/job_state.h"
 #include "parallel/subset_rule.h"
 #include "simplify/simplify.h"
+#include "util/clock.h"
 
 namespace parapm {
 namespace {
@@ -79,8 +80,7 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   for (CollapseRecord& r : result.records) globalise(r, job);
   if (!job.state.empty()) result.state = export_result_state(*metric, working, job);
   result.stats = simplifier.stats();
-  result.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   spdlog::debug(
       "round {} subset {} simplified {}->{} faces ({} owned, {} free vertices) in {:.3f} s"

@@ -9,6 +9,7 @@
 #include "simplify/pm_builder.h"
 #include "simplify/quadric_priority.h"
 #include "simplify/simplifier.h"
+#include "util/clock.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -93,8 +94,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   build_options.keep_order = options.keep_order;
   ProgressiveMesh pm = build_pm_from_collapses(repaired, working, records, build_options);
   pm.info.metric = priority->name();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = seconds_since(start);
   pm.info.seconds = seconds;
   if (stats) {
     stats->collapses = simplifier.stats().collapses;
