@@ -106,25 +106,26 @@ class EnergyPriority : public PriorityModule {
   void import_global(const EnergyState& state);
 
   // Observers, for tests and reports.
-  size_t point_count() const { return points_.size(); }
-  // The face the point projects onto (meaningless while the point is parked).
-  FaceId point_face(size_t i) const { return points_[i].face; }
-  // The vertex the point is the sample of, while that vertex has not moved; else kNoId.
-  VertexId point_parked_at(size_t i) const {
-    const VertexId v = sample_vertex_[i];
-    return v != kNoId && parked_point_[v] == i ? v : kNoId;
-  }
-  double point_distance_sq(size_t i) const { return points_[i].distance_sq; }
-  const Vec3& point_position(size_t i) const { return points_[i].position; }
+  size_t point_count() const { return positions_.size(); }
+  struct PointState {
+    Vec3 position{};
+    double distance_sq = 0;   // to its face, as of the last collapse that touched it
+    FaceId face = kNoId;      // the face it projects onto; kNoId while parked
+    VertexId parked = kNoId;  // the vertex it is the sample of, while that vertex has not moved
+  };
+  // Every point's state, by id (a scan of every face: for tests and reports).
+  std::vector<PointState> point_states() const;
   const SharpCurves& curves() const { return curves_; }
 
  private:
   static constexpr uint32_t kNoPoint = 0xffffffffu;
-  struct Point {
+  // A point as its face holds it: each face keeps its points contiguously, so that the late
+  // collapses, whose stars hold hundreds of points, read them in sequence, not one cache miss
+  // per point.
+  struct FacePoint {
     Vec3 position{};
     double distance_sq = 0;  // to its face, as of the last collapse that touched it
-    FaceId face = kNoId;
-    uint32_t next = kNoPoint;  // the next point of the same face's list
+    uint32_t id = kNoPoint;
   };
   // A face of the star after the collapse: (v, p1, p2) counter-clockwise, v the moving vertex
   // (which was at `before`). `next` and `previous` are the faces across the edges (v, p2) and
@@ -151,8 +152,8 @@ class EnergyPriority : public PriorityModule {
     Vec3 b{};                    // sum of b0 (x - b1 p1 - b2 p2)
   };
 
-  Fit project_points(const std::vector<uint32_t>& ids, const std::vector<int>& homes, const Vec3& v,
-                     std::vector<Projected>* where = nullptr) const;
+  Fit project_points(const std::vector<FacePoint>& points, const std::vector<int>& homes,
+                     const Vec3& v, std::vector<Projected>* where = nullptr) const;
   double scalar_change() const;
   const PointMoments& moments_of(FaceId f) const;
   double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2) const;
@@ -162,9 +163,14 @@ class EnergyPriority : public PriorityModule {
   double moment_distance_before(const CollapseMesh& mesh) const;
   double moment_distance_after(const Vec3& v) const;
   Vec3 moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b) const;
+  void prepare_fan(const CollapseMesh& mesh, VertexId vs);
+  std::pair<int, Projection> closest_fan_face(const CollapseMesh& mesh,
+                                              const std::vector<FaceId>& faces,
+                                              const FacePoint& point, int home) const;
   void update_attributes(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge);
   void gather_face(FaceId f, int home) const;
   void unpark(VertexId v);
+  FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
   double diagonal_of(const CollapseMesh& mesh) const;
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
@@ -174,10 +180,9 @@ class EnergyPriority : public PriorityModule {
 
   std::vector<uint8_t> locked_;
   EnergyOptions options_;
-  std::vector<Point> points_;
-  std::vector<uint32_t> face_first_;     // per face: its first point (a singly linked list)
-  std::vector<uint32_t> parked_point_;   // per vertex: its sample while it has not moved
-  std::vector<VertexId> sample_vertex_;  // per point: the vertex it samples, or kNoId
+  std::vector<Vec3> positions_;                      // per point (they never move)
+  std::vector<std::vector<FacePoint>> face_points_;  // per face: the points projecting onto it
+  std::vector<uint32_t> parked_point_;  // per vertex: its sample while it has not moved
   SharpCurves curves_;
   WedgeAttributes attributes_;       // the input's; initialize copies them into scalar_
   mutable ScalarAttributes scalar_;  // its star scratch is used by the const evaluate
@@ -190,13 +195,14 @@ class EnergyPriority : public PriorityModule {
   // with the star face their points are measured against (-2, -3: the removed faces, homed
   // once the fan is known).
   mutable std::vector<std::pair<FaceId, int>> star_lists_;
-  mutable std::vector<uint32_t> star_points_;
+  mutable std::vector<VertexId> fan_first_ids_, fan_second_ids_;  // star_'s id1, id2
+  mutable std::vector<FacePoint> star_points_;
   // Per star point: the star face its face becomes (-1, -2: the samples of a and b).
   mutable std::vector<int> star_homes_;
   mutable int a_side_faces_ = 0;
   mutable std::array<FaceId, 2> edge_faces_{kNoId, kNoId};  // the two faces the collapse removes
   mutable std::array<int, 2> edge_face_homes_{};            // the star faces their points go to
-  mutable std::vector<uint32_t> parked_ends_;               // the samples of a and b, while parked
+  mutable std::vector<FacePoint> parked_ends_;              // the samples of a and b, while parked
   mutable std::vector<int> parked_end_homes_;
   // Per face, the moments of the points projecting onto it (computed when first needed,
   // forgotten when its point list changes).
@@ -206,6 +212,12 @@ class EnergyPriority : public PriorityModule {
   mutable int joined_count_ = 0;
   mutable std::vector<Projected> projected_;  // per star point, at the chosen placement
   mutable std::array<std::vector<Projected>, 16> placement_projections_;
+  // collapsed(): per face around vs, its bounding sphere.
+  struct FanFace {
+    Vec3 center{};
+    double radius = 0;
+  };
+  std::vector<FanFace> fan_;
   std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
   std::vector<std::array<double, 3>> moved_bary_;
   mutable std::vector<PreparedTriangle> prepared_;  // star_ with v at the projected position

@@ -97,7 +97,9 @@ inline Projection project_on_triangle(const Vec3& p, const Vec3& a, const Vec3& 
 // A triangle prepared for many projections: a point whose plane projection falls inside (the
 // common case) costs two dot products and a few multiplies; outside, the closest point is on
 // an edge across which the projection lies (a negative barycentric coordinate), so at most
-// two segments are tried. Degenerate triangles go to project_on_triangle.
+// two segments are tried. Degenerate triangles go to project_on_triangle. Always inlined: it
+// is the innermost loop of the energy, and the compiler stops inlining it once it has a few
+// callers.
 class PreparedTriangle {
  public:
   PreparedTriangle() = default;
@@ -111,7 +113,7 @@ class PreparedTriangle {
     fast_ = det > 1e-12 * d11_ * d22_ && det > 0;
     inverse_det_ = fast_ ? 1.0 / det : 0.0;
   }
-  Projection project(const Vec3& p) const {
+  [[gnu::always_inline]] Projection project(const Vec3& p) const {
     if (fast_) {
       const Vec3 w = sub(p, a_);
       const double t1 = dot(e1_, w), t2 = dot(e2_, w);

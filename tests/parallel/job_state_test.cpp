@@ -191,20 +191,21 @@ TEST(JobState, ImportedStateEqualsTheReplayedState) {
         ASSERT_EQ(e->point_count(), r->point_count());
         size_t parked = 0, other_face = 0;
         double sum_master = 0, sum_replayed = 0;
-        for (size_t i = 0; i < e->point_count(); ++i) {
-          ASSERT_EQ(e->point_parked_at(i), r->point_parked_at(i)) << what << " point " << i;
-          if (e->point_parked_at(i) != kNoId) {
+        const auto es = e->point_states(), rs = r->point_states();
+        for (size_t i = 0; i < es.size(); ++i) {
+          ASSERT_EQ(es[i].parked, rs[i].parked) << what << " point " << i;
+          if (es[i].parked != kNoId) {
             ++parked;
             continue;
           }
-          sum_master += e->point_distance_sq(i);
-          sum_replayed += r->point_distance_sq(i);
-          if (e->point_face(i) != r->point_face(i)) {
+          sum_master += es[i].distance_sq;
+          sum_replayed += rs[i].distance_sq;
+          if (es[i].face != rs[i].face) {
             ++other_face;
             continue;
           }
           if (round == 0) {
-            ASSERT_EQ(e->point_distance_sq(i), r->point_distance_sq(i)) << what << " point " << i;
+            ASSERT_EQ(es[i].distance_sq, rs[i].distance_sq) << what << " point " << i;
           }
         }
         // Round 0: exactly. From the second round on, a job's mesh lists each vertex's faces

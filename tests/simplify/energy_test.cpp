@@ -171,22 +171,25 @@ TEST(EnergyPriority, PointsFollowTheirFacesThroughCollapses) {
   ASSERT_EQ(energy.point_count(), m.vertex_count() + 2 * m.face_count());
   double worst = 0;
   size_t parked = 0;
-  for (size_t i = 0; i < energy.point_count(); ++i) {
-    if (const VertexId v = energy.point_parked_at(i); v != kNoId) {
+  const auto states = energy.point_states();
+  for (size_t i = 0; i < states.size(); ++i) {
+    const auto& point = states[i];
+    if (const VertexId v = point.parked; v != kNoId) {
       // Parked: the sample of a vertex that never moved, on the mesh by construction.
       ASSERT_TRUE(cm.vertex_alive(v));
-      ASSERT_EQ(energy.point_position(i), cm.position(v));
-      ASSERT_EQ(energy.point_distance_sq(i), 0);
+      ASSERT_EQ(point.position, cm.position(v));
+      ASSERT_EQ(point.distance_sq, 0);
       ++parked;
       continue;
     }
-    const FaceId f = energy.point_face(i);
+    const FaceId f = point.face;
+    ASSERT_NE(f, kNoId) << "point " << i << " is on no face";
     ASSERT_TRUE(cm.face_alive(f)) << "point " << i;
     const Triangle& t = cm.face(f);
-    const double d = project_on_triangle(energy.point_position(i), cm.position(t[0]),
-                                         cm.position(t[1]), cm.position(t[2]))
-                         .distance_sq;
-    ASSERT_NEAR(energy.point_distance_sq(i), d, 1e-12) << "point " << i;
+    const double d =
+        project_on_triangle(point.position, cm.position(t[0]), cm.position(t[1]), cm.position(t[2]))
+            .distance_sq;
+    ASSERT_NEAR(point.distance_sq, d, 1e-12) << "point " << i;
     worst = std::max(worst, std::sqrt(d));
   }
   // The error a record carries is the largest distance of its star's points once performed,
