@@ -52,6 +52,8 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"faces_after", r.faces_after},
                       {"partition_seconds", r.partition_seconds},
                       {"extract_seconds", r.extract_seconds},
+                      {"slowest_extract_cpu_seconds", r.slowest_extract_cpu_seconds},
+                      {"extract_critical_seconds", r.extract_critical_seconds},
                       {"subsets_seconds", r.subsets_seconds},
                       {"merge_seconds", r.merge_seconds},
                       {"slowest_subset_cpu_seconds", r.slowest_subset_cpu_seconds},

@@ -239,32 +239,44 @@ ProgressiveMesh build_progressive_mesh_parallel(
     rs.partition_seconds = seconds_since(t);
     if (events.partitioned) events.partitioned(round, parallel.subsets, rs.faces_before);
 
+    // The jobs: which vertices each subset owns (sequential, O(vertices)), the water level
+    // (sequential, on the master), then each job's mesh and the master's state over it, one
+    // job per pool task (const reads of the whole mesh and the master: concurrently). With a
+    // core per subset, only the slowest job's extraction is on the critical path.
     t = std::chrono::steady_clock::now();
-    // The jobs' meshes carry the input's wedge values; the metric's current ones (E_scalar)
-    // travel in the state.
-    std::vector<SubsetJob> jobs =
-        extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                        vertex_subset, parallel.subsets, round, subset_options);
-    set_targets(jobs, assigned, rs.faces_before, rs.goal_faces);
+    const std::vector<std::vector<VertexId>> owned =
+        owned_vertices(whole, vertex_subset, parallel.subsets);
+    double sequential_extract = seconds_since(t);
     if (parallel.water_level_factor > 0) {
       const auto ts = std::chrono::steady_clock::now();
       rs.water_level = water_level(whole, *master, vertex_subset, parallel.subsets,
                                    rs.faces_before - rs.goal_faces, parallel.water_level_factor);
+      rs.share_seconds = seconds_since(ts);
+      sequential_extract += rs.share_seconds;
+    }
+    std::vector<SubsetJob> jobs(parallel.subsets);
+    std::vector<double> job_cpu(jobs.size(), 0);
+    run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
+      const double cpu = thread_cpu_seconds();
+      // The jobs' meshes carry the input's wedge values; the metric's current ones
+      // (E_scalar) travel in the state.
+      jobs[i] = extract_subset(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
+                               locked, vertex_subset, owned[i], uint32_t(i), round, subset_options);
+      jobs[i].state = export_job_state(*master, jobs[i]);
+      job_cpu[i] = thread_cpu_seconds() - cpu;
+    });
+    set_targets(jobs, assigned, rs.faces_before, rs.goal_faces);
+    if (parallel.water_level_factor > 0)
       for (SubsetJob& job : jobs)
         job.options.max_cost = job.options.max_cost > 0
                                    ? std::min(job.options.max_cost, rs.water_level)
                                    : rs.water_level;
-      rs.share_seconds = seconds_since(ts);
+    for (double c : job_cpu) {
+      subsets_cpu += c;  // master work, on the pool's threads
+      rs.slowest_extract_cpu_seconds = std::max(rs.slowest_extract_cpu_seconds, c);
     }
-    // The master's state of each job (const reads of the master: concurrently).
-    std::vector<double> export_cpu(jobs.size(), 0);
-    run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
-      const double cpu = thread_cpu_seconds();
-      jobs[i].state = export_job_state(*master, jobs[i]);
-      export_cpu[i] = thread_cpu_seconds() - cpu;
-    });
-    for (double c : export_cpu) subsets_cpu += c;  // master work, on the pool's threads
     rs.extract_seconds = seconds_since(t);
+    rs.extract_critical_seconds = sequential_extract + rs.slowest_extract_cpu_seconds;
 
     t = std::chrono::steady_clock::now();
     std::vector<SubsetResult> results = runner->run(jobs, cancel);
@@ -323,7 +335,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     }
     rs.band_pass_seconds = seconds_since(t);
     rs.faces_after = whole.live_faces();
-    st.critical_path_seconds += rs.partition_seconds + rs.extract_seconds +
+    st.critical_path_seconds += rs.partition_seconds + rs.extract_critical_seconds +
                                 rs.slowest_subset_cpu_seconds + rs.merge_seconds +
                                 rs.band_pass_seconds;
     spdlog::debug(

@@ -59,8 +59,12 @@ struct RoundStats {
   uint64_t goal_faces = 0;  // what the round aimed at
   uint64_t faces_after = 0;
   double partition_seconds = 0;
-  double extract_seconds = 0;  // jobs and their state, shares included
+  double extract_seconds = 0;  // jobs and their state, shares included (wall)
   double share_seconds = 0;    // of which costing the edge sample for the water level
+  // Each job's mesh and state are built on the pool: the slowest one's CPU, and the
+  // extraction's share of the critical path (its sequential steps plus the slowest job).
+  double slowest_extract_cpu_seconds = 0;
+  double extract_critical_seconds = 0;
   double water_level = 0;      // the jobs' cost ceiling (ParallelOptions::water_level_factor)
   double subsets_seconds = 0;  // wall time of the round's jobs
   double merge_seconds = 0;    // k-way merge, replay on the whole mesh, state import
@@ -84,8 +88,9 @@ struct ParallelStats {
   double seconds = 0;       // the whole construction, wall
   double cpu_seconds = 0;   // the subsets' CPU plus the master's (partition, merge, final pass)
   // What the build would take with one processor per subset: setup, then per round the
-  // partition, extraction, the slowest subset's CPU and the merge, then the final pass and
-  // the PM assembly (subset CPU, not wall: on a loaded machine wall time is not the job's).
+  // partition, extraction (its sequential steps and the slowest job's), the slowest subset's
+  // CPU, the merge and the band pass, then the final pass and the PM assembly (CPU of the
+  // jobs, not wall: on a loaded machine wall time is not the job's).
   double critical_path_seconds = 0;
 };
 

@@ -12,12 +12,14 @@ uint32_t local_of(const std::vector<uint32_t>& ids, uint32_t global) {
   return uint32_t(std::lower_bound(ids.begin(), ids.end(), global) - ids.begin());
 }
 
-SubsetJob extract_one(const CollapseMesh& mesh, const AttributeLayout& layout,
-                      const std::vector<float>& wedge_values, bool positions_are_float,
-                      const std::vector<uint8_t>& locked,
-                      const std::vector<uint32_t>& vertex_subset,
-                      const std::vector<VertexId>& owned_vertices, uint32_t subset, uint32_t round,
-                      const SubsetOptions& options) {
+}  // namespace
+
+SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout,
+                         const std::vector<float>& wedge_values, bool positions_are_float,
+                         const std::vector<uint8_t>& locked,
+                         const std::vector<uint32_t>& vertex_subset,
+                         const std::vector<VertexId>& owned_vertices, uint32_t subset,
+                         uint32_t round, const SubsetOptions& options) {
   SubsetJob job;
   job.round = round;
   job.subset = subset;
@@ -88,13 +90,9 @@ SubsetJob extract_one(const CollapseMesh& mesh, const AttributeLayout& layout,
   return job;
 }
 
-}  // namespace
-
-std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const AttributeLayout& layout,
-                                       const std::vector<float>& wedge_values,
-                                       bool positions_are_float, const std::vector<uint8_t>& locked,
-                                       const std::vector<uint32_t>& vertex_subset, uint32_t subsets,
-                                       uint32_t round, const SubsetOptions& options) {
+std::vector<std::vector<VertexId>> owned_vertices(const CollapseMesh& mesh,
+                                                  const std::vector<uint32_t>& vertex_subset,
+                                                  uint32_t subsets) {
   if (vertex_subset.size() != mesh.vertex_capacity())
     throw_invalid("extract_subsets: the partition has " + std::to_string(vertex_subset.size()) +
                   " vertices, the mesh " + std::to_string(mesh.vertex_capacity()));
@@ -106,11 +104,20 @@ std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const Attribute
                     std::to_string(vertex_subset[v]) + " of " + std::to_string(subsets));
     owned[vertex_subset[v]].push_back(v);
   }
+  return owned;
+}
+
+std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const AttributeLayout& layout,
+                                       const std::vector<float>& wedge_values,
+                                       bool positions_are_float, const std::vector<uint8_t>& locked,
+                                       const std::vector<uint32_t>& vertex_subset, uint32_t subsets,
+                                       uint32_t round, const SubsetOptions& options) {
+  const std::vector<std::vector<VertexId>> owned = owned_vertices(mesh, vertex_subset, subsets);
   std::vector<SubsetJob> jobs;
   jobs.reserve(subsets);
   for (uint32_t s = 0; s < subsets; ++s)
-    jobs.push_back(extract_one(mesh, layout, wedge_values, positions_are_float, locked,
-                               vertex_subset, owned[s], s, round, options));
+    jobs.push_back(extract_subset(mesh, layout, wedge_values, positions_are_float, locked,
+                                  vertex_subset, owned[s], s, round, options));
   return jobs;
 }
 

@@ -79,6 +79,19 @@ std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const Attribute
                                        const std::vector<uint32_t>& vertex_subset, uint32_t subsets,
                                        uint32_t round, const SubsetOptions& options);
 
+// The two steps of extract_subsets, for a caller that builds the jobs concurrently: the live
+// vertices of each subset, in id order (checked against the mesh, O(vertices)), then one
+// subset's job from its list (const reads of `mesh` only: jobs may be built in parallel).
+std::vector<std::vector<VertexId>> owned_vertices(const CollapseMesh& mesh,
+                                                  const std::vector<uint32_t>& vertex_subset,
+                                                  uint32_t subsets);
+SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout,
+                         const std::vector<float>& wedge_values, bool positions_are_float,
+                         const std::vector<uint8_t>& locked,
+                         const std::vector<uint32_t>& vertex_subset,
+                         const std::vector<VertexId>& owned, uint32_t subset, uint32_t round,
+                         const SubsetOptions& options);
+
 // Checks what a job can check on its own: sizes agree, local ids in range, global ids
 // strictly increasing, every face touches an owned vertex. Throws Error(kInvalidInput)
 // naming the first violation. A worker calls it on a job that came over the network.
