@@ -775,8 +775,8 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   done.error = std::sqrt(max_distance_sq);
 }
 
-// The faces around vs after a collapse, prepared for projections, with the bounding sphere
-// of each (its centroid and the squared distance to its farthest corner).
+// The faces around vs after a collapse, prepared for projections, with what closest_fan_face
+// bounds distances by (FanFace).
 void EnergyPriority::prepare_fan(const CollapseMesh& mesh, VertexId vs) {
   const auto& faces = mesh.faces_of(vs);
   prepared_.clear();
@@ -791,6 +791,9 @@ void EnergyPriority::prepare_fan(const CollapseMesh& mesh, VertexId vs) {
       const Vec3 d = sub(*p, fan.center);
       fan.radius = std::max(fan.radius, std::sqrt(dot(d, d)));
     }
+    const Vec3 n = triangle_normal(p0, p1, p2);
+    const double n_sq = dot(n, n);
+    if (n_sq > 0) fan.normal = scale(n, 1.0 / std::sqrt(n_sq));
     fan_.push_back(fan);
   }
 }
@@ -798,10 +801,11 @@ void EnergyPriority::prepare_fan(const CollapseMesh& mesh, VertexId vs) {
 // The face of the fan (prepare_fan) a point goes to: the closest, the first in the fan's order
 // among equally close ones (as if each were tried in turn), and the point's projection there.
 // Late collapses move hundreds of points over a fan of 6-8 faces: the face the point was on
-// (its home) is tried first, and a face whose bounding sphere lies farther than the best so
-// far is skipped without projecting. With E_scalar the points go where their whole energy is
-// least (a point on a seam is as close to the faces of both sides and belongs to the side
-// whose attributes it has); the distance is a lower bound of that too.
+// (its home) is tried first, and a face is skipped without projecting when a lower bound of
+// the distance (the height over its plane, and how far outside a disc holding it the point
+// lies) exceeds the best so far. With E_scalar the points go where their whole energy is least
+// (a point on a seam is as close to the faces of both sides and belongs to the side whose
+// attributes it has); the distance is a lower bound of that too.
 std::pair<int, Projection> EnergyPriority::closest_fan_face(const CollapseMesh& mesh,
                                                             const std::vector<FaceId>& faces,
                                                             const FacePoint& point,
@@ -810,7 +814,6 @@ std::pair<int, Projection> EnergyPriority::closest_fan_face(const CollapseMesh& 
   int best_j = -1;
   Projection best;
   double best_score = std::numeric_limits<double>::infinity();
-  double reach = std::numeric_limits<double>::infinity();  // sqrt(best_score)
   auto consider = [&](int j) {
     const Projection p = prepared_[j].project(x);
     const double score = scalar_.enabled()
@@ -819,16 +822,25 @@ std::pair<int, Projection> EnergyPriority::closest_fan_face(const CollapseMesh& 
                              : p.distance_sq;
     if (score < best_score || (score == best_score && j < best_j)) {
       best_score = score, best = p, best_j = j;
-      reach = std::sqrt(score);
     }
   };
   if (home >= 0) consider(home);
   for (int j = 0; j < int(faces.size()); ++j) {
     if (j == home) continue;
+    // A lower bound of the squared distance to face j: the height over its plane, and how far
+    // outside the disc around its centroid that holds it the point lies within the plane.
     const FanFace& fan = fan_[j];
     const Vec3 d = sub(x, fan.center);
-    const double bound = fan.radius + reach;
-    if (dot(d, d) > bound * bound) continue;  // every point of the face is farther than best
+    const double height = dot(fan.normal, d);
+    // (A margin, relative to the face's size, keeps rounding from skipping a face that ties.)
+    const double limit = best_score + 1e-9 * (best_score + fan.radius * fan.radius);
+    const double height_sq = height * height;
+    if (height_sq > limit) continue;
+    const double in_plane_sq = dot(d, d) - height_sq;
+    if (in_plane_sq > fan.radius * fan.radius) {
+      const double outside = std::sqrt(in_plane_sq) - fan.radius;
+      if (height_sq + outside * outside > limit) continue;
+    }
     consider(j);
   }
   if (best_j < 0) {  // nothing finite: the first face, as the exhaustive scan would

@@ -212,10 +212,12 @@ class EnergyPriority : public PriorityModule {
   mutable int joined_count_ = 0;
   mutable std::vector<Projected> projected_;  // per star point, at the chosen placement
   mutable std::array<std::vector<Projected>, 16> placement_projections_;
-  // collapsed(): per face around vs, its bounding sphere.
+  // collapsed(): per face around vs, its centroid, the radius of the disc around it that holds
+  // the face, and its unit normal (0 for a degenerate face).
   struct FanFace {
     Vec3 center{};
     double radius = 0;
+    Vec3 normal{};
   };
   std::vector<FanFace> fan_;
   std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
