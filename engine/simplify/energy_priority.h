@@ -197,7 +197,8 @@ class EnergyPriority : public PriorityModule {
   mutable std::vector<std::pair<FaceId, int>> star_lists_;
   mutable std::vector<VertexId> fan_first_ids_, fan_second_ids_;  // star_'s id1, id2
   mutable std::vector<FacePoint> star_points_;
-  // Per star point: the star face its face becomes (-1, -2: the samples of a and b).
+  // Per star point: the star face its face becomes (-1, -2: the samples of a and b). In
+  // collapsed(): the index among vs's faces of its old face's image (-1: an unparked sample).
   mutable std::vector<int> star_homes_;
   mutable int a_side_faces_ = 0;
   mutable std::array<FaceId, 2> edge_faces_{kNoId, kNoId};  // the two faces the collapse removes
