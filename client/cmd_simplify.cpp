@@ -56,6 +56,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"extract_critical_seconds", r.extract_critical_seconds},
                       {"subsets_seconds", r.subsets_seconds},
                       {"merge_seconds", r.merge_seconds},
+                      {"merge_overlap_seconds", r.merge_overlap_seconds},
                       {"slowest_subset_cpu_seconds", r.slowest_subset_cpu_seconds},
                       {"water_level", r.water_level},
                       {"band_pass_collapses", r.band_pass_collapses},

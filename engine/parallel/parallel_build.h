@@ -68,6 +68,9 @@ struct RoundStats {
   double water_level = 0;      // the jobs' cost ceiling (ParallelOptions::water_level_factor)
   double subsets_seconds = 0;  // wall time of the round's jobs
   double merge_seconds = 0;    // k-way merge, replay on the whole mesh, state import
+  // Replay and state import run side by side on two threads; on one thread (--threads 1),
+  // the shorter of the two, which the critical path leaves out.
+  double merge_overlap_seconds = 0;
   double slowest_subset_cpu_seconds = 0;
   uint64_t band_pass_collapses = 0;  // sequential, after the merge (ParallelOptions::band_pass)
   double band_pass_seconds = 0;
