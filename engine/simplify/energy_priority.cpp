@@ -183,30 +183,86 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
 }
 
 void EnergyPriority::import_global(const EnergyState& state) {
+  check_global_state(state);
   for (FaceId f : state.faces) {
-    if (f >= face_points_.size()) throw_invalid("energy state: face out of range");
     face_points_[f].clear();
     moments_ready_[f] = 0;
   }
-  for (VertexId v : state.vertices) {
-    if (v >= parked_point_.size()) throw_invalid("energy state: vertex out of range");
-    parked_point_[v] = kNoPoint;
-  }
+  for (VertexId v : state.vertices) parked_point_[v] = kNoPoint;
   // The faces keep the written order.
   for (const EnergyState::Point& p : state.points) {
-    if (p.id >= positions_.size()) throw_invalid("energy state: point id out of range");
-    positions_[p.id] = p.position;
     if (p.face != kNoId) {
-      if (p.face >= face_points_.size()) throw_invalid("energy state: face out of range");
-      face_points_[p.face].push_back({p.position, p.distance_sq, p.id});
+      face_points_[p.face].push_back({positions_[p.id], p.distance_sq, p.id});
     } else {
-      if (p.vertex >= parked_point_.size()) throw_invalid("energy state: vertex out of range");
       parked_point_[p.vertex] = p.id;
     }
     if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
   }
   if (options_.discontinuities) curves_.import_global(state);
   scalar_.import_global(state);
+}
+
+// What a job gives back (possibly from a worker over the network) may only rearrange the
+// points it was given: every point once, one that was on the state's faces or parked at its
+// vertices, at the position it was sampled at (points never move), on one of those faces or
+// parked at one of those vertices. Checked before the master changes anything. (A point may be
+// missing: a collapse that leaves its vertex without faces drops its star's points, as the
+// sequential build does.)
+void EnergyPriority::check_global_state(const EnergyState& state) const {
+  std::vector<uint8_t>& face_mark = import_face_mark_;
+  std::vector<uint8_t>& vertex_mark = import_vertex_mark_;
+  std::vector<uint8_t>& point_mark = import_point_mark_;
+  face_mark.resize(face_points_.size(), 0);
+  vertex_mark.resize(parked_point_.size(), 0);
+  point_mark.resize(positions_.size(), 0);
+  std::string problem;
+  for (FaceId f : state.faces) {
+    if (f >= face_points_.size()) {
+      problem = "face " + std::to_string(f) + " out of range";
+      break;
+    }
+    face_mark[f] = 1;
+    for (const FacePoint& p : face_points_[f]) point_mark[p.id] = 1;
+  }
+  if (problem.empty())
+    for (VertexId v : state.vertices) {
+      if (v >= parked_point_.size()) {
+        problem = "vertex " + std::to_string(v) + " out of range";
+        break;
+      }
+      vertex_mark[v] = 1;
+      if (parked_point_[v] != kNoPoint) point_mark[parked_point_[v]] = 1;
+    }
+  if (problem.empty())
+    for (const EnergyState::Point& p : state.points) {
+      const std::string name = "point " + std::to_string(p.id);
+      if (p.id >= positions_.size()) {
+        problem = name + " out of range";
+      } else if (point_mark[p.id] != 1) {
+        problem = name + (point_mark[p.id] == 2 ? " given twice" : " is not the job's");
+      } else if (p.position != positions_[p.id]) {
+        problem = name + " moved from where it was sampled";
+      } else if (p.face != kNoId ? p.face >= face_mark.size() || !face_mark[p.face]
+                                 : p.vertex >= vertex_mark.size() || !vertex_mark[p.vertex]) {
+        problem = name + " is on a face or vertex the state does not list";
+      }
+      if (!problem.empty()) break;
+      point_mark[p.id] = 2;
+    }
+  // Clear the marks (only what was set), whatever the outcome.
+  for (FaceId f : state.faces) {
+    if (f >= face_points_.size()) break;
+    face_mark[f] = 0;
+    for (const FacePoint& p : face_points_[f]) point_mark[p.id] = 0;
+  }
+  for (VertexId v : state.vertices) {
+    if (v >= parked_point_.size()) break;
+    vertex_mark[v] = 0;
+    if (parked_point_[v] != kNoPoint) point_mark[parked_point_[v]] = 0;
+  }
+  for (const EnergyState::Point& p : state.points)
+    if (p.id < point_mark.size()) point_mark[p.id] = 0;
+  if (!problem.empty()) throw_invalid("energy state: " + problem);
 }
 
 std::vector<EnergyPriority::PointState> EnergyPriority::point_states() const {

@@ -103,7 +103,7 @@ class EnergyPriority : public PriorityModule {
   void import_local(const CollapseMesh& mesh, const EnergyState& state);
   EnergyState export_global(const CollapseMesh& mesh, const IdMaps& maps,
                             const std::vector<uint8_t>& owned) const;
-  void import_global(const EnergyState& state);
+  void import_global(const EnergyState& state);  // checks the state first (kInvalidInput)
 
   // Observers, for tests and reports.
   size_t point_count() const { return positions_.size(); }
@@ -163,6 +163,7 @@ class EnergyPriority : public PriorityModule {
   double moment_distance_before(const CollapseMesh& mesh) const;
   double moment_distance_after(const Vec3& v) const;
   Vec3 moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b) const;
+  void check_global_state(const EnergyState& state) const;
   void prepare_fan(const CollapseMesh& mesh, VertexId vs);
   std::pair<int, Projection> closest_fan_face(const CollapseMesh& mesh,
                                               const std::vector<FaceId>& faces,
@@ -221,6 +222,8 @@ class EnergyPriority : public PriorityModule {
     Vec3 normal{};
   };
   std::vector<FanFace> fan_;
+  // check_global_state's marks, all 0 between calls.
+  mutable std::vector<uint8_t> import_face_mark_, import_vertex_mark_, import_point_mark_;
   std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
   std::vector<std::array<double, 3>> moved_bary_;
   mutable std::vector<PreparedTriangle> prepared_;  // star_ with v at the projected position

@@ -4,7 +4,9 @@
 // point for point, the state a replay of every merged record through collapsed() gives.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 
 #include "parallel/collapse_merge.h"
 #include "parallel/job_state.h"
@@ -16,6 +18,7 @@
 #include "simplify/quadric_priority.h"
 #include "simplify/simplifier.h"
 #include "simplify/simplify.h"
+#include "util/error.h"
 
 namespace parapm {
 namespace {
@@ -239,6 +242,89 @@ TEST(JobState, ImportedStateEqualsTheReplayedState) {
       }
     }
   }
+}
+
+// What a job gives back may come from a worker over the network: an energy state that loses
+// track of its points (one given twice, one that is another job's, one moved from where it
+// was sampled, one put on a face the state does not list) is refused before the master
+// changes, and the honest state is then taken as usual.
+TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const SimplifyOptions options = options_of("energy");
+  const Mesh& mesh = repaired.mesh;
+  CollapseMesh whole(mesh);
+  auto master = make_priority_module(options, mesh, locked);
+  master->initialize(whole);
+  std::vector<uint32_t> vertex_subset(whole.vertex_capacity(), 0);
+  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+    vertex_subset[v] = whole.position(v)[0] < 0 ? 0 : 1;  // two halves
+  std::vector<SubsetJob> jobs =
+      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                      vertex_subset, 2, 0, subset_options_of(options, mesh));
+  SubsetJob& job = jobs.at(0);
+  job.options.target_faces = job.mesh.face_count() / 2;
+  job.state = export_job_state(*master, job);
+  const SubsetResult result = simplify_subset(job);
+  const EnergyState& honest = result.state.energy;
+  ASSERT_GT(honest.points.size(), 10u);
+  const auto* energy = dynamic_cast<EnergyPriority*>(master.get());
+  ASSERT_NE(energy, nullptr);
+  const auto before = energy->point_states();
+
+  // A point the other job was given, not this one.
+  uint32_t foreign = 0;
+  bool found = false;
+  for (const EnergyState::Point& p : export_job_state(*master, jobs.at(1)).energy.points)
+    if (std::none_of(honest.points.begin(), honest.points.end(),
+                     [&](const EnergyState::Point& q) { return q.id == p.id; })) {
+      foreign = p.id;
+      found = true;
+      break;
+    }
+  ASSERT_TRUE(found);
+  const FaceId unlisted = [&] {
+    for (FaceId f = 0; f < whole.face_capacity(); ++f)
+      if (std::find(honest.faces.begin(), honest.faces.end(), f) == honest.faces.end()) return f;
+    return kNoId;
+  }();
+  ASSERT_NE(unlisted, kNoId);
+
+  struct Tamper {
+    const char* what;
+    std::function<void(EnergyState&)> change;
+  };
+  const std::vector<Tamper> tampers = {
+      {"given twice", [](EnergyState& s) { s.points.push_back(s.points.front()); }},
+      {"is not the job's", [&](EnergyState& s) { s.points.front().id = foreign; }},
+      {"moved from where it was sampled",
+       [](EnergyState& s) { s.points.front().position[0] += 1e-3; }},
+      {"does not list",
+       [&](EnergyState& s) {
+         s.points.front().face = unlisted;
+         s.points.front().vertex = kNoId;
+       }},
+      {"out of range", [](EnergyState& s) { s.points.front().id = 0xfffffff0u; }},
+  };
+  for (const Tamper& tamper : tampers) {
+    MetricState state = result.state;
+    tamper.change(state.energy);
+    try {
+      import_result_state(*master, state);
+      ADD_FAILURE() << tamper.what << ": accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << tamper.what;
+      EXPECT_NE(std::string(e.what()).find(tamper.what), std::string::npos) << e.what();
+    }
+    const auto after = energy->point_states();
+    ASSERT_EQ(after.size(), before.size());
+    for (size_t i = 0; i < after.size(); ++i) {
+      ASSERT_EQ(after[i].face, before[i].face) << tamper.what << " point " << i;
+      ASSERT_EQ(after[i].parked, before[i].parked) << tamper.what << " point " << i;
+      ASSERT_EQ(after[i].distance_sq, before[i].distance_sq) << tamper.what << " point " << i;
+    }
+  }
+  EXPECT_NO_THROW(import_result_state(*master, result.state));
 }
 
 }  // namespace
