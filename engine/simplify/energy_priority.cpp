@@ -235,18 +235,21 @@ void EnergyPriority::check_global_state(const EnergyState& state) const {
     }
   if (problem.empty())
     for (const EnergyState::Point& p : state.points) {
-      const std::string name = "point " + std::to_string(p.id);
+      const char* why = nullptr;
       if (p.id >= positions_.size()) {
-        problem = name + " out of range";
+        why = " out of range";
       } else if (point_mark[p.id] != 1) {
-        problem = name + (point_mark[p.id] == 2 ? " given twice" : " is not the job's");
+        why = point_mark[p.id] == 2 ? " given twice" : " is not the job's";
       } else if (p.position != positions_[p.id]) {
-        problem = name + " moved from where it was sampled";
+        why = " moved from where it was sampled";
       } else if (p.face != kNoId ? p.face >= face_mark.size() || !face_mark[p.face]
                                  : p.vertex >= vertex_mark.size() || !vertex_mark[p.vertex]) {
-        problem = name + " is on a face or vertex the state does not list";
+        why = " is on a face or vertex the state does not list";
       }
-      if (!problem.empty()) break;
+      if (why) {
+        problem = "point " + std::to_string(p.id) + why;
+        break;
+      }
       point_mark[p.id] = 2;
     }
   // Clear the marks (only what was set), whatever the outcome.
