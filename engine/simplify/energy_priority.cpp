@@ -815,19 +815,19 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   double max_distance_sq = curves_.collapsed(done.vs, done.vt, mesh);
   if (faces.empty()) return;
   prepare_fan(mesh, done.vs);
-  moved_faces_.clear();
-  moved_bary_.clear();
-  for (size_t i = 0; i < star_points_.size(); ++i) {
+  moved_faces_.resize(star_points_.size());
+  moved_bary_.resize(star_points_.size());
+  // Last point first: each face then lists its points newest first (see initialize()).
+  for (size_t i = star_points_.size(); i-- > 0;) {
     FacePoint& point = star_points_[i];
     const auto [j, best] = closest_fan_face(mesh, faces, point, star_homes_[i]);
     const FaceId face = faces[j];
-    moved_faces_.push_back(face);
-    moved_bary_.push_back(best.bary);
+    moved_faces_[i] = face;
+    moved_bary_[i] = best.bary;
     point.distance_sq = best.distance_sq;
     face_points_[face].push_back(point);
     max_distance_sq = std::max(max_distance_sq, best.distance_sq);
   }
-  for (FaceId f : faces) std::reverse(face_points_[f].begin(), face_points_[f].end());
   if (scalar_.enabled()) update_attributes(mesh, done, edge);
   // The largest distance of the star's points, where the evaluation may have looked at a
   // subset.
@@ -846,10 +846,12 @@ void EnergyPriority::prepare_fan(const CollapseMesh& mesh, VertexId vs) {
     prepared_.emplace_back(p0, p1, p2);
     FanFace fan;
     fan.center = scale(add(add(p0, p1), p2), 1.0 / 3);
+    double radius_sq = 0;
     for (const Vec3* p : {&p0, &p1, &p2}) {
       const Vec3 d = sub(*p, fan.center);
-      fan.radius = std::max(fan.radius, std::sqrt(dot(d, d)));
+      radius_sq = std::max(radius_sq, dot(d, d));
     }
+    fan.radius = std::sqrt(radius_sq);
     const Vec3 n = triangle_normal(p0, p1, p2);
     const double n_sq = dot(n, n);
     if (n_sq > 0) fan.normal = scale(n, 1.0 / std::sqrt(n_sq));
