@@ -16,9 +16,9 @@ class WithoutInitialize : public PriorityModule {
   explicit WithoutInitialize(PriorityModule& inner) : inner_(inner) {}
   std::string name() const override { return inner_.name(); }
   void initialize(const CollapseMesh&) override {}
-  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                CollapseCandidate& out) const override {
-    return inner_.evaluate(mesh, a, b, out);
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) const override {
+    return inner_.evaluate(mesh, a, b, out, costing);
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                  const EdgeFaces& edge) override {

@@ -104,8 +104,9 @@ double water_level(const CollapseMesh& mesh, const PriorityModule& master,
       const VertexId a = t[k], b = t[(k + 1) % 3];
       if (!inner(a, b) || index++ % stride != 0) continue;
       CollapseCandidate c;
-      costs.push_back(master.evaluate(mesh, a, b, c) ? c.cost
-                                                     : std::numeric_limits<double>::infinity());
+      costs.push_back(master.evaluate(mesh, a, b, c, Costing::kQueue)
+                          ? c.cost
+                          : std::numeric_limits<double>::infinity());
     }
   }
   if (costs.empty()) return std::numeric_limits<double>::infinity();
@@ -144,10 +145,10 @@ class BandPriority : public PriorityModule {
       : inner_(inner), touched_(touched), ceiling_(ceiling) {}
   std::string name() const override { return inner_.name(); }
   void initialize(const CollapseMesh&) override {}
-  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                CollapseCandidate& out) const override {
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) const override {
     if (touched_[a] && touched_[b]) return false;
-    return inner_.evaluate(mesh, a, b, out) && out.cost <= ceiling_;
+    return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= ceiling_;
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                  const EdgeFaces& edge) override {

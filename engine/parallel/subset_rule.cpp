@@ -54,10 +54,10 @@ class SubsetPriority : public PriorityModule {
       : inner_(inner), free_(std::move(free_vertex)), max_cost_(max_cost) {}
   std::string name() const override { return inner_.name(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
-  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                CollapseCandidate& out) const override {
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) const override {
     if (!free_[a] || !free_[b]) return false;
-    return inner_.evaluate(mesh, a, b, out) && out.cost <= max_cost_;
+    return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= max_cost_;
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                  const EdgeFaces& edge) override {

@@ -9,6 +9,7 @@
 
 #include "simplify/face_fold.h"
 #include "simplify/point_projection.h"
+#include "simplify/sample_thinning.h"
 #include "simplify/surface_samples.h"
 #include "simplify/vec_math.h"
 #include "util/error.h"
@@ -390,26 +391,28 @@ double EnergyPriority::moment_distance_after(const Vec3& v) const {
 
 // One step of iteratively reweighted least squares on the planes: each face's |n(v)|^2 taken
 // at `from`, the rest is quadratic in v (add_plane_quadratic); `iso_a` |v|^2 - 2 iso_b.v are
-// the springs' and the curves' terms, as in the projection solve.
-Vec3 EnergyPriority::moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b) const {
-  Eigen::Matrix3d h = Eigen::Matrix3d::Identity() * iso_a;
-  Eigen::Vector3d r(iso_b[0], iso_b[1], iso_b[2]);
+// the springs' and the curves' terms, as in the projection solve. `model`: the planes' and the
+// parked ends' part of what was minimised.
+Vec3 EnergyPriority::moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b,
+                                  PlaneModel* model) const {
+  PlaneModel planes;
   auto add_face = [&](FaceId source, const Vec3& p1, const Vec3& p2) {
     const PointMoments& m = moments_of(source);
     if (m.count == 0) return;
     const Vec3 n = triangle_normal(from, p1, p2);
     const double n_sq = dot(n, n);
-    if (n_sq > 0) add_plane_quadratic(m, p1, p2, 1.0 / n_sq, h, r);
+    if (n_sq > 0) add_plane_quadratic(m, p1, p2, 1.0 / n_sq, planes.h, planes.r, planes.k);
   };
   for (const StarFace& f : star_) add_face(f.source, f.p1, f.p2);
   for (int e = 0; e < 2; ++e)
     if (edge_faces_[e] != kNoId)
       add_face(edge_faces_[e], star_[edge_face_homes_[e]].p1, star_[edge_face_homes_[e]].p2);
-  if (!parked_ends_.empty()) {
-    const Fit fit = project_points(parked_ends_, parked_end_homes_, from);
-    h += Eigen::Matrix3d::Identity() * fit.a;
-    r += Eigen::Vector3d(fit.b[0], fit.b[1], fit.b[2]);
-  }
+  if (!parked_ends_.empty()) planes.ends = project_points(parked_ends_, parked_end_homes_, from);
+  const Eigen::Matrix3d h = planes.h + Eigen::Matrix3d::Identity() * (iso_a + planes.ends.a);
+  const Eigen::Vector3d r =
+      planes.r + Eigen::Vector3d(iso_b[0] + planes.ends.b[0], iso_b[1] + planes.ends.b[1],
+                                 iso_b[2] + planes.ends.b[2]);
+  if (model) *model = planes;
   const Eigen::LDLT<Eigen::Matrix3d> solver(h);
   const Eigen::Vector3d v = solver.solve(r);
   if (solver.info() != Eigen::Success || !v.allFinite()) return from;
@@ -480,7 +483,9 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
     const double b0 = best.bary[0];
     fit.a += b0 * b0;
     const Vec3 rest = add(scale(best_face->p1, best.bary[1]), scale(best_face->p2, best.bary[2]));
-    fit.b = add(fit.b, scale(sub(x, rest), b0));
+    const Vec3 offset = sub(x, rest);
+    fit.b = add(fit.b, scale(offset, b0));
+    fit.c += dot(offset, offset);
   }
   return fit;
 }
@@ -498,7 +503,7 @@ bool EnergyPriority::folds(const Vec3& v) const {
 }
 
 bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                              CollapseCandidate& out) const {
+                              CollapseCandidate& out, Costing costing) const {
   const bool locked_a = !locked_.empty() && locked_[a];
   const bool locked_b = !locked_.empty() && locked_[b];
   if (locked_a && locked_b) return false;
@@ -619,13 +624,34 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   // hundreds of points. A smaller one projects each point, exactly. With E_scalar the points
   // are gathered either way: the attributes need where each one lands.
   const bool by_moments = total > cap;
-  if (!by_moments || scalar_.enabled()) {
+  star_point_weight_ = 1;
+  const size_t sampled = options_.max_sampled_points;
+  auto gather_all = [&] {
     for (const auto& [f, home] : star_lists_)
       gather_face(f, home < 0 ? apex_home[-2 - home] : home);
     star_points_.insert(star_points_.end(), parked_ends_.begin(), parked_ends_.end());
     star_homes_.insert(star_homes_.end(), parked_end_homes_.begin(), parked_end_homes_.end());
+  };
+  if (!by_moments || (scalar_.enabled() && (sampled == 0 || total <= sampled))) {
+    gather_all();
+  } else if (scalar_.enabled()) {
+    // About one point in k stands for k: E_scalar costs each point it sees.
+    const size_t stride = (total + sampled - 1) / sampled;
+    auto take = [&](const FacePoint& p, int home) {
+      if (!kept_when_thinned(point_id_.empty() ? p.id : point_id_[p.id], stride)) return;
+      star_points_.push_back(p);
+      star_homes_.push_back(home);
+    };
+    for (const auto& [f, home] : star_lists_)
+      for (const FacePoint& p : face_points_[f]) take(p, home < 0 ? apex_home[-2 - home] : home);
+    for (size_t i = 0; i < parked_ends_.size(); ++i) take(parked_ends_[i], parked_end_homes_[i]);
+    if (star_points_.empty()) {
+      gather_all();
+    } else {
+      star_point_weight_ = double(total) / double(star_points_.size());
+    }
   }
-  curves_.gather(a, b, mesh);
+  curves_.gather(a, b, mesh, options_.max_sampled_points);
   const double curve_before = curves_.gathered_distance_sq();
   const double distance_before = by_moments ? moment_distance_before(mesh) : exact_distance_sq();
 
@@ -635,13 +661,12 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   spring_pull = scale(spring_pull, 0.5 * kappa);
   const double spring_weight = kappa * double(star_.size());
 
+  static constexpr size_t kNotProjected = ~size_t{0};
   struct Placement {
     Vec3 v;
     double energy;
     double max_distance_sq;
-    double curve_distance_sq;
-    double spring;  // kappa * E_spring after the collapse
-    size_t index;   // into placement_projections_
+    size_t index;  // into placement_projections_; kNotProjected for a modelled placement
   };
   std::array<Placement, 16> placements;
   size_t placed = 0;
@@ -663,19 +688,17 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     const double spring = kappa * spring_energy_after(v);
     const double energy = fit.distance_sq + curve_fit.distance_sq + spring;
     if (placed < placements.size()) {
-      placements[placed] = {v,
-                            energy,
-                            std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
-                            curve_fit.distance_sq,
-                            spring,
+      placements[placed] = {v, energy, std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
                             placed};
       ++placed;
     }
   };
+  PlaneModel plane_model;
   auto solve = [&](const Fit& fit, const Vec3& from) -> Vec3 {
     Vec3 v;
     if (by_moments) {
-      v = moment_solve(from, curve_fit.a + spring_weight, add(curve_fit.b, spring_pull));
+      v = moment_solve(from, curve_fit.a + spring_weight, add(curve_fit.b, spring_pull),
+                       &plane_model);
     } else {
       const double denominator = fit.a + curve_fit.a + spring_weight;
       if (!(denominator > 0)) return from;
@@ -700,6 +723,19 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       measure(v, fit);
       for (int i = 0; i < options_.solves_per_start; ++i) {
         v = solve(fit, v);
+        if (costing == Costing::kQueue && i + 1 == options_.solves_per_start) {
+          // A queue key: the last solve is costed on the model it minimised, not measured
+          // again, which halves the projections. For projected points the model is an upper
+          // bound of the measured energy (each point's barycentric coordinates put it on a
+          // face of the new star), so the key errs towards later, never earlier; the moments'
+          // model is the reweighted planes'. The collapse is measured when it is performed.
+          if (placed < placements.size()) {
+            const double distance = by_moments ? plane_model.at(v) : fit.model_at(v);
+            const double energy = distance + curve_fit.model_at(v) + kappa * spring_energy_after(v);
+            placements[placed++] = {v, energy, 0, kNotProjected};
+          }
+          break;
+        }
         measure(v, fit);
       }
     }
@@ -718,11 +754,13 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   out.position = chosen->v;
   out.cost = chosen->energy - distance_before - curve_before - kappa * spring_before;
   out.error = std::sqrt(chosen->max_distance_sq);
-  if (keep_projections) projected_.swap(placement_projections_[chosen->index]);
   if (by_moments) out.cost += moment_rim_change(mesh, chosen->v);
   // E_scalar wants every point's projection at the chosen placement.
-  if (scalar_.enabled() && by_moments)
+  if (keep_projections && chosen->index != kNotProjected) {
+    projected_.swap(placement_projections_[chosen->index]);
+  } else if (scalar_.enabled()) {
     project_points(star_points_, star_homes_, chosen->v, &projected_);
+  }
   if (scalar_.enabled()) out.cost += scalar_change();
   // Penalised, not forbidden (Hoppe 96): such collapses come after every ordinary one.
   if (topology) out.cost += topology_penalty_;
@@ -742,7 +780,7 @@ double EnergyPriority::scalar_change() const {
     scalar_.add(face.group, id, p.bary[0], face.wedges[1], p.bary[1], face.wedges[2], p.bary[2]);
     before += scalar_.residual(id);
   }
-  return scalar_.star_energy() - before;
+  return (scalar_.star_energy() - before) * star_point_weight_;
 }
 
 // E_scalar after a performed collapse: the wedges joined for good, the star's wedges given the

@@ -24,9 +24,14 @@
 // change): the points' squared distances to each face's plane, before and after, and the
 // placement by iteratively reweighted least squares on those planes, both O(faces of the
 // star) whatever its points. Smaller stars project each point onto the new star (and may move
-// it to the face beside). Only the collapse actually performed re-projects every point of its
-// star onto its closest face, so that the stored distances, and the error recorded in the PM,
-// are exact.
+// it to the face beside). E_scalar and E_disc cost each point or curve sample they see: beyond
+// max_sampled_points, every k-th one stands for k. Only the collapse actually performed
+// re-projects every point of its star onto its closest face, so that the stored distances, and
+// the error recorded in the PM, are exact.
+//
+// Queue keys (Costing::kQueue) are most of the evaluations and most are never used: each start
+// is measured and solved, but the solved position is costed on the model it was solved on,
+// not measured again (see evaluate()).
 //
 // The sample of a vertex that has not moved lies on the mesh, on that vertex, whatever
 // happens around it: it is "parked" at its vertex (in no face's list) and costs nothing until
@@ -36,6 +41,8 @@
 #include <cstdint>
 #include <utility>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "simplify/module_state.h"
 #include "simplify/modules.h"
@@ -51,6 +58,9 @@ struct EnergyOptions {
   uint64_t seed = 1;            // of those extra points
   // Stars with more points are costed by their faces' point moments, not point by point.
   uint32_t max_points_per_evaluation = 16;
+  // Beyond this many, E_scalar's points and E_disc's curve samples are costed on every k-th
+  // one, weighted by k (their cost is per point, not per face). 0: all of them.
+  uint32_t max_sampled_points = 64;
   int solves_per_start = 1;     // least-squares solves after the first projection, per start
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
   bool discontinuities = true;  // E_disc: sample and keep the sharp curves (sharp_curves.h)
@@ -87,8 +97,10 @@ class EnergyPriority : public PriorityModule {
       : locked_(std::move(locked)), options_(options), attributes_(std::move(attributes)) {}
   std::string name() const override { return "energy"; }
   void initialize(const CollapseMesh& mesh) override;
-  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                CollapseCandidate& out) const override;
+  // With Costing::kQueue each start's solve is costed on the model it was solved on, not
+  // measured again (see evaluate()).
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) const override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
 
   // State export/import for the parallel construction (module_state.h). export_local: the
@@ -116,6 +128,9 @@ class EnergyPriority : public PriorityModule {
   // Every point's state, by id (a scan of every face: for tests and reports).
   std::vector<PointState> point_states() const;
   const SharpCurves& curves() const { return curves_; }
+  // How many points or curve samples a candidate's costing sees one by one (the thinning only
+  // changes costs, not the state: tests cost one state both ways).
+  void set_max_sampled_points(uint32_t n) { options_.max_sampled_points = n; }
 
  private:
   static constexpr uint32_t kNoPoint = 0xffffffffu;
@@ -150,6 +165,22 @@ class EnergyPriority : public PriorityModule {
     double max_distance_sq = 0;  // largest single one
     double a = 0;                // sum of b0^2 (b0: barycentric coordinate of v)
     Vec3 b{};                    // sum of b0 (x - b1 p1 - b2 p2)
+    double c = 0;                // sum of |x - b1 p1 - b2 p2|^2
+    // The points' squared distances to where their barycentric coordinates put them with the
+    // moving vertex at w: sum |x - b0 w - b1 p1 - b2 p2|^2 (the least-squares solve's model).
+    double model_at(const Vec3& w) const { return c - 2 * dot(b, w) + a * dot(w, w); }
+  };
+  // The moment solve's model (moment_solve): the planes' squared distances, each weighted by
+  // its normal's length at the start, w^T h w - 2 r.w + k, plus the parked ends' Fit model.
+  struct PlaneModel {
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    double k = 0;
+    Fit ends;
+    double at(const Vec3& w) const {
+      const Eigen::Vector3d x(w[0], w[1], w[2]);
+      return x.dot(h * x) - 2 * r.dot(x) + k + ends.model_at(w);
+    }
   };
 
   Fit project_points(const std::vector<FacePoint>& points, const std::vector<int>& homes,
@@ -162,7 +193,8 @@ class EnergyPriority : public PriorityModule {
   double exact_distance_sq() const;
   double moment_distance_before(const CollapseMesh& mesh) const;
   double moment_distance_after(const Vec3& v) const;
-  Vec3 moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b) const;
+  Vec3 moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b,
+                    PlaneModel* model = nullptr) const;
   void check_global_state(const EnergyState& state) const;
   void prepare_fan(const CollapseMesh& mesh, VertexId vs);
   std::pair<int, Projection> closest_fan_face(const CollapseMesh& mesh,
@@ -201,6 +233,7 @@ class EnergyPriority : public PriorityModule {
   // Per star point: the star face its face becomes (-1, -2: the samples of a and b). In
   // collapsed(): the index among vs's faces of its old face's image (-1: an unparked sample).
   mutable std::vector<int> star_homes_;
+  mutable double star_point_weight_ = 1;  // how many points each of star_points_ stands for
   mutable int a_side_faces_ = 0;
   mutable std::array<FaceId, 2> edge_faces_{kNoId, kNoId};  // the two faces the collapse removes
   mutable std::array<int, 2> edge_face_homes_{};            // the star faces their points go to

@@ -24,6 +24,13 @@ struct CollapseCandidate {
   std::vector<float> changed_values;
 };
 
+// What a costing is for. kPerform: the collapse the engine is about to perform, whose placement
+// and cost go into the PM. kQueue: a key for the priority queue, which a module may estimate
+// more cheaply: an edge is costed again, with kPerform, when it reaches the top. Most queued
+// costs are never used (a neighbouring collapse changes the edge first), so the estimate is
+// where a costly metric saves most of its time.
+enum class Costing { kPerform, kQueue };
+
 class PriorityModule {
  public:
   virtual ~PriorityModule() = default;
@@ -31,8 +38,8 @@ class PriorityModule {
   virtual void initialize(const CollapseMesh& mesh) = 0;
   // Costs the collapse of edge {a, b}, choosing which end survives and where. Returns false
   // when the collapse cannot be placed (the edge is then left alone).
-  virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                        CollapseCandidate& out) const = 0;
+  virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                        Costing costing) const = 0;
   // Called after the mesh performed `done`, to update the module's state. `edge` names the two
   // faces the collapse removed (now dead). The module may refine done.error with what it
   // learns from the performed collapse (the record takes the refined value).

@@ -50,11 +50,11 @@ struct PointMoments {
 };
 
 // The squared distances of the points to the plane of (v, p1, p2), times |n(v)|^2 (n the
-// plane's normal (p1 - v) x (p2 - v)), as a quadratic in v: v^T H v - 2 r.v + const, added
-// (scaled by s) to h and r. It is quadratic because n(v) is linear in v; dividing by |n(v)|^2
+// plane's normal (p1 - v) x (p2 - v)), as a quadratic in v: v^T H v - 2 r.v + k, added
+// (scaled by s) to h, r and k. It is quadratic because n(v) is linear in v; dividing by |n(v)|^2
 // taken at a fixed v gives one step of iteratively reweighted least squares for the vertex v
 // of the faces (v, p1, p2) that minimises the points' plane distances.
 void add_plane_quadratic(const PointMoments& m, const Vec3& p1, const Vec3& p2, double s,
-                         Eigen::Matrix3d& h, Eigen::Vector3d& r);
+                         Eigen::Matrix3d& h, Eigen::Vector3d& r, double& k);
 
 }  // namespace parapm

@@ -25,8 +25,8 @@ class QuadricPriority : public PriorityModule {
       : locked_(std::move(locked)), options_(options) {}
   std::string name() const override { return "quadric"; }
   void initialize(const CollapseMesh& mesh) override;
-  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                CollapseCandidate& out) const override;
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) const override;  // (both costings alike: it is cheap)
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
 
   // State export/import for the parallel construction (module_state.h). export_local: the

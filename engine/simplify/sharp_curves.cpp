@@ -1,5 +1,7 @@
 #include "simplify/sharp_curves.h"
 
+#include "simplify/sample_thinning.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -105,8 +107,10 @@ bool SharpCurves::changes_topology(VertexId a, VertexId b) const {
   return na.size() != 2 && nb.size() != 2;
 }
 
-void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh) const {
+void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh,
+                         size_t max_samples) const {
   gathered_.clear();
+  gathered_weight_ = 1;
   ends_.clear();
   end_positions_.clear();
   if (samples_.empty()) return;
@@ -114,6 +118,19 @@ void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh) const
   for (uint32_t id : listed_at_[b]) {
     const Sample& s = samples_[id];
     if (s.u != a && s.w != a) gathered_.push_back(id);  // else listed at a too
+  }
+  if (max_samples > 0 && gathered_.size() > max_samples) {
+    const size_t n = gathered_.size(), stride = (n + max_samples - 1) / max_samples;
+    size_t kept = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t id = gathered_[i];
+      if (kept_when_thinned(sample_id_.empty() ? id : sample_id_[id], stride))
+        gathered_[kept++] = id;
+    }
+    if (kept > 0) {
+      gathered_.resize(kept);
+      gathered_weight_ = double(n) / double(kept);
+    }
   }
   for (VertexId end : {a, b})
     for (VertexId x : neighbors_[end])
@@ -141,7 +158,15 @@ SharpCurves::Fit SharpCurves::project(const Vec3& v) const {
     fit.distance_sq += best;
     fit.max_distance_sq = std::max(fit.max_distance_sq, best);
     fit.a += b0 * b0;
-    fit.b = add(fit.b, scale(sub(x, rest), b0));
+    const Vec3 offset = sub(x, rest);
+    fit.b = add(fit.b, scale(offset, b0));
+    fit.c += dot(offset, offset);
+  }
+  if (gathered_weight_ != 1) {
+    fit.distance_sq *= gathered_weight_;
+    fit.a *= gathered_weight_;
+    fit.b = scale(fit.b, gathered_weight_);
+    fit.c *= gathered_weight_;
   }
   return fit;
 }
@@ -149,7 +174,7 @@ SharpCurves::Fit SharpCurves::project(const Vec3& v) const {
 double SharpCurves::gathered_distance_sq() const {
   double sum = 0;
   for (uint32_t id : gathered_) sum += samples_[id].distance_sq;
-  return sum;
+  return sum * gathered_weight_;
 }
 
 void SharpCurves::unlist(VertexId v, uint32_t id) {

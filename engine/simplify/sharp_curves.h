@@ -14,6 +14,7 @@
 
 #include "simplify/collapse_mesh.h"
 #include "simplify/module_state.h"
+#include "simplify/vec_math.h"
 
 namespace parapm {
 
@@ -48,11 +49,16 @@ class SharpCurves {
   bool changes_topology(VertexId a, VertexId b) const;
 
   // The samples a collapse of {a, b} moves, and the curve segments (v, x) after it: x runs
-  // over the sharp neighbours of a and b other than a and b.
-  void gather(VertexId a, VertexId b, const CollapseMesh& mesh) const;
+  // over the sharp neighbours of a and b other than a and b. Late collapses move thousands of
+  // samples along a long curve: beyond `max_samples`, about one in k stands for k
+  // (sample_thinning.h; project() and gathered_distance_sq() weigh them), which keeps an
+  // evaluation bounded. The performed collapse (collapsed()) moves every sample.
+  void gather(VertexId a, VertexId b, const CollapseMesh& mesh, size_t max_samples) const;
   struct Fit {
     double distance_sq = 0, max_distance_sq = 0, a = 0;
-    Vec3 b{};  // as EnergyPriority's: sum of b0^2 and of b0 (x - (1 - b0) x_other)
+    Vec3 b{};      // as EnergyPriority's: sum of b0^2 and of b0 (x - (1 - b0) x_other)
+    double c = 0;  // and of |x - (1 - b0) x_other|^2
+    double model_at(const Vec3& w) const { return c - 2 * dot(b, w) + a * dot(w, w); }
   };
   // The gathered samples projected onto the gathered segments with the moved vertex at v
   // (onto v itself when no segment is left).
@@ -99,6 +105,7 @@ class SharpCurves {
 
   // Scratch of one evaluation.
   mutable std::vector<uint32_t> gathered_;
+  mutable double gathered_weight_ = 1;  // how many samples each gathered one stands for
   mutable std::vector<VertexId> ends_;  // the x of the segments (v, x)
   mutable std::vector<Vec3> end_positions_;
 };

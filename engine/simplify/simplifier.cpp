@@ -13,7 +13,7 @@ void Simplifier::push_edge(VertexId a, VertexId b) {
   if (a > b) std::swap(a, b);
   CollapseCandidate candidate;
   ++stats_.evaluations;
-  if (!priority_.evaluate(mesh_, a, b, candidate)) return;
+  if (!priority_.evaluate(mesh_, a, b, candidate, Costing::kQueue)) return;
   heap_.push({static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]});
 }
 
@@ -98,7 +98,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       const VertexId a = t[k], b = t[(k + 1) % 3];
       if (a > b && mesh_.edge_faces(b, a).left != kNoId) continue;  // counted from b->a
       CollapseCandidate candidate;
-      if (priority_.evaluate(mesh_, std::min(a, b), std::max(a, b), candidate))
+      if (priority_.evaluate(mesh_, std::min(a, b), std::max(a, b), candidate, Costing::kQueue))
         heap_.items().push_back(
             {static_cast<float>(candidate.cost), std::min(a, b), std::max(a, b), 0});
     }
@@ -132,7 +132,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     // legality depends on the neighbourhood and is checked now (Decimater: re-check on pop).
     CollapseCandidate candidate;
     ++stats_.evaluations;
-    if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate)) continue;
+    if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate, Costing::kPerform)) continue;
     const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
     if (edge.left == kNoId && edge.right == kNoId) {  // a re-costed edge that is gone
       ++stats_.stale;

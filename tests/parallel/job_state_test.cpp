@@ -31,7 +31,8 @@ SimplifyOptions options_of(const std::string& metric) {
 }
 
 // One job owning the whole live mesh (p = 1), its module imported from `master`, and every
-// edge costed by both: the same end kept, the same position and cost. `exact`: bit for bit
+// edge costed by both, as a queue key and as a collapse to perform: the same end kept, the
+// same position and cost. `exact`: bit for bit
 // (the job's mesh lists each vertex's faces in id order; after collapses the whole mesh's
 // lists are in another order, which changes the order of the energy's sums, hence the last
 // bits).
@@ -55,29 +56,32 @@ void expect_round_trip(const RepairedMesh& repaired, const SimplifyOptions& opti
     if (!local.vertex_alive(a)) continue;
     std::vector<VertexId> around;
     local.neighbors(a, around);
-    for (VertexId b : around) {
-      if (b < a) continue;
-      ++edges;
-      CollapseCandidate x, y;
-      const bool ok_master = master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], x);
-      const bool ok_imported = imported->evaluate(local, a, b, y);
-      ASSERT_EQ(ok_master, ok_imported) << what << " edge " << a << " " << b;
-      if (!ok_master) continue;
-      ++placed;
-      ASSERT_EQ(x.vs, job.global_vertex[y.vs]) << what;
-      ASSERT_EQ(x.vt, job.global_vertex[y.vt]) << what;
-      if (exact) {
-        ASSERT_EQ(x.cost, y.cost) << what << " edge " << a << " " << b;
-        for (int k = 0; k < 3; ++k) ASSERT_EQ(x.position[k], y.position[k]) << what;
-        ASSERT_EQ(x.error, y.error) << what;
-      } else {
-        const double scale = std::max({std::abs(x.cost), 1e-30});
-        worst = std::max(worst, std::abs(x.cost - y.cost) / scale);
-        ASSERT_NEAR(x.cost, y.cost, 1e-6 * scale + 1e-24) << what << " edge " << a << " " << b;
-        for (int k = 0; k < 3; ++k)
-          ASSERT_NEAR(x.position[k], y.position[k], 1e-9 * job.options.reference_diagonal) << what;
+    for (VertexId b : around)
+      for (const Costing costing : {Costing::kQueue, Costing::kPerform}) {
+        if (b < a) continue;
+        ++edges;
+        CollapseCandidate x, y;
+        const bool ok_master =
+            master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], x, costing);
+        const bool ok_imported = imported->evaluate(local, a, b, y, costing);
+        ASSERT_EQ(ok_master, ok_imported) << what << " edge " << a << " " << b;
+        if (!ok_master) continue;
+        ++placed;
+        ASSERT_EQ(x.vs, job.global_vertex[y.vs]) << what;
+        ASSERT_EQ(x.vt, job.global_vertex[y.vt]) << what;
+        if (exact) {
+          ASSERT_EQ(x.cost, y.cost) << what << " edge " << a << " " << b;
+          for (int k = 0; k < 3; ++k) ASSERT_EQ(x.position[k], y.position[k]) << what;
+          ASSERT_EQ(x.error, y.error) << what;
+        } else {
+          const double scale = std::max({std::abs(x.cost), 1e-30});
+          worst = std::max(worst, std::abs(x.cost - y.cost) / scale);
+          ASSERT_NEAR(x.cost, y.cost, 1e-6 * scale + 1e-24) << what << " edge " << a << " " << b;
+          for (int k = 0; k < 3; ++k)
+            ASSERT_NEAR(x.position[k], y.position[k], 1e-9 * job.options.reference_diagonal)
+                << what;
+        }
       }
-    }
   }
   EXPECT_GT(placed, edges / 2) << what;
   std::printf("%-40s %6zu edges costed alike (%zu placed; worst relative cost gap %.2e)\n",

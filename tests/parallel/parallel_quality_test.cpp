@@ -7,10 +7,13 @@
 //
 // What is asserted, per mesh and metric, as regression guards at today's figures with a
 // margin: the median RMS ratio over the (p, level) cells within 10% (2026-11-21: 1.00-1.02 on
-// the CAD part and the vessel, 1.06 on the bunny), the worst cells under RMS 1.35 and
-// Hausdorff 2.6. Issue 5's target, every cell within 5% (RMS) and 10%
-// (Hausdorff), is NOT met on these small meshes (at p = 16 the bunny's subsets hold 600
-// faces; worst cells 2026-11-21: RMS 1.29, Hausdorff 2.49); it is on the 203k dragon
+// the CAD part and the vessel, 1.06 on the bunny; the energy's, pooled over three draws of
+// extra points, 2026-11-22: 0.98 on the vessel, 1.0 on the bunny), the worst cells under RMS
+// 1.35 (the energy's pooled cells: 1.6, as single cells of the bunny's 2% level range over
+// 0.84-1.45 from one draw to the next) and Hausdorff 2.6. Issue 5's target, every cell within
+// 5% (RMS) and 10% (Hausdorff), is NOT met on these small meshes (at p = 16 the bunny's
+// subsets hold 600 faces; worst cells 2026-11-21: RMS 1.29, Hausdorff 2.49; with the energy
+// the bunny's 10% level is 1.17-1.34 in every draw); it is on the 203k dragon
 // (docs/BENCHMARKS.md, bench/parallel.sh with metro).
 #include <gtest/gtest.h>
 
@@ -39,9 +42,9 @@ struct Ratios {
   }
 };
 
-void expect_near_sequential(Ratios r, const std::string& name) {
+void expect_near_sequential(Ratios r, const std::string& name, double worst_rms = 1.35) {
   EXPECT_LE(r.median_rms(), 1.10) << name;
-  EXPECT_LE(r.worst_rms, 1.35) << name;
+  EXPECT_LE(r.worst_rms, worst_rms) << name;
   EXPECT_LE(r.worst_hausdorff, 2.6) << name;
 }
 
@@ -89,12 +92,25 @@ TEST(ParallelQuality, QuadricLevelsMatchTheSequentialOnes) {
   }
 }
 
+// Pooled over three draws of extra points: on a 10k-face mesh one draw moves single cells by
+// +-25% (the bunny's 2% level: RMS 0.040-0.054 sequential, 0.85-1.26 the ratio), so one run's
+// median says more about the draw than about the build.
 TEST(ParallelQuality, EnergyLevelsMatchTheSequentialOnes) {
   for (const char* name : {"gmsh-aneurysm-20k.stl.gz", "pymeshlab-bunny-textured-10k.obj"}) {
-    SimplifyOptions options;
-    options.metric = "energy";
-    options.target_ratio = 0.01;
-    expect_near_sequential(compare(name, repaired_test_mesh(name), options, {2, 4}), name);
+    const RepairedMesh repaired = repaired_test_mesh(name);
+    Ratios pooled;
+    for (const uint64_t seed : {1, 2, 3}) {
+      SimplifyOptions options;
+      options.metric = "energy";
+      options.target_ratio = 0.01;
+      options.samples_per_face = 0.05;
+      options.seed = seed;
+      const Ratios r = compare(name, repaired, options, {2, 4});
+      pooled.rms.insert(pooled.rms.end(), r.rms.begin(), r.rms.end());
+      pooled.worst_rms = std::max(pooled.worst_rms, r.worst_rms);
+      pooled.worst_hausdorff = std::max(pooled.worst_hausdorff, r.worst_hausdorff);
+    }
+    expect_near_sequential(pooled, name, 1.6);
   }
 }
 

@@ -136,7 +136,7 @@ TEST(EnergyPriority, LeastSquaresPlacesTheVertexOnTheRidge) {
   // (On it up to the springs' pull: with 8 points per face kappa is 1e-8, which moves the
   // optimum by a few 1e-9 towards the ring's centroid.)
   CollapseCandidate c;
-  ASSERT_TRUE(energy.evaluate(cm, a, b, c));
+  ASSERT_TRUE(energy.evaluate(cm, a, b, c, Costing::kPerform));
   EXPECT_NEAR(c.position[1], 0, 1e-7);
   EXPECT_NEAR(c.position[2], 0, 1e-7);
   EXPECT_GE(c.position[0], 0 - 1e-7);
@@ -147,13 +147,13 @@ TEST(EnergyPriority, LeastSquaresPlacesTheVertexOnTheRidge) {
   // Across the ridge, from a ridge vertex to a vertex of the slope, the best placement is
   // the ridge vertex itself (again exact); halfway down the slope it would not be.
   const VertexId down = 3 * 5 + 2;
-  ASSERT_TRUE(energy.evaluate(cm, a, down, c));
+  ASSERT_TRUE(energy.evaluate(cm, a, down, c, Costing::kPerform));
   EXPECT_NEAR(c.position[1], 0, 1e-7);
   EXPECT_LT(c.error, 1e-7);
   // Collapsing two slope vertices off the ridge keeps every point on the surface too, but a
   // placement off the slope's plane would not: the solve keeps it in the plane.
   const VertexId slope_a = 3 * 5 + 1, slope_b = 3 * 5 + 2;
-  ASSERT_TRUE(energy.evaluate(cm, slope_a, slope_b, c));
+  ASSERT_TRUE(energy.evaluate(cm, slope_a, slope_b, c, Costing::kPerform));
   EXPECT_NEAR(c.position[2], -0.5 * std::abs(c.position[1]), 1e-7);
 }
 

@@ -53,17 +53,16 @@ TEST(PointMoments, PlaneQuadraticIsTheScaledPlaneEnergyAtEveryVertexPosition) {
   const Vec3 p1{1, 0, 0.2}, p2{0, 1, -0.1};
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
   Eigen::Vector3d r = Eigen::Vector3d::Zero();
-  add_plane_quadratic(m, p1, p2, 1.0, h, r);
-  // sum ((x - p1).n(v))^2 = v^T H v - 2 r.v + K for one K at every v.
   double constant = 0;
+  add_plane_quadratic(m, p1, p2, 1.0, h, r, constant);
+  // sum ((x - p1).n(v))^2 = v^T H v - 2 r.v + K at every v.
   for (int trial = 0; trial < 10; ++trial) {
     const Vec3 v{random.uniform() * 2 - 1, random.uniform() * 2 - 1, random.uniform() * 2 - 1};
     const Vec3 n = triangle_normal(v, p1, p2);
     const double exact = direct_plane_sum(points, p1, scale(n, 1 / length(n))) * dot(n, n);
     const Eigen::Vector3d ev(v[0], v[1], v[2]);
-    const double k = exact - (ev.dot(h * ev) - 2 * r.dot(ev));
-    if (trial == 0) constant = k;
-    EXPECT_NEAR(k, constant, 1e-9 * (1 + std::abs(exact))) << trial;
+    EXPECT_NEAR(ev.dot(h * ev) - 2 * r.dot(ev) + constant, exact, 1e-9 * (1 + std::abs(exact)))
+        << trial;
   }
 }
 
@@ -88,7 +87,8 @@ TEST(PointMoments, ReweightedSolveFindsThePlaneOfCoplanarPoints) {
     Eigen::Vector3d r = Eigen::Vector3d::Zero();
     for (size_t j = 0; j < rim.size(); ++j) {
       const Vec3 n = triangle_normal(v, rim[j].first, rim[j].second);
-      add_plane_quadratic(faces[j], rim[j].first, rim[j].second, 1 / dot(n, n), h, r);
+      double constant = 0;
+      add_plane_quadratic(faces[j], rim[j].first, rim[j].second, 1 / dot(n, n), h, r, constant);
     }
     const Eigen::Vector3d next = h.ldlt().solve(r);
     v = {next[0], next[1], next[2]};
