@@ -595,10 +595,14 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   for (int j = 0; j < star_size; ++j) {
     StarFace& face = star_[j];
     const VertexId first = face.id1, second = face.id2;
+    // Branch-free (the last match wins), so that the compiler vectorises the scan.
+    int next = face.next, previous = face.previous;
     for (int k = 0; k < star_size; ++k) {
-      if (fan_first_ids_[k] == second) face.next = k;
-      if (fan_second_ids_[k] == first) face.previous = k;
+      next = fan_first_ids_[k] == second ? k : next;
+      previous = fan_second_ids_[k] == first ? k : previous;
     }
+    face.next = next;
+    face.previous = previous;
     for (int e = 0; e < edge_faces; ++e)
       if (face.id1 == edge_apexes[e] || face.id2 == edge_apexes[e]) apex_home[e] = j;
     // A neighbour's parked sample sits on the star's rim: half of it counts as the star's.
