@@ -69,6 +69,7 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
   face_points_.assign(mesh.face_capacity(), {});
   moments_.assign(mesh.face_capacity(), PointMoments{});
   moments_ready_.assign(mesh.face_capacity(), 0);
+  own_.assign(mesh.face_capacity(), OwnError{});
   parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
   for (const SurfaceSample& s : samples) {
     const auto id = uint32_t(positions_.size());
@@ -166,6 +167,7 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   face_points_.assign(mesh.face_capacity(), {});
   moments_.assign(mesh.face_capacity(), PointMoments{});
   moments_ready_.assign(mesh.face_capacity(), 0);
+  own_.assign(mesh.face_capacity(), OwnError{});
   parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
   // The faces keep the written order.
   for (size_t i = 0; i < n; ++i) {
@@ -299,6 +301,17 @@ const PointMoments& EnergyPriority::moments_of(FaceId f) const {
   return moments_[f];
 }
 
+const EnergyPriority::OwnError& EnergyPriority::own_error_of(const CollapseMesh& mesh,
+                                                             FaceId f) const {
+  if (moments_ready_[f] != 2) {
+    const Triangle& t = mesh.face(f);
+    const Vec3 &q0 = mesh.position(t[0]), &q1 = mesh.position(t[1]), &q2 = mesh.position(t[2]);
+    own_[f] = {plane_distance_sq(f, q0, q1, q2), rim_sq(f, q0, q1, q2)};
+    moments_ready_[f] = 2;
+  }
+  return own_[f];
+}
+
 // The squared distances of face f's points to the plane of (q0, q1, q2); to the triangle
 // itself when it is too thin to have a plane.
 double EnergyPriority::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1,
@@ -350,13 +363,11 @@ double EnergyPriority::moment_rim_change(const CollapseMesh& mesh, const Vec3& v
   double change = 0;
   for (size_t j = 0; j < star_.size(); ++j)
     change += rim_sq(star_[j].source, v, star_[j].p1, star_[j].p2, int(j)) -
-              rim_sq(star_[j].source, star_[j].before, star_[j].p1, star_[j].p2);
+              own_error_of(mesh, star_[j].source).rim_sq;
   for (int e = 0; e < 2; ++e)
     if (const FaceId f = edge_faces_[e]; f != kNoId) {
       const StarFace& home = star_[edge_face_homes_[e]];
-      const Triangle& t = mesh.face(f);
-      change += rim_sq(f, v, home.p1, home.p2, edge_face_homes_[e]) -
-                rim_sq(f, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+      change += rim_sq(f, v, home.p1, home.p2, edge_face_homes_[e]) - own_error_of(mesh, f).rim_sq;
     }
   return change;
 }
@@ -368,12 +379,9 @@ double EnergyPriority::moment_rim_change(const CollapseMesh& mesh, const Vec3& v
 // projected one by one.
 double EnergyPriority::moment_distance_before(const CollapseMesh& mesh) const {
   double sum = 0;
-  for (const StarFace& f : star_) sum += plane_distance_sq(f.source, f.before, f.p1, f.p2);
+  for (const StarFace& f : star_) sum += own_error_of(mesh, f.source).plane_sq;
   for (const FaceId f : edge_faces_)
-    if (f != kNoId) {
-      const Triangle& t = mesh.face(f);
-      sum += plane_distance_sq(f, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
-    }
+    if (f != kNoId) sum += own_error_of(mesh, f).plane_sq;
   return sum;
 }
 

@@ -187,6 +187,12 @@ class EnergyPriority : public PriorityModule {
                      const Vec3& v, std::vector<Projected>* where = nullptr) const;
   double scalar_change() const;
   const PointMoments& moments_of(FaceId f) const;
+  // Face f's points against its own plane and rim as the mesh has it now: the "before" of
+  // every star holding f, kept with its moments.
+  struct OwnError {
+    double plane_sq = 0, rim_sq = 0;
+  };
+  const OwnError& own_error_of(const CollapseMesh& mesh, FaceId f) const;
   double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2) const;
   double rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2, int star_face = -1) const;
   double moment_rim_change(const CollapseMesh& mesh, const Vec3& v) const;
@@ -242,7 +248,10 @@ class EnergyPriority : public PriorityModule {
   // Per face, the moments of the points projecting onto it (computed when first needed,
   // forgotten when its point list changes).
   mutable std::vector<PointMoments> moments_;
-  mutable std::vector<uint8_t> moments_ready_;                   // star_ holds a's faces, then b's
+  // 0: nothing known, 1: moments_, 2: moments_ and own_ (a face's corners move only in a
+  // collapse that re-projects its points, which resets this).
+  mutable std::vector<uint8_t> moments_ready_;
+  mutable std::vector<OwnError> own_;
   mutable std::array<std::pair<WedgeId, WedgeId>, 2> joined_{};  // wedges of a, b in fl, fr
   mutable int joined_count_ = 0;
   mutable std::vector<Projected> projected_;  // per star point, at the chosen placement
