@@ -1,13 +1,12 @@
 #include "simplify/sharp_curves.h"
 
-#include "simplify/sample_thinning.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
 
 #include "simplify/point_projection.h"
+#include "simplify/sample_thinning.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -188,7 +187,8 @@ void SharpCurves::unlist(VertexId v, uint32_t id) {
 double SharpCurves::collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh) {
   // A job may hold sharp edges but none of their samples: the curves are updated anyway.
   if (samples_.empty() && neighbors_[vs].empty() && neighbors_[vt].empty()) return 0;
-  std::vector<uint32_t>& moved = gathered_;
+  std::vector<uint32_t>& moved = gathered_;  // (every sample: no weights here)
+  gathered_weight_ = 1;
   moved.assign(listed_at_[vs].begin(), listed_at_[vs].end());
   for (uint32_t id : listed_at_[vt]) {
     const Sample& s = samples_[id];
