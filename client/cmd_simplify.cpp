@@ -31,6 +31,7 @@ struct SimplifyArgs {
   unsigned threads = 0;   // 0: min(p, hardware threads)
   uint32_t rounds = ParallelOptions{}.rounds;
   double handover = ParallelOptions{}.handover_ratio;
+  uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
   bool json = false;
 };
 
@@ -99,6 +100,7 @@ int run_simplify(const SimplifyArgs& args) {
     parallel.threads = args.threads;
     parallel.rounds = args.rounds;
     parallel.handover_ratio = args.handover;
+    parallel.extra_round_subset_faces = args.extra_round_faces;
     pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
                                          bar.callback(), nullptr);
     stats.collapses = parallel_stats.collapses;
@@ -232,6 +234,11 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                   "input faces (or the target if larger); the sequential final pass does the "
                   "rest")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--extra-round-faces", args->extra_round_faces,
+                  "With --parallel: past the handover, more rounds at the same ratio while the "
+                  "last one removed at least 90% of what it was asked and the next would leave "
+                  "each subset at least this many faces (0: none)")
       ->capture_default_str();
   cmd->add_flag("--json", args->json,
                 "Print one JSON object on stdout (with --parallel, under \"parallel\": p, rounds "

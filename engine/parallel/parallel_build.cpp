@@ -219,15 +219,35 @@ ProgressiveMesh build_progressive_mesh_parallel(
   std::vector<CollapseRecord> records;
   std::vector<uint8_t> touched(whole.vertex_capacity(), 0);  // vs or vt of a collapse so far
   double subsets_cpu = 0;
-  for (uint32_t round = 0; round < parallel.rounds; ++round) {
+  // The scheduled rounds' ratio per round, which extra rounds past the handover keep.
+  const double step =
+      std::pow(double(handover) / double(input_faces), 1.0 / double(parallel.rounds));
+  for (uint32_t round = 0; round < 64; ++round) {
     RoundStats rs;
     rs.round = round;
     rs.faces_before = whole.live_faces();
-    if (rs.faces_before <= handover || whole.live_vertices() < 4 * size_t(parallel.subsets)) break;
-    // Geometric steps from the present face count to the handover.
-    rs.goal_faces = uint64_t(
-        std::llround(double(rs.faces_before) * std::pow(double(handover) / double(rs.faces_before),
-                                                        1.0 / double(parallel.rounds - round))));
+    if (whole.live_vertices() < 4 * size_t(parallel.subsets)) break;
+    if (round < parallel.rounds) {
+      if (rs.faces_before <= handover) break;
+      // Geometric steps from the present face count to the handover.
+      rs.goal_faces = uint64_t(std::llround(double(rs.faces_before) *
+                                            std::pow(double(handover) / double(rs.faces_before),
+                                                     1.0 / double(parallel.rounds - round))));
+    } else {
+      // An extra round, if the last one did what it was asked (a mesh whose locked parts stop
+      // it short gains nothing from more) and the subsets stay large enough that their
+      // borders do not decide the order.
+      if (parallel.extra_round_subset_faces == 0 || st.round_stats.empty()) break;
+      const RoundStats& last = st.round_stats.back();
+      const double asked = double(last.faces_before) - double(last.goal_faces);
+      const double done = double(last.faces_before) - double(last.faces_after);
+      if (!(done >= 0.9 * asked)) break;
+      rs.goal_faces =
+          std::max<uint64_t>(target, uint64_t(std::llround(double(rs.faces_before) * step)));
+      if (rs.goal_faces >= rs.faces_before ||
+          rs.goal_faces < uint64_t(parallel.subsets) * parallel.extra_round_subset_faces)
+        break;
+    }
 
     // A new partition of the current mesh: the previous round's borders, whose vertices could
     // not move, are inside subsets now.
@@ -411,8 +431,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
   spdlog::debug(
       "parallel build p={} rounds={}: {} -> {} faces in {:.3f} s ({:.3f} s CPU), final pass {} "
       "collapses in {:.3f} s ({})",
-      parallel.subsets, parallel.rounds, input_faces, pm.base.face_count(), st.seconds,
-      st.cpu_seconds, st.final_pass_collapses, st.final_pass_seconds, st.stop_reason);
+      parallel.subsets, st.rounds, input_faces, pm.base.face_count(), st.seconds, st.cpu_seconds,
+      st.final_pass_collapses, st.final_pass_seconds, st.stop_reason);
   return pm;
 }
 

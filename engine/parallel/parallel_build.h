@@ -31,6 +31,12 @@ struct ParallelOptions {
   // on the whole mesh, collapses what the last round's borders kept and goes on to the
   // target. The defaults are measured in docs/ARCHITECTURE.md, "Parallel construction".
   double handover_ratio = 0.1;
+  // Past the handover, further rounds at the same ratio per round, while the last round
+  // removed at least 90% of the faces it was asked to and the next one would leave each subset
+  // at least this many faces (0: none). A large mesh gets its final pass shorter (the 871k
+  // dragon at p = 8: 5 rounds); a mesh whose locked parts stop it early, or a small one, does
+  // not (docs/BENCHMARKS.md, "After the energy's queue keys").
+  uint64_t extra_round_subset_faces = 2000;
   // Jobs leave alone edges costing more than this factor times the round's water level
   // (parallel_build.cpp, water_level: the cost below which a sample of the edges would give
   // the round's collapses), besides stopping at their share of the faces; 0: shares only.
@@ -79,7 +85,7 @@ struct RoundStats {
 
 struct ParallelStats {
   uint32_t subsets = 0;
-  uint32_t rounds = 0;  // performed (fewer than asked when the mesh reached the handover)
+  uint32_t rounds = 0;  // performed (fewer than asked at the handover, more with extra rounds)
   unsigned threads = 0;
   std::vector<RoundStats> round_stats;
   double setup_seconds = 0;  // the master's metric, initialised once on the whole mesh
