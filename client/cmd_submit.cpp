@@ -25,6 +25,7 @@ struct SubmitArgs {
   double crease_angle = 60;
   double attribute_weight = 0.01;
   double handover = 0;
+  int64_t extra_round_faces = -1;  // -1: not given (the coordinator's default)
   bool keep_order = false;
   bool wait = false;
   bool json = false;
@@ -56,6 +57,9 @@ int run_submit(SubmitArgs& args) {
   o.set_crease_angle_degrees(args.crease_angle);
   o.set_attribute_weight(args.attribute_weight > 0 ? args.attribute_weight : -1);
   o.set_handover_ratio(args.handover);
+  // The API reads 0 as "the default" and a negative count as "none".
+  if (args.extra_round_faces >= 0)
+    o.set_extra_round_faces(args.extra_round_faces == 0 ? -1 : args.extra_round_faces);
   o.set_keep_order(args.keep_order);
   parapm::v1::Job job;
   {
@@ -138,6 +142,10 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--handover-ratio", args->handover,
                   "the rounds go down to this fraction of the input faces (default 0.1)")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--extra-round-faces", args->extra_round_faces,
+                  "past the handover, more rounds while every subset keeps this many faces and "
+                  "the last round did its share (default 2000; 0: none)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
   cmd->add_option("--seed", args->seed, "seed of the randomised steps")->capture_default_str();
   cmd->add_option("--samples-per-face", args->samples_per_face, "energy: extra sample points")
       ->check(CLI::Range(0.0, 64.0));

@@ -199,6 +199,10 @@ std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
   if (o.attribute_weight() < 0) number("--attribute-weight", 0);
   if (o.attribute_weight() > 0) number("--attribute-weight", o.attribute_weight());
   if (o.handover_ratio() > 0) number("--handover-ratio", o.handover_ratio());
+  if (o.extra_round_faces() != 0)
+    args.insert(args.end(),
+                {"--extra-round-faces",
+                 std::to_string(o.extra_round_faces() < 0 ? 0 : o.extra_round_faces())});
   if (o.keep_order()) args.push_back("--keep-order");
   return args;
 }

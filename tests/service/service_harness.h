@@ -79,7 +79,8 @@ CliResult run_parapm(const std::vector<std::string>& args, const fs::path& dir,
                      milliseconds timeout = seconds(120));
 
 // The `parapm simplify` arguments meaning what `options` means in a job (parallelism,
-// rounds, metric, target, seed, samples, crease angle, attribute weight, handover).
+// rounds, metric, target, seed, samples, crease angle, attribute weight, handover, extra
+// rounds).
 std::vector<std::string> simplify_args(const parapm::v1::JobOptions& options);
 // The .pm `parapm simplify IN --parallel P ...` writes for these options; built once per
 // (mesh, options) and kept for the program's life.
