@@ -32,6 +32,7 @@ struct SimplifyArgs {
   uint32_t rounds = ParallelOptions{}.rounds;
   double handover = ParallelOptions{}.handover_ratio;
   uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
+  bool no_carry_keys = false;
   bool json = false;
 };
 
@@ -60,6 +61,8 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"merge_overlap_seconds", r.merge_overlap_seconds},
                       {"slowest_subset_cpu_seconds", r.slowest_subset_cpu_seconds},
                       {"water_level", r.water_level},
+                      {"keys_carried", r.keys_carried},
+                      {"keys_reused", r.keys_reused},
                       {"band_pass_collapses", r.band_pass_collapses},
                       {"band_pass_seconds", r.band_pass_seconds},
                       {"subsets", subsets}});
@@ -101,6 +104,7 @@ int run_simplify(const SimplifyArgs& args) {
     parallel.rounds = args.rounds;
     parallel.handover_ratio = args.handover;
     parallel.extra_round_subset_faces = args.extra_round_faces;
+    parallel.carry_keys = !args.no_carry_keys;
     pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
                                          bar.callback(), nullptr);
     stats.collapses = parallel_stats.collapses;
@@ -240,6 +244,10 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                   "last one removed at least 90% of what it was asked and the next would leave "
                   "each subset at least this many faces (0: none)")
       ->capture_default_str();
+  cmd->add_flag("--no-carry-keys", args->no_carry_keys,
+                "With --parallel: every round's jobs cost all their edges again instead of "
+                "taking the queue keys still exact from the round before (the PM is the same; "
+                "for measuring the work it saves)");
   cmd->add_flag("--json", args->json,
                 "Print one JSON object on stdout (with --parallel, under \"parallel\": p, rounds "
                 "performed, per round the partition, extraction, subset (per subset wall and "

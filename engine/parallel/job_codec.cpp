@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 1;
+constexpr uint8_t kVersion = 2;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -53,6 +53,7 @@ constexpr uint64_t kMinVertexBytes = 12 + 1 + 1;  // f32 position, flags, global
 constexpr uint64_t kMinFaceBytes = 3 + 1;         // corners, global id
 constexpr uint64_t kMinWedgeBytes = 1 + 1;        // its vertex, global id
 // A record: flags, vs vt, vl fl vr fr, 9 f32, 6 corner wedges, cost, error, change count.
+constexpr uint64_t kMinKeyBytes = 1 + 1 + 8;
 constexpr uint64_t kMinRecordBytes = 1 + 2 + 4 + 36 + 6 + 8 + 4 + 1;
 constexpr uint64_t kMinSampleBytes = 1 + 24 + 8 + 1 + 1;  // id, position, distance, u, w
 constexpr uint64_t kQuadricBytes = 11 * 8;
@@ -506,6 +507,47 @@ void check_job_state(ByteReader& in, const SubsetJob& job) {
     in.fail("the state's wedges are not the job's");
 }
 
+// ---- Queue keys ---------------------------------------------------------------------------
+
+// Sorted by (a, b), a < b: a as its gap from the previous key's a, b as b - a - 1.
+void write_keys(ByteWriter& out, const std::vector<EdgeKey>& keys) {
+  out.varint(keys.size());
+  VertexId previous_a = 0;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const EdgeKey& k = keys[i];
+    if (k.a >= k.b || k.b == kNoId || k.a < previous_a ||
+        (i > 0 && k.a == previous_a && k.b <= keys[i - 1].b))
+      cannot_encode("queue keys not sorted by (a, b) with a < b");
+    out.varint(k.a - previous_a);
+    out.varint(k.b - k.a - 1);
+    out.f64(k.cost);
+    previous_a = k.a;
+  }
+}
+
+// Ids below `bound`. A cost may be NaN (the edge cannot be placed) or anything else: a key
+// only orders the queue, the edge is costed again before it is collapsed.
+void read_keys(ByteReader& in, uint64_t bound, std::vector<EdgeKey>& keys) {
+  in.set_context("queue keys");
+  const uint64_t n = read_count(in, kMinKeyBytes, "queue keys");
+  keys.resize(n);
+  uint64_t previous_a = 0, previous_b = 0;
+  for (uint64_t i = 0; i < n; ++i) {
+    const uint64_t start = in.offset();
+    // Each step checked before it is added, so that no sum wraps.
+    const uint64_t gap = in.varint64();
+    const uint64_t a = gap < bound - previous_a ? previous_a + gap : bound;
+    const uint64_t span = in.varint64();
+    if (a + 1 >= bound || span >= bound - a - 1)
+      in.fail_at(start, "queue key " + std::to_string(i) + " out of range");
+    const uint64_t b = a + 1 + span;
+    if (i > 0 && a == previous_a && b <= previous_b) in.fail_at(start, "queue keys not sorted");
+    keys[i] = {VertexId(a), VertexId(b), in.f64()};
+    previous_a = a;
+    previous_b = b;
+  }
+}
+
 void write_job(ByteWriter& out, const SubsetJob& job) {
   const Mesh& m = job.mesh;
   const size_t floats = size_t(m.layout.floats_per_wedge());
@@ -546,6 +588,7 @@ void write_job(ByteWriter& out, const SubsetJob& job) {
   write_increasing(out, job.global_wedge, "global wedge");
   out.varint(job.owned_faces);
   write_state(out, job.state);
+  write_keys(out, job.keys);
 }
 
 void read_job(ByteReader& in, SubsetJob& job) {
@@ -625,6 +668,7 @@ void read_job(ByteReader& in, SubsetJob& job) {
   read_state(in, StateBounds{vertices, faces, wedges}, job.state);
   in.set_context("state");
   check_job_state(in, job);
+  read_keys(in, vertices, job.keys);
   expect_end(in);
 }
 
@@ -679,6 +723,8 @@ void write_summary(ByteWriter& out, const SubsetResult& r) {
   out.varint(r.round);
   out.varint(r.subset);
   write_state(out, r.state);
+  write_keys(out, r.keys);
+  out.varint(r.keys_reused);
   out.varint(r.faces);
   out.varint(r.owned_faces);
   out.varint(r.free_vertices);
@@ -696,7 +742,9 @@ void read_summary(ByteReader& in, SubsetResult& r) {
   r.round = in.varint32();
   r.subset = in.varint32();
   read_state(in, StateBounds{}, r.state);
+  read_keys(in, kNoId, r.keys);
   in.set_context("counts");
+  r.keys_reused = in.varint64();
   r.faces = in.varint64();
   r.owned_faces = in.varint64();
   r.free_vertices = in.varint64();

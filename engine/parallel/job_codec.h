@@ -8,7 +8,7 @@
 // id then each gap minus one). Every message starts with a 4-byte magic naming its kind and a
 // version byte, so that one kind is never decoded as another.
 //
-//   job     "PPJB" 1 | round v, subset v | V v, F v, W v (counts first: checked before
+//   job     "PPJB" 2 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
 //           samples_per_face f64, crease_angle f64, attribute_weight f64, seed u64,
 //           reference_diagonal f64, target_faces v, max_cost f64 | mesh flags u8 (1
@@ -17,7 +17,7 @@
 //           vertex: position (3 f32 or 3 f64), owned | locked << 1 u8 | global_vertex ids+ |
 //           per face: 3 corners v | global_face ids+ | per wedge: wedge_vertex v, then all
 //           values f32, then (flag 16) per face 3 wedges v | global_wedge ids+ |
-//           owned_faces v | state.
+//           owned_faces v | state | keys.
 //   state   metric u8, then the metric's part (the other part must be empty):
 //           quadric: n v, vertices ids+, n x 11 f64 (a00 a01 a02 a11 a12 a22 b0 b1 b2 c w).
 //           energy: faces n v + ids+, vertices n v + ids+, k u8 (floats per point and per
@@ -28,13 +28,15 @@
 //           wedges n v + ids+, n x k f32 values, per wedge (its index - the index of its
 //           class's wedge) v. A point: id v, position 3 f64, distance_sq f64, [residual f64],
 //           k f32; its face or vertex is the one it is written under (export order).
-//   records "PPCR" 1 | n v | k u8 (floats per changed wedge) | per record: flags u8 (1:
+//   keys    n v, then per key (sorted by (a, b), a < b: edge_keys.h) a minus the previous
+//           key's a v, b - a - 1 v, cost f64 (NaN: the edge cannot be placed).
+//   records "PPCR" 2 | n v | k u8 (floats per changed wedge) | per record: flags u8 (1:
 //           positions as f32), vs v, vt v, vl fl vr fr id+1, vs_position vt_position position
 //           (3 f32 or 3 f64 each), corner_wedges 6 x id+1, cost f64, error f32, changed n v,
 //           n ids v, n x k f32.
-//   summary "PPSS" 1 | round v, subset v | state | faces v, owned_faces v, free_vertices v |
-//           collapses rejected stale reevaluated evaluations v, stop_reason (length v <= 4096,
-//           bytes) | wall_seconds f64, cpu_seconds f64.
+//   summary "PPSS" 2 | round v, subset v | state | keys | keys_reused v | faces v,
+//           owned_faces v, free_vertices v | collapses rejected stale reevaluated evaluations
+//           v, stop_reason (length v <= 4096, bytes) | wall_seconds f64, cpu_seconds f64.
 //
 // Decoding is written for hostile input (a network peer): every count is checked against the
 // bytes that remain before anything is reserved, every id against what it indexes, positions

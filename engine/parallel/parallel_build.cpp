@@ -8,10 +8,12 @@
 #include <spdlog/spdlog.h>
 
 #include "parallel/collapse_merge.h"
+#include "parallel/edge_keys.h"
 #include "parallel/job_pool.h"
 #include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
+#include "parallel/subset_rule.h"
 #include "partition/partition.h"
 #include "simplify/energy_priority.h"
 #include "simplify/modules.h"
@@ -162,6 +164,25 @@ class BandPriority : public PriorityModule {
   double ceiling_;
 };
 
+// The master's current keys of the job's edges with two free ends (the only ones it costs), in
+// its local ids, sorted. Const reads of `memo`: jobs may take theirs concurrently.
+std::vector<EdgeKey> keys_of_job(const KeyMemo& memo, const SubsetJob& job) {
+  const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+  const std::vector<VertexId>& global = job.global_vertex;
+  std::vector<EdgeKey> keys;
+  for (VertexId a = 0; a < global.size(); ++a) {
+    if (!free[a]) continue;
+    memo.for_each_current_at(global[a], [&](const EdgeKey& k) {
+      const auto it = std::lower_bound(global.begin() + a + 1, global.end(), k.b);
+      if (it == global.end() || *it != k.b) return;
+      const auto b = VertexId(it - global.begin());
+      if (free[b]) keys.push_back({a, b, k.cost});
+    });
+  }
+  sort_keys(keys);
+  return keys;
+}
+
 }  // namespace
 
 std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
@@ -206,6 +227,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
   CollapseMesh whole(mesh);
   std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
   master->initialize(whole);
+  // The master's queue keys: the water level's sample, the jobs' keys after a round,
+  // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
+  KeyMemo keys(*master, whole.vertex_capacity());
   st.setup_seconds = seconds_since(t);
   st.critical_path_seconds = st.setup_seconds;
 
@@ -270,7 +294,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     double sequential_extract = seconds_since(t);
     if (parallel.water_level_factor > 0) {
       const auto ts = std::chrono::steady_clock::now();
-      rs.water_level = water_level(whole, *master, vertex_subset, parallel.subsets,
+      rs.water_level = water_level(whole, keys, vertex_subset, parallel.subsets,
                                    rs.faces_before - rs.goal_faces, parallel.water_level_factor);
       rs.share_seconds = seconds_since(ts);
       sequential_extract += rs.share_seconds;
@@ -284,6 +308,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       jobs[i] = extract_subset(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
                                locked, vertex_subset, owned[i], uint32_t(i), round, subset_options);
       jobs[i].state = export_job_state(*master, jobs[i]);
+      if (parallel.carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i]);
       job_cpu[i] = thread_cpu_seconds() - cpu;
     });
     set_targets(jobs, assigned, rs.faces_before, rs.goal_faces);
@@ -292,6 +317,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
         job.options.max_cost = job.options.max_cost > 0
                                    ? std::min(job.options.max_cost, rs.water_level)
                                    : rs.water_level;
+    for (const SubsetJob& job : jobs) rs.keys_carried += job.keys.size();
     for (double c : job_cpu) {
       subsets_cpu += c;  // master work, on the pool's threads
       rs.slowest_extract_cpu_seconds = std::max(rs.slowest_extract_cpu_seconds, c);
@@ -318,6 +344,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       subsets_cpu += r.cpu_seconds;
       rs.slowest_subset_cpu_seconds = std::max(rs.slowest_subset_cpu_seconds, r.cpu_seconds);
       lists.push_back(std::move(r.records));
+      rs.keys_reused += r.keys_reused;
     }
     std::vector<CollapseRecord> merged = merge_by_cost(std::move(lists));
     ReplayReport replay;
@@ -358,6 +385,11 @@ ProgressiveMesh build_progressive_mesh_parallel(
       ceiling = costs[k];
     }
     for (const CollapseRecord& r : merged) touched[r.vs] = touched[r.vt] = 1;
+    // The jobs' keys are current on the master (edge_keys.h).
+    std::vector<EdgeKey> returned;
+    if (parallel.carry_keys)
+      for (SubsetResult& r : results) returned.insert(returned.end(), r.keys.begin(), r.keys.end());
+    keys.reset(returned);
     records.insert(records.end(), std::make_move_iterator(merged.begin()),
                    std::make_move_iterator(merged.end()));
     rs.merge_seconds = seconds_since(t);
@@ -368,7 +400,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // new partition takes its band in parallel.)
     t = std::chrono::steady_clock::now();
     if (parallel.band_pass && round >= 1) {
-      BandPriority band(*master, touched, ceiling);
+      BandPriority band(keys, touched, ceiling);
       Simplifier pass(whole, band, standard_constraints(locked));
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
@@ -398,7 +430,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
 
   // The final pass: the borders and whatever remains down to the target, sequentially.
   t = std::chrono::steady_clock::now();
-  std::unique_ptr<PriorityModule> continued = without_initialize(*master);
+  // The band pass's keys too, so that the final pass starts from the queue as it is.
+  keys.reset(parallel.carry_keys ? keys.current_keys(whole) : std::vector<EdgeKey>{});
+  std::unique_ptr<PriorityModule> continued = without_initialize(keys);
   Simplifier final_pass(whole, *continued, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target;

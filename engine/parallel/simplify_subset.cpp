@@ -30,6 +30,17 @@ void globalise(CollapseRecord& r, const SubsetJob& job) {
   for (WedgeId& w : r.changed_wedges) w = wedge(w);
 }
 
+// Still sorted: local ids follow the global order.
+std::vector<EdgeKey> current_keys_in_global_ids(const KeyMemo& memo, const CollapseMesh& mesh,
+                                                const SubsetJob& job) {
+  std::vector<EdgeKey> keys = memo.current_keys(mesh);
+  for (EdgeKey& k : keys) {
+    k.a = job.global_vertex[k.a];
+    k.b = job.global_vertex[k.b];
+  }
+  return keys;
+}
+
 }  // namespace
 
 double thread_cpu_seconds() {
@@ -68,8 +79,10 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
     import_job_state(*metric, working, job);
     imported = without_initialize(*metric);
   }
+  KeyMemo memo(imported ? *imported : *metric, working.vertex_capacity());
+  memo.reset(job.keys);
   std::unique_ptr<PriorityModule> priority = make_subset_priority(
-      imported ? *imported : *metric, std::move(free_vertex),
+      memo, std::move(free_vertex),
       job.options.max_cost > 0 ? job.options.max_cost : std::numeric_limits<double>::infinity());
   auto constraints = standard_constraints(job.locked);
   constraints.push_back(make_subset_constraint(job.owned));
@@ -79,6 +92,9 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   result.records = simplifier.run(limits, progress, cancel);
   for (CollapseRecord& r : result.records) globalise(r, job);
   if (!job.state.empty()) result.state = export_result_state(*metric, working, job);
+  // Keys mean something to the master only when the job's state is the master's.
+  if (!job.state.empty()) result.keys = current_keys_in_global_ids(memo, working, job);
+  result.keys_reused = memo.reused();
   result.stats = simplifier.stats();
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "parallel/edge_keys.h"
 #include "simplify/collapse_mesh.h"
 #include "simplify/module_state.h"
 #include "simplify/simplify.h"
@@ -66,6 +67,9 @@ struct SubsetJob {
   // curves, wedge classes or quadrics. Empty: the job initialises its metric on its own mesh
   // (its own random points, seeded per round and subset).
   MetricState state;
+  // Queue keys still exact on the master (edge_keys.h), in local ids, a < b, sorted; only of
+  // edges with two free ends (subset_rule.h), the only ones the job costs.
+  std::vector<EdgeKey> keys;
 };
 
 // Builds the job of every subset of `vertex_subset` (per global vertex its subset in

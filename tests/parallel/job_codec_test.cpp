@@ -82,6 +82,14 @@ void expect_same_state(const MetricState& a, const MetricState& b, const std::st
   ASSERT_EQ(x.wedge_class, y.wedge_class) << what;
 }
 
+void expect_same_keys(const std::vector<EdgeKey>& a, const std::vector<EdgeKey>& b,
+                      const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (size_t i = 0; i < a.size(); ++i)
+    ASSERT_TRUE(a[i].a == b[i].a && a[i].b == b[i].b && same_bits(a[i].cost, b[i].cost))
+        << what << " key " << i;
+}
+
 void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& what) {
   ASSERT_EQ(a.round, b.round) << what;
   ASSERT_EQ(a.subset, b.subset) << what;
@@ -107,6 +115,7 @@ void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& 
               o.target_faces == p.target_faces && same_bits(o.max_cost, p.max_cost))
       << what;
   expect_same_state(a.state, b.state, what);
+  expect_same_keys(a.keys, b.keys, what);
 }
 
 void expect_same_records(const std::vector<CollapseRecord>& a, const std::vector<CollapseRecord>& b,
@@ -136,11 +145,14 @@ void expect_same_summary(const SubsetResult& a, const SubsetResult& b, const std
   ASSERT_TRUE(same_bits(a.wall_seconds, b.wall_seconds) && same_bits(a.cpu_seconds, b.cpu_seconds))
       << what;
   expect_same_state(a.state, b.state, what);
+  ASSERT_EQ(a.keys_reused, b.keys_reused) << what;
+  expect_same_keys(a.keys, b.keys, what + " keys");
 }
 
 // ---- Jobs as the parallel build makes them ---------------------------------------------------
 
-// Round 0 of a p-subset build of a test mesh: the jobs with the master's state.
+// Round 0 of a p-subset build of a test mesh: the jobs with the master's state and its queue
+// keys of their free edges.
 std::vector<SubsetJob> jobs_of(const std::string& name, const std::string& metric, uint32_t p) {
   const RepairedMesh repaired = testing::repaired_test_mesh(name);
   const Mesh& mesh = repaired.mesh;
@@ -158,6 +170,7 @@ std::vector<SubsetJob> jobs_of(const std::string& name, const std::string& metri
   for (SubsetJob& job : jobs) {
     job.options.target_faces = job.mesh.face_count() * 2 / 5;
     job.state = export_job_state(*master, job);
+    job.keys = testing::fresh_keys(*master, whole, job);
   }
   return jobs;
 }
@@ -196,6 +209,8 @@ TEST(JobCodec, JobsRecordsAndSummariesComeBackBitForBit) {
     const SubsetResult original = simplify_subset(job);
     const SubsetResult remote = simplify_subset(decoded);
     ASSERT_GT(original.records.size(), 100u) << what;
+    ASSERT_FALSE(job.keys.empty()) << what;
+    ASSERT_FALSE(remote.keys.empty()) << what;
     expect_same_records(original.records, remote.records, what + " simplified remotely");
     expect_same_state(original.state, remote.state, what + " result state");
     expect_same_records(original.records, records_round_trip(remote.records, 97),
@@ -326,27 +341,27 @@ TEST(JobCodec, HugeCountsAreRefusedBeforeAllocating) {
   // A job of 3 vertices and 2^40 faces, and one of 2^40 vertices.
   std::string message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(1);
+    out.u8(2);
     for (uint64_t x : {uint64_t(0), uint64_t(0), uint64_t(3), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 faces"), std::string::npos) << message;
   EXPECT_NE(message.find("subset job: byte "), std::string::npos) << message;
   message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(1);
+    out.u8(2);
     for (uint64_t x : {uint64_t(0), uint64_t(0), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 vertices"), std::string::npos) << message;
   message = message_of(Kind::kRecords, [&](ByteWriter& out) {
     out.bytes("PPCR", 4);
-    out.u8(1);
+    out.u8(2);
     out.varint(kHuge);
   });
   EXPECT_NE(message.find("1099511627776 records"), std::string::npos) << message;
   // A summary whose energy state claims 2^40 faces.
   message = message_of(Kind::kSummary, [&](ByteWriter& out) {
     out.bytes("PPSS", 4);
-    out.u8(1);
+    out.u8(2);
     out.varint(0);
     out.varint(0);
     out.u8(2);  // energy
@@ -405,6 +420,41 @@ TEST(JobCodec, MasterRefusesAReturnedStateOutsideItsMesh) {
       },
       "vertex");
   import_result_state(*master, result.state);  // the genuine one still goes in
+}
+
+// Queue keys name vertices: a job's must be its own (the decoder checks), a summary's the
+// master's (KeyMemo::reset checks, before they index anything).
+TEST(JobCodec, KeysOutsideTheMeshAreRefused) {
+  std::vector<SubsetJob> jobs = jobs_of("stratocaster-9k.ply", "energy", 4);
+  SubsetJob& job = jobs[2];
+  ASSERT_FALSE(job.keys.empty());
+  job.keys.push_back({job.keys.back().a + 1, VertexId(job.mesh.vertex_count()), 1.0});
+  std::string message;
+  EXPECT_FALSE(decodes(Kind::kJob, encode_subset_job(job), &message));
+  EXPECT_NE(message.find("queue key"), std::string::npos) << message;
+  job.keys.pop_back();
+
+  SubsetResult result;
+  decode_subset_summary(encode_subset_summary(simplify_subset(job)), result);
+  ASSERT_FALSE(result.keys.empty());
+  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
+  SimplifyOptions options;
+  options.metric = "energy";
+  std::unique_ptr<PriorityModule> master =
+      make_priority_module(options, repaired.mesh, locked_vertices(repaired));
+  KeyMemo memo(*master, repaired.mesh.vertex_count());
+  memo.reset(result.keys);  // the genuine ones go in
+  SubsetResult bad = result;
+  bad.keys.push_back({VertexId(repaired.mesh.vertex_count()) - 1,
+                      VertexId(repaired.mesh.vertex_count()) + 5, 1.0});
+  SubsetResult decoded;
+  decode_subset_summary(encode_subset_summary(bad), decoded);
+  try {
+    memo.reset(decoded.keys);
+    ADD_FAILURE() << "a key outside the mesh went in";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << e.what();
+  }
 }
 
 TEST(JobCodec, ReplayRefusesRecordsThatDoNotFitTheMesh) {

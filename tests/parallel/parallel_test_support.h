@@ -1,12 +1,19 @@
 // Shared by the parallel tests: a repaired real mesh, and a PM serialised to bytes.
 #pragma once
 
+#include <algorithm>
+#include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "io/mesh_io.h"
 #include "mesh/repair.h"
+#include "parallel/edge_keys.h"
+#include "parallel/subset_job.h"
+#include "parallel/subset_rule.h"
 #include "pm/pm_file.h"
+#include "simplify/modules.h"
 #include "test_support.h"
 
 namespace parapm::testing {
@@ -19,6 +26,30 @@ inline std::string pm_bytes(const ProgressiveMesh& pm) {
   std::ostringstream out;
   write_pm(pm, out);
   return out.str();
+}
+
+// Fresh queue keys of the job's edges with two free ends, costed by the master's module on the
+// whole mesh, in the job's local ids: what the job would cost itself.
+inline std::vector<EdgeKey> fresh_keys(const PriorityModule& master, const CollapseMesh& whole,
+                                       const SubsetJob& job) {
+  const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+  std::vector<EdgeKey> keys;
+  for (const Triangle& t : job.mesh.faces)
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
+      if (!free[a] || !free[b]) continue;
+      CollapseCandidate c;
+      const bool placed =
+          master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], c, Costing::kQueue);
+      keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
+    }
+  sort_keys(keys);
+  // An inner edge is listed by both its faces.
+  keys.erase(
+      std::unique(keys.begin(), keys.end(),
+                  [](const EdgeKey& x, const EdgeKey& y) { return x.a == y.a && x.b == y.b; }),
+      keys.end());
+  return keys;
 }
 
 }  // namespace parapm::testing

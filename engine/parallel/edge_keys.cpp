@@ -1,0 +1,83 @@
+#include "parallel/edge_keys.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "util/error.h"
+
+namespace parapm {
+
+void sort_keys(std::vector<EdgeKey>& keys) {
+  std::sort(keys.begin(), keys.end(),
+            [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+}
+
+KeyMemo::KeyMemo(PriorityModule& inner, size_t vertex_capacity)
+    : inner_(inner), head_(vertex_capacity, kEnd), changed_at_(vertex_capacity, 0) {}
+
+KeyMemo::Entry* KeyMemo::find(VertexId a, VertexId b) const {
+  for (uint32_t i = head_[a]; i != kEnd; i = entries_[i].next)
+    if (entries_[i].other == b) return &entries_[i];
+  return nullptr;
+}
+
+void KeyMemo::store(VertexId a, VertexId b, double cost, bool carried) const {
+  if (Entry* e = find(a, b)) {
+    *e = {b, e->next, time_, carried, cost};
+    return;
+  }
+  entries_.push_back({b, head_[a], time_, carried, cost});
+  head_[a] = uint32_t(entries_.size() - 1);
+}
+
+bool KeyMemo::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                       Costing costing) const {
+  if (costing != Costing::kQueue) return inner_.evaluate(mesh, a, b, out, costing);
+  const VertexId lo = std::min(a, b), hi = std::max(a, b);
+  if (Entry* e = find(lo, hi); e && e->carried && current(lo, *e)) {
+    ++reused_;
+    e->carried = false;  // answered once: the simplifier's next costing of it needs a fresh one
+    // A queue costing's caller reads only the cost (modules.h: the edge is costed again, with
+    // kPerform, before it is collapsed).
+    out.cost = e->cost;
+    return !std::isnan(e->cost);
+  }
+  const bool placed = inner_.evaluate(mesh, a, b, out, costing);
+  store(lo, hi, placed ? out.cost : std::numeric_limits<double>::quiet_NaN(), false);
+  return placed;
+}
+
+void KeyMemo::collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) {
+  inner_.collapsed(mesh, done, edge);
+  ++time_;
+  changed_at_[done.vs] = changed_at_[done.vt] = time_;
+}
+
+void KeyMemo::reset(const std::vector<EdgeKey>& keys) {
+  head_.assign(head_.size(), kEnd);
+  entries_.clear();
+  entries_.reserve(keys.size());
+  for (const EdgeKey& k : keys) {
+    // Keys may come from a worker: refused before they index anything.
+    if (k.a >= k.b || k.b >= head_.size())
+      throw_invalid("queue key (" + std::to_string(k.a) + ", " + std::to_string(k.b) +
+                    ") is not an edge of a mesh of " + std::to_string(head_.size()) + " vertices");
+    store(k.a, k.b, k.cost, true);
+  }
+}
+
+std::vector<EdgeKey> KeyMemo::current_keys(const CollapseMesh& mesh) const {
+  std::vector<EdgeKey> keys;
+  for (VertexId a = 0; a < head_.size(); ++a) {
+    if (!mesh.vertex_alive(a)) continue;
+    for_each_current_at(a, [&](const EdgeKey& k) {
+      if (mesh.vertex_alive(k.b)) keys.push_back(k);
+    });
+  }
+  sort_keys(keys);
+  return keys;
+}
+
+}  // namespace parapm

@@ -1,0 +1,164 @@
+// Queue keys carried between rounds (engine/parallel/edge_keys.h), on real meshes: a carried
+// key answers the first queue costing of its edge unless a collapse has changed an end of it,
+// every other costing is the module's, and a job given the keys its own costing would give
+// simplifies exactly as without them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "parallel/edge_keys.h"
+#include "parallel/job_state.h"
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_job.h"
+#include "parallel_test_support.h"
+#include "partition/partition.h"
+#include "simplify/simplify.h"
+
+namespace parapm {
+namespace {
+
+bool same_cost(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
+
+// Every edge once, a < b.
+std::vector<std::pair<VertexId, VertexId>> edges_of(const CollapseMesh& mesh) {
+  std::set<std::pair<VertexId, VertexId>> edges;
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    for (int k = 0; k < 3; ++k)
+      edges.insert({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+  }
+  return {edges.begin(), edges.end()};
+}
+
+TEST(EdgeKeys, ACarriedKeyAnswersOnceUntilAnEndOfItsEdgeChanges) {
+  for (const char* metric : {"energy", "quadric"}) {
+    const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
+    SimplifyOptions options;
+    options.metric = metric;
+    const std::vector<uint8_t> locked = locked_vertices(repaired);
+    CollapseMesh mesh(repaired.mesh);
+    std::unique_ptr<PriorityModule> module = make_priority_module(options, repaired.mesh, locked);
+    module->initialize(mesh);
+
+    // Keys that are not the module's (its own costs plus one), so that an answer from a key
+    // and a costing are told apart.
+    std::vector<EdgeKey> carried;
+    for (auto [a, b] : edges_of(mesh)) {
+      CollapseCandidate c;
+      if (module->evaluate(mesh, a, b, c, Costing::kQueue)) carried.push_back({a, b, c.cost + 1});
+    }
+    KeyMemo memo(*module, mesh.vertex_capacity());
+    memo.reset(carried);
+
+    // Collapses through the memo, as the simplifier performs them: every 7th edge that is
+    // still there, legal and placed.
+    const auto constraints = standard_constraints(locked);
+    for (auto& c : constraints) c->initialize(mesh);
+    std::vector<uint8_t> changed(mesh.vertex_capacity(), 0);
+    size_t collapses = 0, index = 0;
+    for (auto [a, b] : edges_of(mesh)) {
+      if (index++ % 7 != 0 || !mesh.vertex_alive(a) || !mesh.vertex_alive(b)) continue;
+      CollapseCandidate c;
+      if (!memo.evaluate(mesh, a, b, c, Costing::kPerform)) continue;
+      const EdgeFaces edge = mesh.edge_faces(c.vs, c.vt);
+      if (edge.left == kNoId && edge.right == kNoId) continue;
+      bool legal = true;
+      for (const auto& constraint : constraints) legal = legal && constraint->allows(mesh, c, edge);
+      if (!legal) continue;
+      mesh.collapse(c.vs, c.vt, c.position, edge);
+      memo.collapsed(mesh, c, edge);
+      for (const auto& constraint : constraints) constraint->collapsed(mesh, c);
+      changed[c.vs] = changed[c.vt] = 1;
+      ++collapses;
+    }
+    ASSERT_GT(collapses, 200u) << metric;
+    EXPECT_EQ(memo.reused(), 0u) << "a performed costing never takes a key";
+
+    // The first queue costing of an edge with both ends unchanged takes its carried key; any
+    // other costing is the module's, of the mesh as it is now.
+    size_t answered = 0, costed = 0;
+    for (auto [a, b] : edges_of(mesh)) {
+      const auto key = std::lower_bound(
+          carried.begin(), carried.end(), EdgeKey{a, b, 0},
+          [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+      const bool was_carried = key != carried.end() && key->a == a && key->b == b;
+      for (int ask = 0; ask < 2; ++ask) {
+        CollapseCandidate from_memo, fresh;
+        const bool placed = memo.evaluate(mesh, a, b, from_memo, Costing::kQueue);
+        const bool placed_fresh = module->evaluate(mesh, a, b, fresh, Costing::kQueue);
+        if (ask == 0 && was_carried && !changed[a] && !changed[b]) {
+          ASSERT_TRUE(placed && same_cost(from_memo.cost, key->cost))
+              << metric << " " << a << "-" << b;
+          ++answered;
+          continue;
+        }
+        ASSERT_EQ(placed, placed_fresh) << metric << " " << a << "-" << b;
+        if (placed) {
+          ASSERT_TRUE(same_cost(from_memo.cost, fresh.cost)) << metric << " " << a << "-" << b;
+        }
+        if (ask == 0) ++costed;
+      }
+    }
+    EXPECT_EQ(memo.reused(), answered) << metric;
+    EXPECT_GT(answered, 1000u) << metric;
+    EXPECT_GT(costed, 1000u) << metric;
+    // The memo's current keys are edges of the mesh.
+    for (const EdgeKey& k : memo.current_keys(mesh)) {
+      const EdgeFaces e = mesh.edge_faces(k.a, k.b);
+      ASSERT_TRUE(e.left != kNoId || e.right != kNoId) << k.a << "-" << k.b;
+    }
+    std::printf("%-8s %zu collapses: %zu edges answered from carried keys, %zu costed\n", metric,
+                collapses, answered, costed);
+  }
+}
+
+// A round-0 job given its free edges' keys as the master costs them (exactly what it would
+// cost itself) makes the same collapses, the same returned state and keys, and answers its
+// first costing of every one of them from the keys.
+TEST(EdgeKeys, AJobGivenFreshKeysSimplifiesAsWithout) {
+  for (const char* name : {"pymeshlab-bunny-textured-10k.obj", "stratocaster-9k.ply"}) {
+    const RepairedMesh repaired = testing::repaired_test_mesh(name);
+    const Mesh& mesh = repaired.mesh;
+    SimplifyOptions options;
+    options.metric = "energy";
+    const std::vector<uint8_t> locked = locked_vertices(repaired);
+    CollapseMesh whole(mesh);
+    std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
+    master->initialize(whole);
+    const Partition partition = partition_mesh(mesh, 3);
+    std::vector<SubsetJob> jobs =
+        extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                        partition.vertex_subset, 3, 0, subset_options_of(options, mesh));
+    SubsetJob& job = jobs[1];
+    job.options.target_faces = job.mesh.face_count() / 2;
+    job.state = export_job_state(*master, job);
+    const SubsetResult without = simplify_subset(job);
+    job.keys = testing::fresh_keys(*master, whole, job);
+    ASSERT_GT(job.keys.size(), 1000u) << name;
+    const SubsetResult with = simplify_subset(job);
+
+    EXPECT_EQ(without.keys_reused, 0u) << name;
+    EXPECT_GE(with.keys_reused, job.keys.size()) << name;
+    ASSERT_EQ(with.records.size(), without.records.size()) << name;
+    for (size_t i = 0; i < with.records.size(); ++i) {
+      const CollapseRecord &x = with.records[i], &y = without.records[i];
+      ASSERT_TRUE(x.vs == y.vs && x.vt == y.vt && same_cost(x.cost, y.cost) &&
+                  x.position == y.position)
+          << name << " record " << i;
+    }
+    ASSERT_EQ(with.keys.size(), without.keys.size()) << name;
+    for (size_t i = 0; i < with.keys.size(); ++i)
+      ASSERT_TRUE(with.keys[i].a == without.keys[i].a && with.keys[i].b == without.keys[i].b &&
+                  same_cost(with.keys[i].cost, without.keys[i].cost))
+          << name << " key " << i;
+    std::printf("%-36s job of %zu faces: %zu keys given, %llu answered, %zu collapses alike\n",
+                name, job.mesh.face_count(), job.keys.size(), (unsigned long long)with.keys_reused,
+                with.records.size());
+  }
+}
+
+}  // namespace
+}  // namespace parapm
