@@ -30,6 +30,8 @@ class QuadHeap {
     items_[i] = item;
   }
 
+  const T& top() const { return items_.front(); }  // not empty
+
   T pop() {
     const T top = items_.front();
     const T last = items_.back();

@@ -38,6 +38,20 @@ void Simplifier::remember_rejected(VertexId v, VertexId other) {
   if (std::find(list.begin(), list.end(), other) == list.end()) list.push_back(other);
 }
 
+bool Simplifier::take_requeued(const Entry& entry, CollapseCandidate& out) {
+  if (requeued_.empty()) return false;
+  const auto it = requeued_.find(edge_key(entry.a, entry.b));
+  if (it == requeued_.end()) return false;
+  const bool unchanged = star_changed_at_[entry.a] <= it->second.first &&
+                         star_changed_at_[entry.b] <= it->second.first;
+  if (unchanged) {
+    out = std::move(it->second.second);
+    ++stats_.requeue_reused;
+  }
+  requeued_.erase(it);
+  return unchanged;
+}
+
 bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const {
   for (const auto& module : constraints_)
     if (!module->allows(mesh_, candidate, edge)) return false;
@@ -83,6 +97,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   priority_.initialize(mesh_);
   for (const auto& module : constraints_) module->initialize(mesh_);
   version_.assign(mesh_.vertex_capacity(), 0);
+  star_changed_at_.assign(mesh_.vertex_capacity(), 0);
+  collapses_ = 0;
+  requeued_.clear();
   rejected_.assign(mesh_.vertex_capacity(), {});
 
   // Every undirected edge once: from the face holding a->b with a < b, or from the only face
@@ -131,8 +148,10 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     // The entry is current, so the cost and placement are those of the present mesh; only
     // legality depends on the neighbourhood and is checked now (Decimater: re-check on pop).
     CollapseCandidate candidate;
-    ++stats_.evaluations;
-    if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate, Costing::kPerform)) continue;
+    if (!take_requeued(entry, candidate)) {
+      ++stats_.evaluations;
+      if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate, Costing::kPerform)) continue;
+    }
     const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
     if (edge.left == kNoId && edge.right == kNoId) {  // a re-costed edge that is gone
       ++stats_.stale;
@@ -144,10 +163,28 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       remember_rejected(entry.b, entry.a);
       continue;
     }
+    // A key is kept until an end of its edge changes, though collapses beside the edge change
+    // its star, and with it the cost (the energy's points move in). A key that has fallen
+    // behind lets its edge jump the queue: when the cost now is above the next key, the edge
+    // goes back with it (lazy re-evaluation). It comes out again at its true cost, so the
+    // loop ends: a requeue changes no state.
+    while (!heap_.empty() && is_stale(heap_.top())) {
+      heap_.pop();
+      ++stats_.stale;
+    }
+    if (!heap_.empty() && static_cast<float>(candidate.cost) > heap_.top().cost) {
+      heap_.push({static_cast<float>(candidate.cost), entry.a, entry.b, entry.stamp});
+      ++stats_.requeued;
+      requeued_[edge_key(entry.a, entry.b)] = {collapses_, std::move(candidate)};
+      continue;
+    }
     records.push_back(perform(candidate, edge));
     const VertexId vs = candidate.vs;
     ++version_[vs];
     mesh_.neighbors(vs, ring);
+    ++collapses_;
+    star_changed_at_[vs] = star_changed_at_[candidate.vt] = collapses_;
+    for (VertexId n : ring) star_changed_at_[n] = collapses_;
     for (VertexId n : ring) push_edge(vs, n);
     // Edges vetoed earlier around the changed star may be legal now: cost them again.
     rejected_[candidate.vt].clear();

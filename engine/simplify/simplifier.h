@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "simplify/collapse_mesh.h"
@@ -47,7 +48,10 @@ struct SimplifierStats {
   uint64_t stale = 0;        // pops of outdated queue entries
   uint64_t reevaluated = 0;  // rejected edges costed again after their star changed
   uint64_t evaluations = 0;  // calls to the priority module's evaluate
-  std::string stop_reason;   // why the loop ended
+  // Popped edges whose cost, costed afresh, was above the next key: queued again with it.
+  uint64_t requeued = 0;
+  uint64_t requeue_reused = 0;  // of those, taken out again with their star unchanged
+  std::string stop_reason;      // why the loop ended
 };
 
 class Simplifier {
@@ -92,6 +96,14 @@ class Simplifier {
   QuadHeap<Entry, Before> heap_;
   std::vector<uint32_t> version_;
   std::vector<std::vector<VertexId>> rejected_;  // per vertex: edges vetoed since its last change
+  // Requeued edges' costings, kept while no collapse changes the edge's star (a collapse
+  // changes the faces around vs, vt and the neighbours of vs): the edge needs no new costing
+  // when it comes out again.
+  static uint64_t edge_key(VertexId a, VertexId b) { return uint64_t(a) << 32 | b; }
+  bool take_requeued(const Entry& entry, CollapseCandidate& out);
+  std::unordered_map<uint64_t, std::pair<uint32_t, CollapseCandidate>> requeued_;
+  std::vector<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
+  uint32_t collapses_ = 0;
   SimplifierStats stats_;
 };
 

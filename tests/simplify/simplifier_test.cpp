@@ -1,6 +1,7 @@
 // The collapse driver on drawn meshes: where it stops, determinism, the records it keeps.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "drawn_meshes.h"
@@ -87,6 +88,57 @@ TEST(Simplifier, RecordsNameTheApexesOfTheRemovedFaces) {
   const int j = corner_of(fr, first.vt);
   EXPECT_EQ(fr[(j + 1) % 3], first.vs);
   EXPECT_EQ(fr[(j + 2) % 3], first.vr);
+}
+
+// Costs an edge by its squared length, except that one edge's cost, costed for a collapse,
+// has grown past its queue key (as an energy key's does when collapses beside the edge move
+// points onto its star).
+class GrownCost : public PriorityModule {
+ public:
+  GrownCost(VertexId a, VertexId b) : a_(std::min(a, b)), b_(std::max(a, b)) {}
+  std::string name() const override { return "grown"; }
+  void initialize(const CollapseMesh&) override {}
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) const override {
+    const Vec3 &p = mesh.position(a), &q = mesh.position(b);
+    out.vs = a;
+    out.vt = b;
+    out.position = {(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2};
+    out.cost = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+               (p[2] - q[2]) * (p[2] - q[2]);
+    if (costing == Costing::kPerform && std::min(a, b) == a_ && std::max(a, b) == b_)
+      out.cost += 1000;
+    return true;
+  }
+  void collapsed(const CollapseMesh&, CollapseCandidate&, const EdgeFaces&) override {}
+
+ private:
+  VertexId a_, b_;
+};
+
+// The first key's edge costs more now than the next key: it goes back in the queue with
+// its present cost, and the cheaper collapses come first.
+TEST(Simplifier, AnEdgeWhoseCostGrewGoesBackInTheQueue) {
+  const Mesh sphere = uv_sphere(12, 16);
+  CollapseMesh cm(sphere);
+  // The edge collapsed first when no cost grows.
+  CollapseMesh plain_mesh(sphere);
+  GrownCost plain(kNoId, kNoId);
+  Simplifier first_run(plain_mesh, plain, standard_constraints({}));
+  const auto first = first_run.run({sphere.face_count() - 2}, {}, nullptr);
+  ASSERT_EQ(first.size(), 1u);
+  const VertexId sa = first[0].vs, sb = first[0].vt;
+  GrownCost priority(sa, sb);
+  std::vector<uint8_t> locked;
+  Simplifier simplifier(cm, priority, standard_constraints(locked));
+  const auto records = simplifier.run({sphere.face_count() - 40}, {}, nullptr);
+  ASSERT_EQ(records.size(), 20u);
+  EXPECT_GE(simplifier.stats().requeued, 1u);
+  for (const CollapseRecord& r : records) {
+    EXPECT_LT(r.cost, 1000) << "the grown edge went first";
+    EXPECT_FALSE(std::min(r.vs, r.vt) == std::min(sa, sb) &&
+                 std::max(r.vs, r.vt) == std::max(sa, sb));
+  }
 }
 
 }  // namespace
