@@ -246,12 +246,13 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_flag("--no-carry-keys", args->no_carry_keys,
                 "With --parallel: every round's jobs cost all their edges again instead of "
-                "taking the queue keys still exact from the round before (the PM is the same; "
-                "for measuring the work it saves)");
+                "starting from the queue keys the round before left (for measuring the work "
+                "they save; the PM differs a little, docs/BENCHMARKS.md)");
   cmd->add_flag("--json", args->json,
                 "Print one JSON object on stdout (with --parallel, under \"parallel\": p, rounds "
                 "performed, per round the partition, extraction, subset (per subset wall and "
-                "CPU) and merge seconds, the final pass, the CPU in all and the critical path)");
+                "CPU) and merge seconds, the queue keys carried and reused, the final pass, the "
+                "CPU in all and the critical path)");
   cmd->callback([args, &exit_code] { exit_code = run_simplify(*args); });
 }
 

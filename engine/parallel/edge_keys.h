@@ -1,7 +1,7 @@
 // Queue keys carried from round to round of the parallel construction. Every round's jobs
 // used to cost every edge of their subsets before their first collapse, although most of
 // those edges had a key at the end of the previous round that the sequential build would
-// still hold in its queue: on the 203k dragon at p = 2, a quarter of the build's work
+// still hold in its queue: on the 203k dragon at p = 2, a third of the subsets' work
 // (docs/BENCHMARKS.md, "Carried queue keys").
 //
 // The sequential build keeps an edge's key in its queue until a collapse changes one of its

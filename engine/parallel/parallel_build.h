@@ -44,9 +44,10 @@ struct ParallelOptions {
   // After each round but the first, a sequential pass over the edges around vertices no
   // collapse has touched, up to the 95th percentile of the round's costs (parallel_build.cpp).
   bool band_pass = true;
-  // Queue keys still exact after a round travel into the next round's jobs and the final
-  // pass, which cost only the other edges (edge_keys.h). Off: every job costs every edge; the
-  // PM is the same either way (tested), so this is for measuring.
+  // Queue keys still current after a round (no collapse changed an end of their edge) travel
+  // into the next round's jobs and the final pass, which cost only the other edges
+  // (edge_keys.h). Off: every job costs every edge afresh (for measuring; the PM differs a
+  // little, docs/BENCHMARKS.md "Carried queue keys").
   bool carry_keys = true;
   // Tests only: the master follows each round by re-running its module's collapsed() on every
   // merged record (the first step's path) instead of importing the jobs' returned states.
@@ -82,7 +83,7 @@ struct RoundStats {
   // the shorter of the two, which the critical path leaves out.
   double merge_overlap_seconds = 0;
   double slowest_subset_cpu_seconds = 0;
-  uint64_t keys_carried = 0;         // exact queue keys given to the jobs (edge_keys.h)
+  uint64_t keys_carried = 0;         // queue keys given to the jobs (edge_keys.h)
   uint64_t keys_reused = 0;          // the jobs' queue costings answered by them
   uint64_t band_pass_collapses = 0;  // sequential, after the merge (ParallelOptions::band_pass)
   double band_pass_seconds = 0;

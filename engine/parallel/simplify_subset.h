@@ -22,8 +22,8 @@ struct SubsetResult {
   // With a job state: the metric's state at the end, of the faces with three owned corners,
   // the owned vertices and their wedges, in global ids (job_state.h). Empty otherwise.
   MetricState state;
-  // The queue keys still exact at the end (edge_keys.h), in global ids, sorted by (a, b); the
-  // next round's jobs take those of their free edges instead of costing them again.
+  // The queue keys still current at the end (edge_keys.h), in global ids, sorted by (a, b);
+  // the next round's jobs take those of their free edges instead of costing them again.
   std::vector<EdgeKey> keys;
   uint64_t keys_reused = 0;  // queue costings the job answered from the job's keys
   uint64_t faces = 0;        // of the job's mesh, halo included

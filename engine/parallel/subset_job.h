@@ -67,8 +67,8 @@ struct SubsetJob {
   // curves, wedge classes or quadrics. Empty: the job initialises its metric on its own mesh
   // (its own random points, seeded per round and subset).
   MetricState state;
-  // Queue keys still exact on the master (edge_keys.h), in local ids, a < b, sorted; only of
-  // edges with two free ends (subset_rule.h), the only ones the job costs.
+  // Queue keys still current on the master (edge_keys.h), in local ids, a < b, sorted; only
+  // of edges with two free ends (subset_rule.h), the only ones the job costs.
   std::vector<EdgeKey> keys;
 };
 
