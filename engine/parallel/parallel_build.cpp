@@ -249,6 +249,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   for (uint32_t round = 0; round < 64; ++round) {
     RoundStats rs;
     rs.round = round;
+    uint32_t subsets = parallel.subsets;  // of this round
     rs.faces_before = whole.live_faces();
     if (whole.live_vertices() < 4 * size_t(parallel.subsets)) break;
     if (round < parallel.rounds) {
@@ -268,9 +269,12 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (!(done >= 0.9 * asked)) break;
       rs.goal_faces =
           std::max<uint64_t>(target, uint64_t(std::llround(double(rs.faces_before) * step)));
-      if (rs.goal_faces >= rs.faces_before ||
-          rs.goal_faces < uint64_t(parallel.subsets) * parallel.extra_round_subset_faces)
-        break;
+      if (rs.goal_faces >= rs.faces_before) break;
+      // Narrower rounds once p subsets would leave fewer faces each than the floor: the mesh
+      // keeps shrinking in parallel, and the sequential final pass stays short at any p.
+      subsets = uint32_t(
+          std::min<uint64_t>(parallel.subsets, rs.goal_faces / parallel.extra_round_subset_faces));
+      if (subsets < 2) break;
     }
 
     // A new partition of the current mesh: the previous round's borders, whose vertices could
@@ -280,26 +284,25 @@ ProgressiveMesh build_progressive_mesh_parallel(
     partition_options.seed = round_seed(options.seed, round);
     std::vector<uint32_t> vertex_subset;
     std::vector<uint64_t> assigned;
-    partition_live(whole, parallel.subsets, partition_options, vertex_subset, assigned);
+    partition_live(whole, subsets, partition_options, vertex_subset, assigned);
     rs.partition_seconds = seconds_since(t);
-    if (events.partitioned) events.partitioned(round, parallel.subsets, rs.faces_before);
+    if (events.partitioned) events.partitioned(round, subsets, rs.faces_before);
 
     // The jobs: which vertices each subset owns (sequential, O(vertices)), the water level
     // (sequential, on the master), then each job's mesh and the master's state over it, one
     // job per pool task (const reads of the whole mesh and the master: concurrently). With a
     // core per subset, only the slowest job's extraction is on the critical path.
     t = std::chrono::steady_clock::now();
-    const std::vector<std::vector<VertexId>> owned =
-        owned_vertices(whole, vertex_subset, parallel.subsets);
+    const std::vector<std::vector<VertexId>> owned = owned_vertices(whole, vertex_subset, subsets);
     double sequential_extract = seconds_since(t);
     if (parallel.water_level_factor > 0) {
       const auto ts = std::chrono::steady_clock::now();
-      rs.water_level = water_level(whole, keys, vertex_subset, parallel.subsets,
+      rs.water_level = water_level(whole, keys, vertex_subset, subsets,
                                    rs.faces_before - rs.goal_faces, parallel.water_level_factor);
       rs.share_seconds = seconds_since(ts);
       sequential_extract += rs.share_seconds;
     }
-    std::vector<SubsetJob> jobs(parallel.subsets);
+    std::vector<SubsetJob> jobs(subsets);
     std::vector<double> job_cpu(jobs.size(), 0);
     run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
       const double cpu = thread_cpu_seconds();
@@ -330,10 +333,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
     jobs.clear();
     rs.subsets_seconds = seconds_since(t);
     if (cancel) cancel->check();
-    if (results.size() != parallel.subsets)
+    if (results.size() != subsets)
       throw Error(ErrorCode::kInternal, "the subset runner returned " +
                                             std::to_string(results.size()) + " results for " +
-                                            std::to_string(parallel.subsets) + " jobs");
+                                            std::to_string(subsets) + " jobs");
 
     t = std::chrono::steady_clock::now();
     std::vector<std::vector<CollapseRecord>> lists;
@@ -418,9 +421,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
         "parallel round {}: {} subsets {}->{} faces (goal {}), partition {:.3f} s, extract "
         "{:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} replayed), band "
         "pass {} collapses in {:.3f} s",
-        round, parallel.subsets, rs.faces_before, rs.faces_after, rs.goal_faces,
-        rs.partition_seconds, rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds,
-        rs.merge_seconds, replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
+        round, subsets, rs.faces_before, rs.faces_after, rs.goal_faces, rs.partition_seconds,
+        rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds, rs.merge_seconds,
+        replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
     if (events.merged) events.merged(rs);
     st.round_stats.push_back(std::move(rs));
     if (progress) progress(input_faces - whole.live_faces(), input_faces - target);

@@ -32,10 +32,11 @@ struct ParallelOptions {
   // target. The defaults are measured in docs/ARCHITECTURE.md, "Parallel construction".
   double handover_ratio = 0.1;
   // Past the handover, further rounds at the same ratio per round, while the last round
-  // removed at least 90% of the faces it was asked to and the next one would leave each subset
-  // at least this many faces (0: none). A large mesh gets its final pass shorter (the 871k
-  // dragon at p = 8: 5 rounds); a mesh whose locked parts stop it early, or a small one, does
-  // not (docs/BENCHMARKS.md, "After the energy's queue keys").
+  // removed at least 90% of the faces it was asked to, each with as many subsets (up to p, at
+  // least 2) as leave each subset at least this many faces (0: none). A large mesh gets its
+  // final pass shorter (the 871k dragon at p = 16: 7 rounds, the last ones on 8, 4 and 2
+  // subsets); a mesh whose locked parts stop it early, or a small one, does not
+  // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds").
   uint64_t extra_round_subset_faces = 2000;
   // Jobs leave alone edges costing more than this factor times the round's water level
   // (parallel_build.cpp, water_level: the cost below which a sample of the edges would give

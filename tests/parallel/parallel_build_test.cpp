@@ -128,6 +128,33 @@ TEST(ParallelBuild, ExtraRoundsPastTheHandoverWhileTheyDoTheirShare) {
       (unsigned long long)none.final_pass_collapses);
 }
 
+// Past the handover, once p subsets would leave fewer faces each than the floor, the extra
+// rounds go on with fewer subsets (at least two): the vessel at p = 4 with a floor of 400 gets
+// a fourth round on 2 subsets, and a lossless PM.
+TEST(ParallelBuild, ExtraRoundsNarrowToKeepTheFloor) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
+  const SimplifyOptions options = metric_options("quadric", 0.005);
+  ParallelOptions parallel = with_p(4);
+  parallel.extra_round_subset_faces = 400;
+  ParallelStats stats;
+  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, parallel, &stats);
+  ASSERT_GT(stats.rounds, 3u);
+  for (size_t r = 0; r < stats.round_stats.size(); ++r) {
+    const RoundStats& round = stats.round_stats[r];
+    const size_t subsets = round.subsets.size();
+    if (r < 3) {
+      EXPECT_EQ(subsets, 4u) << "round " << r;
+      continue;
+    }
+    EXPECT_GE(subsets, 2u) << "round " << r;
+    EXPECT_LT(subsets, 4u) << "round " << r << ": 4 subsets would hold fewer than 400 faces";
+    EXPECT_GE(round.goal_faces, subsets * 400) << "round " << r;
+  }
+  const MeshDifference diff =
+      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
+  EXPECT_TRUE(diff.equal) << diff.first_difference;
+}
+
 // Keys carried from round to round (edge_keys.h): every round after the first gives its jobs
 // most of their edges' keys, the jobs answer their first costing of them from the keys, and
 // the PM stays lossless; without carrying, no key travels.
