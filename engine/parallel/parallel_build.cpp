@@ -230,6 +230,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // The master's queue keys: the water level's sample, the jobs' keys after a round,
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
   KeyMemo keys(*master, whole.vertex_capacity());
+  const bool carry_keys = parallel.carry_keys && carries_keys(options.metric);
   st.setup_seconds = seconds_since(t);
   st.critical_path_seconds = st.setup_seconds;
 
@@ -311,7 +312,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       jobs[i] = extract_subset(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
                                locked, vertex_subset, owned[i], uint32_t(i), round, subset_options);
       jobs[i].state = export_job_state(*master, jobs[i]);
-      if (parallel.carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i]);
+      if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i]);
       job_cpu[i] = thread_cpu_seconds() - cpu;
     });
     set_targets(jobs, assigned, rs.faces_before, rs.goal_faces);
@@ -390,7 +391,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     for (const CollapseRecord& r : merged) touched[r.vs] = touched[r.vt] = 1;
     // The jobs' keys are current on the master (edge_keys.h).
     std::vector<EdgeKey> returned;
-    if (parallel.carry_keys)
+    if (carry_keys)
       for (SubsetResult& r : results) returned.insert(returned.end(), r.keys.begin(), r.keys.end());
     keys.reset(returned);
     records.insert(records.end(), std::make_move_iterator(merged.begin()),
@@ -434,7 +435,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // The final pass: the borders and whatever remains down to the target, sequentially.
   t = std::chrono::steady_clock::now();
   // The band pass's keys too, so that the final pass starts from the queue as it is.
-  keys.reset(parallel.carry_keys ? keys.current_keys(whole) : std::vector<EdgeKey>{});
+  keys.reset(carry_keys ? keys.current_keys(whole) : std::vector<EdgeKey>{});
   std::unique_ptr<PriorityModule> continued = without_initialize(keys);
   Simplifier final_pass(whole, *continued, standard_constraints(locked));
   SimplifierLimits limits;

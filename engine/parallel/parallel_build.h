@@ -47,8 +47,9 @@ struct ParallelOptions {
   bool band_pass = true;
   // Queue keys still current after a round (no collapse changed an end of their edge) travel
   // into the next round's jobs and the final pass, which cost only the other edges
-  // (edge_keys.h). Off: every job costs every edge afresh (for measuring; the PM differs a
-  // little, docs/BENCHMARKS.md "Carried queue keys").
+  // (edge_keys.h; the energy only: the quadric's costings are cheaper than carrying them).
+  // Off: every job costs every edge afresh (for measuring; the PM differs a little,
+  // docs/BENCHMARKS.md "Carried queue keys").
   bool carry_keys = true;
   // Tests only: the master follows each round by re-running its module's collapsed() on every
   // merged record (the first step's path) instead of importing the jobs' returned states.

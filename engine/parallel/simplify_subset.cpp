@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <limits>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -79,10 +80,14 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
     import_job_state(*metric, working, job);
     imported = without_initialize(*metric);
   }
-  KeyMemo memo(imported ? *imported : *metric, working.vertex_capacity());
-  memo.reset(job.keys);
+  PriorityModule& module = imported ? *imported : *metric;
+  std::optional<KeyMemo> memo;  // only for a metric whose keys are worth carrying
+  if (carries_keys(job.options.metric)) {
+    memo.emplace(module, working.vertex_capacity());
+    memo->reset(job.keys);
+  }
   std::unique_ptr<PriorityModule> priority = make_subset_priority(
-      memo, std::move(free_vertex),
+      memo ? *memo : module, std::move(free_vertex),
       job.options.max_cost > 0 ? job.options.max_cost : std::numeric_limits<double>::infinity());
   auto constraints = standard_constraints(job.locked);
   constraints.push_back(make_subset_constraint(job.owned));
@@ -93,8 +98,8 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   for (CollapseRecord& r : result.records) globalise(r, job);
   if (!job.state.empty()) result.state = export_result_state(*metric, working, job);
   // Keys mean something to the master only when the job's state is the master's.
-  if (!job.state.empty()) result.keys = current_keys_in_global_ids(memo, working, job);
-  result.keys_reused = memo.reused();
+  if (memo && !job.state.empty()) result.keys = current_keys_in_global_ids(*memo, working, job);
+  result.keys_reused = memo ? memo->reused() : 0;
   result.stats = simplifier.stats();
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
