@@ -12,6 +12,31 @@ uint32_t local_of(const std::vector<uint32_t>& ids, uint32_t global) {
   return uint32_t(std::lower_bound(ids.begin(), ids.end(), global) - ids.begin());
 }
 
+// Per thread (jobs are built concurrently, one per pool task), a stamp and a slot per element
+// of the whole mesh: the extraction collects each face and vertex once, and finds a corner's
+// local id, without sorting every corner or searching for it (on the 871k dragon both were an
+// eighth of the quadric's parallel build).
+class Marks {
+ public:
+  void begin(size_t size) {
+    if (stamp_.size() < size) stamp_.resize(size, 0), slot_.resize(size, 0);
+    if (++generation_ == 0) {  // wrapped: forget every stamp
+      std::fill(stamp_.begin(), stamp_.end(), 0);
+      generation_ = 1;
+    }
+  }
+  bool first_visit(uint32_t id) {  // true once per id between begin() calls
+    if (stamp_[id] == generation_) return false;
+    stamp_[id] = generation_;
+    return true;
+  }
+  uint32_t& slot(uint32_t id) { return slot_[id]; }
+
+ private:
+  std::vector<uint32_t> stamp_, slot_;
+  uint32_t generation_ = 0;
+};
+
 }  // namespace
 
 SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout,
@@ -28,17 +53,20 @@ SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout
   job.options.seed = options.seed + 0x9E3779B97F4A7C15ull * (uint64_t(round) * 257 + subset + 1);
 
   // Faces: every live face around an owned vertex (the subset's faces and the halo).
+  thread_local Marks face_marks, vertex_marks;
+  face_marks.begin(mesh.face_capacity());
   for (VertexId v : owned_vertices)
-    for (FaceId f : mesh.faces_of(v)) job.global_face.push_back(f);
+    for (FaceId f : mesh.faces_of(v))
+      if (face_marks.first_visit(f)) job.global_face.push_back(f);
   std::sort(job.global_face.begin(), job.global_face.end());
-  job.global_face.erase(std::unique(job.global_face.begin(), job.global_face.end()),
-                        job.global_face.end());
   // Vertices: the corners of those faces.
+  vertex_marks.begin(mesh.vertex_capacity());
   for (FaceId f : job.global_face)
-    for (VertexId v : mesh.face(f)) job.global_vertex.push_back(v);
+    for (VertexId v : mesh.face(f))
+      if (vertex_marks.first_visit(v)) job.global_vertex.push_back(v);
   std::sort(job.global_vertex.begin(), job.global_vertex.end());
-  job.global_vertex.erase(std::unique(job.global_vertex.begin(), job.global_vertex.end()),
-                          job.global_vertex.end());
+  for (size_t i = 0; i < job.global_vertex.size(); ++i)
+    vertex_marks.slot(job.global_vertex[i]) = uint32_t(i);
 
   Mesh& out = job.mesh;
   out.positions_are_float = positions_are_float;
@@ -56,7 +84,7 @@ SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout
     Triangle local;
     bool all_owned = true;
     for (int k = 0; k < 3; ++k) {
-      local[k] = local_of(job.global_vertex, t[k]);
+      local[k] = vertex_marks.slot(t[k]);
       all_owned = all_owned && job.owned[local[k]];
     }
     out.faces.push_back(local);
