@@ -25,9 +25,9 @@ KeyMemo::Entry* KeyMemo::find(VertexId a, VertexId b) const {
   return nullptr;
 }
 
-void KeyMemo::store(VertexId a, VertexId b, double cost, bool carried) const {
-  if (Entry* e = find(a, b)) {
-    *e = {b, e->next, time_, carried, cost};
+void KeyMemo::store(Entry* found, VertexId a, VertexId b, double cost, bool carried) const {
+  if (found) {
+    *found = {b, found->next, time_, carried, cost};
     return;
   }
   entries_.push_back({b, head_[a], time_, carried, cost});
@@ -38,7 +38,8 @@ bool KeyMemo::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, Collaps
                        Costing costing) const {
   if (costing != Costing::kQueue) return inner_.evaluate(mesh, a, b, out, costing);
   const VertexId lo = std::min(a, b), hi = std::max(a, b);
-  if (Entry* e = find(lo, hi); e && e->carried && current(lo, *e)) {
+  Entry* const e = find(lo, hi);
+  if (e && e->carried && current(lo, *e)) {
     ++reused_;
     e->carried = false;  // answered once: the simplifier's next costing of it needs a fresh one
     // A queue costing's caller reads only the cost (modules.h: the edge is costed again, with
@@ -47,7 +48,8 @@ bool KeyMemo::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, Collaps
     return !std::isnan(e->cost);
   }
   const bool placed = inner_.evaluate(mesh, a, b, out, costing);
-  store(lo, hi, placed ? out.cost : std::numeric_limits<double>::quiet_NaN(), false);
+  // (The inner module never touches the memo, so `e` still points at the entry.)
+  store(e, lo, hi, placed ? out.cost : std::numeric_limits<double>::quiet_NaN(), false);
   return placed;
 }
 
@@ -66,7 +68,7 @@ void KeyMemo::reset(const std::vector<EdgeKey>& keys) {
     if (k.a >= k.b || k.b >= head_.size())
       throw_invalid("queue key (" + std::to_string(k.a) + ", " + std::to_string(k.b) +
                     ") is not an edge of a mesh of " + std::to_string(head_.size()) + " vertices");
-    store(k.a, k.b, k.cost, true);
+    store(find(k.a, k.b), k.a, k.b, k.cost, true);
   }
 }
 

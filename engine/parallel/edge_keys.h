@@ -82,7 +82,8 @@ class KeyMemo : public PriorityModule {
     return changed_at_[a] <= e.time && changed_at_[e.other] <= e.time;
   }
   Entry* find(VertexId a, VertexId b) const;
-  void store(VertexId a, VertexId b, double cost, bool carried) const;
+  // Overwrites `found` (find(a, b)'s answer) or lists a new entry at a.
+  void store(Entry* found, VertexId a, VertexId b, double cost, bool carried) const;
 
   PriorityModule& inner_;
   mutable std::vector<uint32_t> head_;  // per vertex: its first entry, kEnd for none

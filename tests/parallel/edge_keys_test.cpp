@@ -13,7 +13,6 @@
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
 #include "parallel_test_support.h"
-#include "partition/partition.h"
 #include "simplify/simplify.h"
 
 namespace parapm {
@@ -120,23 +119,13 @@ TEST(EdgeKeys, ACarriedKeyAnswersOnceUntilAnEndOfItsEdgeChanges) {
 // first costing of every one of them from the keys.
 TEST(EdgeKeys, AJobGivenFreshKeysSimplifiesAsWithout) {
   for (const char* name : {"pymeshlab-bunny-textured-10k.obj", "stratocaster-9k.ply"}) {
-    const RepairedMesh repaired = testing::repaired_test_mesh(name);
-    const Mesh& mesh = repaired.mesh;
     SimplifyOptions options;
     options.metric = "energy";
-    const std::vector<uint8_t> locked = locked_vertices(repaired);
-    CollapseMesh whole(mesh);
-    std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
-    master->initialize(whole);
-    const Partition partition = partition_mesh(mesh, 3);
-    std::vector<SubsetJob> jobs =
-        extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                        partition.vertex_subset, 3, 0, subset_options_of(options, mesh));
-    SubsetJob& job = jobs[1];
+    testing::RoundZero round(name, options, 3);
+    SubsetJob& job = round.jobs[1];
     job.options.target_faces = job.mesh.face_count() / 2;
-    job.state = export_job_state(*master, job);
     const SubsetResult without = simplify_subset(job);
-    job.keys = testing::fresh_keys(*master, whole, job);
+    job.keys = testing::fresh_keys(*round.master, round.whole, job);
     ASSERT_GT(job.keys.size(), 1000u) << name;
     const SubsetResult with = simplify_subset(job);
 

@@ -154,25 +154,15 @@ void expect_same_summary(const SubsetResult& a, const SubsetResult& b, const std
 // Round 0 of a p-subset build of a test mesh: the jobs with the master's state and its queue
 // keys of their free edges.
 std::vector<SubsetJob> jobs_of(const std::string& name, const std::string& metric, uint32_t p) {
-  const RepairedMesh repaired = testing::repaired_test_mesh(name);
-  const Mesh& mesh = repaired.mesh;
   SimplifyOptions options;
   options.metric = metric;
   options.samples_per_face = metric == "energy" ? 1 : 0;  // points on faces, not only parked
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  CollapseMesh whole(mesh);
-  std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
-  master->initialize(whole);
-  const Partition partition = partition_mesh(mesh, p);
-  std::vector<SubsetJob> jobs =
-      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                      partition.vertex_subset, p, 0, subset_options_of(options, mesh));
-  for (SubsetJob& job : jobs) {
+  testing::RoundZero round(name, options, p);
+  for (SubsetJob& job : round.jobs) {
     job.options.target_faces = job.mesh.face_count() * 2 / 5;
-    job.state = export_job_state(*master, job);
-    job.keys = testing::fresh_keys(*master, whole, job);
+    job.keys = testing::fresh_keys(*round.master, round.whole, job);
   }
-  return jobs;
+  return std::move(round.jobs);
 }
 
 // Records in batches of `batch`, as a worker streams them.
@@ -374,21 +364,12 @@ TEST(JobCodec, HugeCountsAreRefusedBeforeAllocating) {
 // A summary's state is in global ids, which only the master can check: it refuses ids
 // outside its mesh before they index anything.
 TEST(JobCodec, MasterRefusesAReturnedStateOutsideItsMesh) {
-  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
-  const Mesh& mesh = repaired.mesh;
   SimplifyOptions options;
   options.metric = "energy";
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  CollapseMesh whole(mesh);
-  std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
-  master->initialize(whole);
-  const Partition partition = partition_mesh(mesh, 4);
-  std::vector<SubsetJob> jobs =
-      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                      partition.vertex_subset, 4, 0, subset_options_of(options, mesh));
-  SubsetJob& job = jobs[0];
+  testing::RoundZero round("stratocaster-9k.ply", options, 4);
+  const Mesh& mesh = round.repaired.mesh;
+  SubsetJob& job = round.jobs[0];
   job.options.target_faces = job.mesh.face_count() / 2;
-  job.state = export_job_state(*master, job);
   SubsetResult result;
   decode_subset_summary(encode_subset_summary(simplify_subset(job)), result);
   const EnergyState& state = result.state.energy;
@@ -404,7 +385,7 @@ TEST(JobCodec, MasterRefusesAReturnedStateOutsideItsMesh) {
     decode_subset_summary(encode_subset_summary(bad), decoded);
     // ... and the master refuses it.
     try {
-      import_result_state(*master, decoded.state);
+      import_result_state(*round.master, decoded.state);
       ADD_FAILURE() << what << ": imported";
     } catch (const Error& e) {
       EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << what << ": " << e.what();
@@ -420,7 +401,7 @@ TEST(JobCodec, MasterRefusesAReturnedStateOutsideItsMesh) {
         s.vertices.back() = outside;
       },
       "vertex");
-  import_result_state(*master, result.state);  // the genuine one still goes in
+  import_result_state(*round.master, result.state);  // the genuine one still goes in
 }
 
 // Queue keys name vertices: a job's must be its own (the decoder checks), a summary's the

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -10,10 +11,13 @@
 #include "io/mesh_io.h"
 #include "mesh/repair.h"
 #include "parallel/edge_keys.h"
+#include "parallel/job_state.h"
 #include "parallel/subset_job.h"
 #include "parallel/subset_rule.h"
+#include "partition/partition.h"
 #include "pm/pm_file.h"
 #include "simplify/modules.h"
+#include "simplify/simplify.h"
 #include "test_support.h"
 
 namespace parapm::testing {
@@ -27,6 +31,29 @@ inline std::string pm_bytes(const ProgressiveMesh& pm) {
   write_pm(pm, out);
   return out.str();
 }
+
+// Round 0 of a p-subset build of a test mesh, as the parallel build starts it: the whole mesh,
+// the master's module initialised on it, and every subset's job with the master's state (no
+// target, no keys: the test sets them).
+struct RoundZero {
+  RoundZero(const std::string& name, const SimplifyOptions& options, uint32_t p)
+      : repaired(repaired_test_mesh(name)),
+        locked(locked_vertices(repaired)),
+        whole(repaired.mesh),
+        master(make_priority_module(options, repaired.mesh, locked)) {
+    const Mesh& mesh = repaired.mesh;
+    master->initialize(whole);
+    const Partition partition = partition_mesh(mesh, p);
+    jobs = extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                           partition.vertex_subset, p, 0, subset_options_of(options, mesh));
+    for (SubsetJob& job : jobs) job.state = export_job_state(*master, job);
+  }
+  RepairedMesh repaired;
+  std::vector<uint8_t> locked;
+  CollapseMesh whole;
+  std::unique_ptr<PriorityModule> master;
+  std::vector<SubsetJob> jobs;
+};
 
 // Fresh queue keys of the job's edges with two free ends, costed by the master's module on the
 // whole mesh, in the job's local ids: what the job would cost itself.

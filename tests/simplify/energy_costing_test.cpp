@@ -147,8 +147,8 @@ class FreshCosting : public ConstraintModule {
               const EdgeFaces&) const override {
     CollapseCandidate fresh;
     // As the simplifier asks: the edge's ends in id order.
-    const bool placed = priority_.evaluate(mesh, std::min(c.vs, c.vt), std::max(c.vs, c.vt),
-                                           fresh, Costing::kPerform);
+    const bool placed = priority_.evaluate(mesh, std::min(c.vs, c.vt), std::max(c.vs, c.vt), fresh,
+                                           Costing::kPerform);
     ++checked;
     if (!placed || fresh.vs != c.vs || fresh.cost != c.cost || fresh.position != c.position)
       ++differ;
