@@ -103,6 +103,7 @@ ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseReco
       done.position = r.position;
       done.cost = r.cost;
       done.error = r.error;
+      done.vs_before = r.vs_position;
       priority->collapsed(mesh, done, edge);
       if (done.changed_wedges != r.changed_wedges || done.changed_values != r.changed_values)
         ++report.attribute_mismatches;

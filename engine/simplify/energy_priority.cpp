@@ -70,6 +70,8 @@ void EnergyPriority::initialize(const CollapseMesh& mesh) {
   moments_.assign(mesh.face_capacity(), PointMoments{});
   moments_ready_.assign(mesh.face_capacity(), 0);
   own_.assign(mesh.face_capacity(), OwnError{});
+  max_distance_sq_.assign(mesh.face_capacity(), 0);
+  drift_.assign(mesh.face_capacity(), 0);
   parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
   for (const SurfaceSample& s : samples) {
     const auto id = uint32_t(positions_.size());
@@ -97,10 +99,11 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
                                   bool to_local, EnergyState& out) const {
   const IdTranslation to_face{maps.face, to_local}, to_vertex{maps.vertex, to_local};
   const int floats = scalar_.enabled() ? scalar_.floats() : 0;
-  auto add_point = [&](const FacePoint& p, FaceId face, VertexId vertex) {
+  // A face's drift goes into its points' distances: the state holds bounds, and no drift.
+  auto add_point = [&](const FacePoint& p, FaceId face, VertexId vertex, double distance_sq) {
     const uint32_t id = p.id;
     out.points.push_back({point_id_.empty() ? id : point_id_[id], face, vertex, p.position,
-                          p.distance_sq, floats ? scalar_.residual(id) : 0.0});
+                          distance_sq, floats ? scalar_.residual(id) : 0.0});
     if (floats)
       out.point_values.insert(out.point_values.end(), scalar_.point_values(id),
                               scalar_.point_values(id) + floats);
@@ -108,12 +111,13 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
   for (FaceId f : faces) {
     const FaceId written = to_face(f);
     out.faces.push_back(written);
-    for (const FacePoint& p : face_points_[f]) add_point(p, written, kNoId);
+    for (const FacePoint& p : face_points_[f])
+      add_point(p, written, kNoId, bounded_distance_sq(f, p));
   }
   for (VertexId v : vertices) {
     const VertexId written = to_vertex(v);
     out.vertices.push_back(written);
-    if (parked_point_[v] != kNoPoint) add_point(parked(parked_point_[v]), kNoId, written);
+    if (parked_point_[v] != kNoPoint) add_point(parked(parked_point_[v]), kNoId, written, 0.0);
   }
   curves_.export_state(vertices, to_vertex, out);
   if (floats) scalar_.export_wedges(wedges, IdTranslation{maps.wedge, to_local}, out);
@@ -168,6 +172,8 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   moments_.assign(mesh.face_capacity(), PointMoments{});
   moments_ready_.assign(mesh.face_capacity(), 0);
   own_.assign(mesh.face_capacity(), OwnError{});
+  max_distance_sq_.assign(mesh.face_capacity(), 0);
+  drift_.assign(mesh.face_capacity(), 0);
   parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
   // The faces keep the written order.
   for (size_t i = 0; i < n; ++i) {
@@ -190,6 +196,7 @@ void EnergyPriority::import_global(const EnergyState& state) {
   for (FaceId f : state.faces) {
     face_points_[f].clear();
     moments_ready_[f] = 0;
+    drift_[f] = 0;
   }
   for (VertexId v : state.vertices) parked_point_[v] = kNoPoint;
   // The faces keep the written order.
@@ -277,7 +284,7 @@ std::vector<EnergyPriority::PointState> EnergyPriority::point_states() const {
   for (FaceId f = 0; f < face_points_.size(); ++f)
     for (const FacePoint& p : face_points_[f]) {
       states[p.id].face = f;
-      states[p.id].distance_sq = p.distance_sq;
+      states[p.id].distance_sq = bounded_distance_sq(f, p);
     }
   for (VertexId v = 0; v < parked_point_.size(); ++v)
     if (parked_point_[v] != kNoPoint) states[parked_point_[v]].parked = v;
@@ -287,6 +294,7 @@ std::vector<EnergyPriority::PointState> EnergyPriority::point_states() const {
 void EnergyPriority::gather_face(FaceId f, int home) const {
   for (const FacePoint& p : face_points_[f]) {
     star_points_.push_back(p);
+    star_points_.back().distance_sq = bounded_distance_sq(f, p);
     star_homes_.push_back(home);
   }
 }
@@ -294,8 +302,13 @@ void EnergyPriority::gather_face(FaceId f, int home) const {
 const PointMoments& EnergyPriority::moments_of(FaceId f) const {
   if (!moments_ready_[f]) {
     PointMoments m;
-    for (const FacePoint& p : face_points_[f]) m.add(p.position);
+    double max_distance_sq = 0;
+    for (const FacePoint& p : face_points_[f]) {
+      m.add(p.position);
+      max_distance_sq = std::max(max_distance_sq, p.distance_sq);
+    }
     moments_[f] = m;
+    max_distance_sq_[f] = max_distance_sq;
     moments_ready_[f] = 1;
   }
   return moments_[f];
@@ -832,8 +845,15 @@ void EnergyPriority::update_attributes(const CollapseMesh& mesh, CollapseCandida
 void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                                const EdgeFaces& edge) {
   // Every point of the old star goes to its closest face of the new one; so do the samples
-  // of vt (removed) and of vs if it moved.
+  // of vt (removed) and of vs if it moved. A star too rich in points moves only those of the
+  // removed faces and the samples (see the header).
   const auto& faces = mesh.faces_of(done.vs);
+  size_t in_star = 0;
+  for (FaceId f : {edge.left, edge.right})
+    if (f != kNoId) in_star += face_points_[f].size();
+  for (FaceId f : faces) in_star += face_points_[f].size();
+  const uint32_t cap = options_.max_points_per_reprojection;
+  const bool keep_faces = !scalar_.enabled() && cap > 0 && in_star > cap;
   auto index_of = [&](VertexId corner) {
     for (size_t j = 0; j < faces.size(); ++j)
       if (corner_of(mesh.face(faces[j]), corner) >= 0) return int(j);
@@ -847,14 +867,17 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
     star_homes_.insert(star_homes_.end(), list.size(), home);
     list.clear();
     moments_ready_[f] = 0;
+    drift_[f] = 0;
   };
   for (const auto& [removed, apex] :
        {std::pair{edge.left, edge.left_apex}, std::pair{edge.right, edge.right_apex}})
     if (removed != kNoId) {
+      // (Its stored distances may lag: moved again, each point's is computed anew.)
       take(removed, index_of(apex));
       face_points_[removed].shrink_to_fit();
     }
-  for (size_t j = 0; j < faces.size(); ++j) take(faces[j], int(j));
+  if (!keep_faces)
+    for (size_t j = 0; j < faces.size(); ++j) take(faces[j], int(j));
   unpark(done.vt);
   const uint32_t vs_sample = parked_point_[done.vs];
   // vs's own sample stays exact while vs stays put, unless E_scalar gives its wedges new
@@ -864,6 +887,21 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   star_homes_.resize(star_points_.size(), -1);  // the unparked samples: no home
   double max_distance_sq = curves_.collapsed(done.vs, done.vt, mesh);
   if (faces.empty()) return;
+  if (keep_faces) {
+    // A point's closest point on a face of the fan is b0 v + b1 p1 + b2 p2, with v where vs
+    // or vt was: it moves by at most b0 |v - old|.
+    const Vec3 to_s = sub(done.position, done.vs_before);
+    const Vec3 to_t = sub(done.position, mesh.position(done.vt));  // (vt keeps its position)
+    const double shift = std::sqrt(std::max(dot(to_s, to_s), dot(to_t, to_t)));
+    for (FaceId f : faces) {
+      if (face_points_[f].empty()) continue;
+      moments_of(f);
+      moments_ready_[f] = 1;  // the points are the same, the corners not
+      drift_[f] += shift;
+      const double bound = std::sqrt(max_distance_sq_[f]) + drift_[f];
+      max_distance_sq = std::max(max_distance_sq, bound * bound);
+    }
+  }
   prepare_fan(mesh, done.vs);
   moved_faces_.resize(star_points_.size());
   moved_bary_.resize(star_points_.size());
@@ -876,6 +914,7 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
     moved_bary_[i] = best.bary;
     point.distance_sq = best.distance_sq;
     face_points_[face].push_back(point);
+    moments_ready_[face] = 0;
     max_distance_sq = std::max(max_distance_sq, best.distance_sq);
   }
   if (scalar_.enabled()) update_attributes(mesh, done, edge);

@@ -25,9 +25,14 @@
 // placement by iteratively reweighted least squares on those planes, both O(faces of the
 // star) whatever its points. Smaller stars project each point onto the new star (and may move
 // it to the face beside). E_scalar and E_disc cost each point or curve sample they see: beyond
-// max_sampled_points, every k-th one stands for k. Only the collapse actually performed
-// re-projects every point of its star onto its closest face, so that the stored distances, and
-// the error recorded in the PM, are exact.
+// max_sampled_points, every k-th one stands for k. The collapse actually performed re-projects
+// every point of its star onto its closest face, so that the stored distances, and the error
+// recorded in the PM, are exact; but a star holding more than max_points_per_reprojection
+// points (the last collapses of a large mesh: thousands) only re-projects the points of the
+// two faces it removes and the samples of its vertices, and the other faces keep theirs, their
+// moments still valid: O(faces) again. Such a face's stored distances then lag behind its
+// corners; it keeps a bound of how far they moved (drift_), and every distance read from it
+// is stored distance + drift, an upper bound (the error recorded in the PM stays one).
 //
 // Queue keys (Costing::kQueue) are most of the evaluations and most are never used: each start
 // is measured and solved, but the solved position is costed on the model it was solved on,
@@ -38,6 +43,7 @@
 // a collapse moves or removes the vertex. Early on, that is almost every point.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -61,6 +67,9 @@ struct EnergyOptions {
   // Beyond this many, E_scalar's points and E_disc's curve samples are costed on every k-th
   // one, weighted by k (their cost is per point, not per face). 0: all of them.
   uint32_t max_sampled_points = 64;
+  // A performed collapse whose star holds more points re-projects only the points that must
+  // move (see above). 0: always every point. Not with E_scalar (its residuals are per point).
+  uint32_t max_points_per_reprojection = 1024;
   int solves_per_start = 1;     // least-squares solves after the first projection, per start
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
   bool discontinuities = true;  // E_disc: sample and keep the sharp curves (sharp_curves.h)
@@ -208,6 +217,12 @@ class EnergyPriority : public PriorityModule {
                                               const FacePoint& point, int home) const;
   void update_attributes(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge);
   void gather_face(FaceId f, int home) const;
+  // The points' stored squared distance to face f, raised by its drift (an upper bound).
+  double bounded_distance_sq(FaceId f, const FacePoint& p) const {
+    if (drift_[f] == 0) return p.distance_sq;
+    const double d = std::sqrt(p.distance_sq) + drift_[f];
+    return d * d;
+  }
   void unpark(VertexId v);
   FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
   double diagonal_of(const CollapseMesh& mesh) const;
@@ -249,9 +264,13 @@ class EnergyPriority : public PriorityModule {
   // forgotten when its point list changes).
   mutable std::vector<PointMoments> moments_;
   // 0: nothing known, 1: moments_, 2: moments_ and own_ (a face's corners move only in a
-  // collapse that re-projects its points, which resets this).
+  // performed collapse, which resets this to 0, or to 1 when the face keeps its points).
   mutable std::vector<uint8_t> moments_ready_;
   mutable std::vector<OwnError> own_;
+  // Per face: the largest stored squared distance of its points (kept with its moments), and
+  // how far the closest surface points of its points may have moved since they were stored.
+  mutable std::vector<double> max_distance_sq_;
+  std::vector<double> drift_;
   mutable std::array<std::pair<WedgeId, WedgeId>, 2> joined_{};  // wedges of a, b in fl, fr
   mutable int joined_count_ = 0;
   mutable std::vector<Projected> projected_;  // per star point, at the chosen placement

@@ -18,6 +18,7 @@ struct CollapseCandidate {
   Vec3 position{};
   double cost = 0;   // priority: smaller collapses first; units are the module's own
   double error = 0;  // geometric error of the collapse in model units (for cutting a PM)
+  Vec3 vs_before{};  // where vs was: set when the collapse is performed (or replayed)
   // Filled by PriorityModule::collapsed when the module changed wedge values (E_scalar): the
   // wedges and their new values, floats_per_wedge each.
   std::vector<WedgeId> changed_wedges;
@@ -41,8 +42,9 @@ class PriorityModule {
   virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                         Costing costing) const = 0;
   // Called after the mesh performed `done`, to update the module's state. `edge` names the two
-  // faces the collapse removed (now dead). The module may refine done.error with what it
-  // learns from the performed collapse (the record takes the refined value).
+  // faces the collapse removed (now dead); done.vs_before where vs was (vt keeps its position
+  // in the mesh). The module may refine done.error with what it learns from the performed
+  // collapse (the record takes the refined value).
   virtual void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                          const EdgeFaces& edge) = 0;
 };

@@ -81,6 +81,7 @@ CollapseRecord Simplifier::perform(CollapseCandidate c, const EdgeFaces& edge) {
     corners(edge.left, c.vs, 0);
     corners(edge.right, c.vt, 3);
   }
+  c.vs_before = mesh_.position(c.vs);
   mesh_.collapse(c.vs, c.vt, c.position, edge);
   priority_.collapsed(mesh_, c, edge);
   r.error = static_cast<float>(c.error);

@@ -67,6 +67,7 @@ TEST(EdgeKeys, ACarriedKeyAnswersOnceUntilAnEndOfItsEdgeChanges) {
       bool legal = true;
       for (const auto& constraint : constraints) legal = legal && constraint->allows(mesh, c, edge);
       if (!legal) continue;
+      c.vs_before = mesh.position(c.vs);
       mesh.collapse(c.vs, c.vt, c.position, edge);
       memo.collapsed(mesh, c, edge);
       for (const auto& constraint : constraints) constraint->collapsed(mesh, c);
