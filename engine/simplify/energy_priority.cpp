@@ -680,7 +680,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   const double curve_before = curves_.gathered_distance_sq();
   const double distance_before = by_moments ? moment_distance_before(mesh) : exact_distance_sq();
 
-  const double kappa = spring_constant(points_around / double(star_.size()));
+  const double kappa =
+      options_.spring_scale * spring_constant(points_around / double(star_.size()));
   Vec3 spring_pull{};  // kappa/2 * sum (p1 + p2): the springs' part of the normal equations
   for (const StarFace& f : star_) spring_pull = add(spring_pull, add(f.p1, f.p2));
   spring_pull = scale(spring_pull, 0.5 * kappa);

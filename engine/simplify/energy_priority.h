@@ -5,10 +5,10 @@
 //   sampled on the original surface to the current mesh (each point keeps the face it
 //   projects onto), E_spring = kappa * sum over edges of |e|^2, with kappa adapted per
 //   collapse from the ratio of points to faces around the edge (a regulariser that fades as
-//   points accumulate), and E_disc the same distance for points sampled on the sharp curves
-//   (boundaries, creases, seams), measured against the curves (sharp_curves.h), and E_scalar
-//   the attributes' error at the same points (scalar_attributes.h). A collapse that changes
-//   the curves' topology is penalised.
+//   points accumulate: Hoppe's schedule, scaled by EnergyOptions::spring_scale), and E_disc the
+//   same distance for points sampled on the sharp curves (boundaries, creases, seams), measured
+//   against the curves (sharp_curves.h), and E_scalar the attributes' error at the same points
+//   (scalar_attributes.h). A collapse that changes the curves' topology is penalised.
 //
 // The cost of collapsing {a, b} is the change of E restricted to the star of the edge and the
 // points on it, with the surviving vertex placed by the best of three starts (a, b, the
@@ -70,6 +70,11 @@ struct EnergyOptions {
   // A performed collapse whose star holds more points re-projects only the points that must
   // move (see above). 0: always every point. Not with E_scalar (its residuals are per point).
   uint32_t max_points_per_reprojection = 1024;
+  // E_spring's kappa is Hoppe's schedule (spring_constant) times this. Hoppe's own values,
+  // with one point per vertex (about one per two faces), make a young star's springs outweigh
+  // its points' distances many times over: collapses are then ordered and placed by edge
+  // length, a smoothing, not by distance (docs/BENCHMARKS.md, "E_spring's weight").
+  double spring_scale = 0.03;
   int solves_per_start = 1;     // least-squares solves after the first projection, per start
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
   bool discontinuities = true;  // E_disc: sample and keep the sharp curves (sharp_curves.h)

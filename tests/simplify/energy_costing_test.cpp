@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "io/mesh_io.h"
+#include "measure/surface_distance.h"
 #include "mesh/repair.h"
 #include "simplify/energy_priority.h"
 #include "simplify/point_projection.h"
@@ -176,6 +177,36 @@ TEST(EnergyCosting, PointsLeftOnTheirFacesKeepUpperBoundsOfTheirDistances) {
   EXPECT_GT(kept.above, kept.points / 10);
   EXPECT_EQ(moved.above, 0u);
   EXPECT_LT(kept.true_sum, 1.5 * moved.true_sum);
+}
+
+// The live faces of a simplified mesh, as a Mesh (unused vertices stay: they do not count).
+Mesh live_mesh(const CollapseMesh& mesh) {
+  Mesh out;
+  out.positions = mesh.positions();
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
+    if (mesh.face_alive(f)) out.faces.push_back(mesh.face(f));
+  return out;
+}
+
+// Hoppe's spring constants with one point per vertex let a young star's springs outweigh its
+// points' distances, and collapses go by edge length: the default scale (EnergyOptions::
+// spring_scale) gives the scanned vessel a lower RMS distance to its input at 10% and 2% than
+// Hoppe's own values (2026-11-22: 0.70 and 0.95 of it; nine meshes of ../shared/meshes in
+// docs/BENCHMARKS.md, "E_spring's weight").
+TEST(EnergyCosting, ScaledSpringsKeepTheSurfaceCloserThanHoppesValues) {
+  const Mesh input = repair_mesh(read_mesh(testing::test_data("gmsh-aneurysm-20k.stl.gz"))).mesh;
+  for (const double ratio : {0.1, 0.02}) {
+    EnergyOptions hoppe;
+    hoppe.spring_scale = 1;
+    const Simplified scaled = simplified("gmsh-aneurysm-20k.stl.gz", EnergyOptions{}, ratio);
+    const Simplified original = simplified("gmsh-aneurysm-20k.stl.gz", hoppe, ratio);
+    const SurfaceDistance a = surface_distance(input, live_mesh(*scaled.mesh), 100000);
+    const SurfaceDistance b = surface_distance(input, live_mesh(*original.mesh), 100000);
+    std::printf(
+        "gmsh-aneurysm-20k at %2.0f%%: RMS %.3g (scale %.2g) against %.3g (Hoppe's), ratio %.3f\n",
+        ratio * 100, a.rms, EnergyOptions{}.spring_scale, b.rms, a.rms / b.rms);
+    EXPECT_LT(a.rms, b.rms) << "at " << ratio;
+  }
 }
 
 // Checks, as the last constraint (after the standard ones, so on every candidate the
