@@ -292,11 +292,13 @@ std::vector<EnergyPriority::PointState> EnergyPriority::point_states() const {
 }
 
 void EnergyPriority::gather_face(FaceId f, int home) const {
-  for (const FacePoint& p : face_points_[f]) {
-    star_points_.push_back(p);
-    star_points_.back().distance_sq = bounded_distance_sq(f, p);
-    star_homes_.push_back(home);
-  }
+  const auto& list = face_points_[f];
+  const size_t first = star_points_.size();
+  star_points_.insert(star_points_.end(), list.begin(), list.end());
+  star_homes_.insert(star_homes_.end(), list.size(), home);
+  if (drift_[f] != 0)  // rare: a face left with its points by a rich star's collapse
+    for (size_t i = first; i < star_points_.size(); ++i)
+      star_points_[i].distance_sq = bounded_distance_sq(f, star_points_[i]);
 }
 
 const PointMoments& EnergyPriority::moments_of(FaceId f) const {
