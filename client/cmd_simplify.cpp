@@ -51,6 +51,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
     rounds.push_back({{"round", r.round},
                       {"faces_before", r.faces_before},
                       {"goal_faces", r.goal_faces},
+                      {"asked_faces", r.asked_faces},
                       {"faces_after", r.faces_after},
                       {"partition_seconds", r.partition_seconds},
                       {"extract_seconds", r.extract_seconds},

@@ -27,10 +27,9 @@ namespace parapm {
 namespace {
 
 // Partitions the live part of `mesh` (a compact copy: the partitioner wants a plain mesh) into
-// p subsets; vertex_subset gets, per vertex of `mesh`, its subset (0 for dead vertices), and
-// assigned the faces each subset was given.
-void partition_live(const CollapseMesh& mesh, uint32_t p, const PartitionOptions& options,
-                    std::vector<uint32_t>& vertex_subset, std::vector<uint64_t>& assigned) {
+// p subsets; returns, per vertex of `mesh`, its subset (0 for dead vertices).
+std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
+                                     const PartitionOptions& options) {
   std::vector<VertexId> compact(mesh.vertex_capacity(), kNoId);
   Mesh live;
   for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
@@ -45,11 +44,34 @@ void partition_live(const CollapseMesh& mesh, uint32_t p, const PartitionOptions
       live.faces.push_back({compact[t[0]], compact[t[1]], compact[t[2]]});
     }
   const Partition partition = partition_mesh(live, p, options);
-  vertex_subset.assign(mesh.vertex_capacity(), 0);
+  std::vector<uint32_t> vertex_subset(mesh.vertex_capacity(), 0);
   for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
     if (compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[compact[v]];
-  assigned.assign(p, 0);
-  for (uint32_t s : partition.face_subset) ++assigned[s];
+  return vertex_subset;
+}
+
+// Per subset, the faces its job can remove: all three corners in the subset, at most one of
+// them on the border (the corners of faces whose corners lie in more than one subset: each has
+// a neighbour in another subset, so no collapse of the round can move it, subset_rule.h). A
+// face with two border corners has no edge with two free ends.
+std::vector<uint64_t> removable_faces(const CollapseMesh& mesh,
+                                      const std::vector<uint32_t>& vertex_subset,
+                                      uint32_t subsets) {
+  auto mixed = [&](const Triangle& t) {
+    return vertex_subset[t[1]] != vertex_subset[t[0]] || vertex_subset[t[2]] != vertex_subset[t[0]];
+  };
+  std::vector<uint8_t> border(mesh.vertex_capacity(), 0);
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
+    if (mesh.face_alive(f) && mixed(mesh.face(f)))
+      for (VertexId v : mesh.face(f)) border[v] = 1;
+  std::vector<uint64_t> removable(subsets, 0);
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    if (!mixed(t) && border[t[0]] + border[t[1]] + border[t[2]] <= 1)
+      ++removable[vertex_subset[t[0]]];
+  }
+  return removable;
 }
 
 void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
@@ -124,18 +146,26 @@ double water_level(const CollapseMesh& mesh, const PriorityModule& master,
   return std::max(factor * quantile(fraction), quantile(std::min(1.0, 2 * fraction)));
 }
 
-// Each subset removes its share of the round's faces, in proportion to the faces the
-// partition gave it.
-void set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& assigned,
-                 uint64_t faces_before, uint64_t goal) {
-  const uint64_t remove = faces_before > goal ? faces_before - goal : 0;
+// Each subset removes the round's fraction (faces_before - goal) / faces_before of the faces it
+// can remove, so that its inside leaves the round as coarse as the whole mesh should. Its
+// border stays finer, for the next round's new partition or the final pass to take, cheapest
+// first, as a sequential run would have. (A share of all its faces made a job coarsen its
+// inside further to make up for its border: the level a round left was uneven, up to 11%
+// worse in RMS than the sequential one on a small mesh cut in 8; docs/BENCHMARKS.md,
+// "Shares of the removable faces".) Returns the faces asked of all jobs.
+uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& removable,
+                     uint64_t faces_before, uint64_t goal) {
+  const double fraction =
+      faces_before > goal ? double(faces_before - goal) / double(faces_before) : 0.0;
+  uint64_t asked = 0;
   for (size_t s = 0; s < jobs.size(); ++s) {
-    const auto share = uint64_t(std::llround(double(remove) * double(assigned[s]) /
-                                             double(std::max<uint64_t>(1, faces_before))));
+    const auto share = uint64_t(std::llround(fraction * double(removable[s])));
     const uint64_t faces = jobs[s].mesh.face_count();
     // 0 would mean "as far as legal": a job with nothing to remove keeps one face.
     jobs[s].options.target_faces = std::max<uint64_t>(1, faces > share ? faces - share : 0);
+    asked += faces - jobs[s].options.target_faces;
   }
+  return asked;
 }
 
 // The band pass's priority: the master's metric, restricted to edges with an end that no
@@ -260,14 +290,13 @@ ProgressiveMesh build_progressive_mesh_parallel(
                                             std::pow(double(handover) / double(rs.faces_before),
                                                      1.0 / double(parallel.rounds - round))));
     } else {
-      // An extra round, if the last one did what it was asked (a mesh whose locked parts stop
-      // it short gains nothing from more) and the subsets stay large enough that their
-      // borders do not decide the order.
+      // An extra round, if the last one's jobs did what they were asked (a mesh whose locked
+      // parts stop it short gains nothing from more) and the subsets stay large enough that
+      // their borders do not decide the order.
       if (parallel.extra_round_subset_faces == 0 || st.round_stats.empty()) break;
       const RoundStats& last = st.round_stats.back();
-      const double asked = double(last.faces_before) - double(last.goal_faces);
       const double done = double(last.faces_before) - double(last.faces_after);
-      if (!(done >= 0.9 * asked)) break;
+      if (!(done >= 0.9 * double(last.asked_faces))) break;
       rs.goal_faces =
           std::max<uint64_t>(target, uint64_t(std::llround(double(rs.faces_before) * step)));
       if (rs.goal_faces >= rs.faces_before) break;
@@ -283,9 +312,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     t = std::chrono::steady_clock::now();
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options.seed, round);
-    std::vector<uint32_t> vertex_subset;
-    std::vector<uint64_t> assigned;
-    partition_live(whole, subsets, partition_options, vertex_subset, assigned);
+    const std::vector<uint32_t> vertex_subset = partition_live(whole, subsets, partition_options);
     rs.partition_seconds = seconds_since(t);
     if (events.partitioned) events.partitioned(round, subsets, rs.faces_before);
 
@@ -295,6 +322,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // core per subset, only the slowest job's extraction is on the critical path.
     t = std::chrono::steady_clock::now();
     const std::vector<std::vector<VertexId>> owned = owned_vertices(whole, vertex_subset, subsets);
+    const std::vector<uint64_t> removable = removable_faces(whole, vertex_subset, subsets);
     double sequential_extract = seconds_since(t);
     if (parallel.water_level_factor > 0) {
       const auto ts = std::chrono::steady_clock::now();
@@ -315,7 +343,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i]);
       job_cpu[i] = thread_cpu_seconds() - cpu;
     });
-    set_targets(jobs, assigned, rs.faces_before, rs.goal_faces);
+    rs.asked_faces = set_targets(jobs, removable, rs.faces_before, rs.goal_faces);
     if (parallel.water_level_factor > 0)
       for (SubsetJob& job : jobs)
         job.options.max_cost = job.options.max_cost > 0

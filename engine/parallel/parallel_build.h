@@ -32,9 +32,9 @@ struct ParallelOptions {
   // target. The defaults are measured in docs/ARCHITECTURE.md, "Parallel construction".
   double handover_ratio = 0.1;
   // Past the handover, further rounds at the same ratio per round, while the last round
-  // removed at least 90% of the faces it was asked to, each with as many subsets (up to p, at
-  // least 2) as leave each subset at least this many faces (0: none). A large mesh gets its
-  // final pass shorter (the 871k dragon at p = 16: 7 rounds, the last ones on 8, 4 and 2
+  // removed at least 90% of the faces its jobs were asked to, each with as many subsets (up to p,
+  // at least 2) as leave each subset at least this many faces (0: none). A large mesh gets its
+  // final pass shorter (the 871k dragon at p = 16: 7 rounds, the last ones on 11, 6 and 3
   // subsets); a mesh whose locked parts stop it early, or a small one, does not
   // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds").
   uint64_t extra_round_subset_faces = 2000;
@@ -70,6 +70,9 @@ struct RoundStats {
   uint32_t round = 0;
   uint64_t faces_before = 0;
   uint64_t goal_faces = 0;  // what the round aimed at
+  // Faces its jobs were asked to remove: the round's fraction of those they can remove (not
+  // their borders), so it ends above its goal (parallel_build.cpp, set_targets).
+  uint64_t asked_faces = 0;
   uint64_t faces_after = 0;
   double partition_seconds = 0;
   double extract_seconds = 0;  // jobs and their state, shares included (wall)

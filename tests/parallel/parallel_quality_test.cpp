@@ -8,15 +8,18 @@
 // What is asserted, per mesh and metric, as regression guards at today's figures with a
 // margin: the median RMS ratio over the (p, level) cells within 10% (2026-11-21: 1.00-1.02 on
 // the CAD part and the vessel, 1.06 on the bunny; the energy's, pooled over three draws of
-// extra points, 2026-11-22: 0.98 on the vessel, 1.0 on the bunny), the worst cells under RMS
+// extra points, 2026-11-22: 0.98 on the vessel, 1.0 on the bunny), the median of the 10% cells
+// alone (the level the rounds hand over at) within 7% (2026-11-22, since the jobs' shares of
+// their removable faces: 0.99-1.06; 1.08-1.09 on the vessel before), the worst cells under RMS
 // 1.35 (the energy's pooled cells: 1.6, as single cells of the bunny's 2% level range over
 // 0.84-1.45 from one draw to the next) and Hausdorff 2.6. Issue 5's target, every cell within
 // 5% (RMS) and 10% (Hausdorff), is NOT met on these small meshes (at p = 16 the bunny's
 // subsets hold 600 faces; worst cells 2026-11-21: RMS 1.29, Hausdorff 2.49; with the energy
 // the bunny's 10% level was 1.17-1.34 in every draw; since the simplifier's requeue and the
 // carried keys, 2026-11-22, it is 0.99-1.05, but its 2% and base levels 0.90-1.37; since the
-// springs' scale the vessel's 10% level, the rounds' handover, is 1.05-1.13); it is on the 203k
-// dragon (docs/BENCHMARKS.md, bench/parallel.sh with metro).
+// springs' scale the vessel's 10% level, the rounds' handover, was 1.05-1.13, since the
+// shares of removable faces 0.99-1.02); it is on the 203k dragon (docs/BENCHMARKS.md,
+// bench/parallel.sh with metro).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -35,17 +38,26 @@ namespace {
 
 constexpr uint64_t kSamples = 20000;
 
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
 struct Ratios {
   std::vector<double> rms;
+  std::vector<double> handover_rms;  // the 10% cells: where the rounds hand over by default
   double worst_rms = 0, worst_hausdorff = 0;
-  double median_rms() {
-    std::sort(rms.begin(), rms.end());
-    return rms[rms.size() / 2];
+  void add(const Ratios& r) {
+    rms.insert(rms.end(), r.rms.begin(), r.rms.end());
+    handover_rms.insert(handover_rms.end(), r.handover_rms.begin(), r.handover_rms.end());
+    worst_rms = std::max(worst_rms, r.worst_rms);
+    worst_hausdorff = std::max(worst_hausdorff, r.worst_hausdorff);
   }
 };
 
-void expect_near_sequential(Ratios r, const std::string& name, double worst_rms = 1.35) {
-  EXPECT_LE(r.median_rms(), 1.10) << name;
+void expect_near_sequential(const Ratios& r, const std::string& name, double worst_rms = 1.35) {
+  EXPECT_LE(median(r.rms), 1.10) << name;
+  EXPECT_LE(median(r.handover_rms), 1.07) << name << ": the rounds' last level is uneven";
   EXPECT_LE(r.worst_rms, worst_rms) << name;
   EXPECT_LE(r.worst_hausdorff, 2.6) << name;
 }
@@ -77,6 +89,7 @@ Ratios compare(const std::string& name, const RepairedMesh& repaired,
       const double rms = d.rms / seq[i].rms, hausdorff = d.hausdorff / seq[i].hausdorff;
       std::printf("  %s rms %.3f haus %.3f", levels[i].first, rms, hausdorff);
       worst.rms.push_back(rms);
+      if (i == 1) worst.handover_rms.push_back(rms);
       worst.worst_rms = std::max(worst.worst_rms, rms);
       worst.worst_hausdorff = std::max(worst.worst_hausdorff, hausdorff);
     }
@@ -107,10 +120,7 @@ TEST(ParallelQuality, EnergyLevelsMatchTheSequentialOnes) {
       options.target_ratio = 0.01;
       options.samples_per_face = 0.05;
       options.seed = seed;
-      const Ratios r = compare(name, repaired, options, {2, 4});
-      pooled.rms.insert(pooled.rms.end(), r.rms.begin(), r.rms.end());
-      pooled.worst_rms = std::max(pooled.worst_rms, r.worst_rms);
-      pooled.worst_hausdorff = std::max(pooled.worst_hausdorff, r.worst_hausdorff);
+      pooled.add(compare(name, repaired, options, {2, 4}));
     }
     expect_near_sequential(pooled, name, 1.6);
   }
