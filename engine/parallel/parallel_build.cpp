@@ -50,30 +50,6 @@ std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
   return vertex_subset;
 }
 
-// Per subset, the faces its job can remove: all three corners in the subset, at most one of
-// them on the border (the corners of faces whose corners lie in more than one subset: each has
-// a neighbour in another subset, so no collapse of the round can move it, subset_rule.h). A
-// face with two border corners has no edge with two free ends.
-std::vector<uint64_t> removable_faces(const CollapseMesh& mesh,
-                                      const std::vector<uint32_t>& vertex_subset,
-                                      uint32_t subsets) {
-  auto mixed = [&](const Triangle& t) {
-    return vertex_subset[t[1]] != vertex_subset[t[0]] || vertex_subset[t[2]] != vertex_subset[t[0]];
-  };
-  std::vector<uint8_t> border(mesh.vertex_capacity(), 0);
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
-    if (mesh.face_alive(f) && mixed(mesh.face(f)))
-      for (VertexId v : mesh.face(f)) border[v] = 1;
-  std::vector<uint64_t> removable(subsets, 0);
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-    if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    if (!mixed(t) && border[t[0]] + border[t[1]] + border[t[2]] <= 1)
-      ++removable[vertex_subset[t[0]]];
-  }
-  return removable;
-}
-
 void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
   if (parallel.subsets < 1 || parallel.subsets > kMaxPartitionSubsets)
     throw_invalid("the subset count p must be in [1, 256], got " +
@@ -194,10 +170,11 @@ class BandPriority : public PriorityModule {
   double ceiling_;
 };
 
-// The master's current keys of the job's edges with two free ends (the only ones it costs), in
-// its local ids, sorted. Const reads of `memo`: jobs may take theirs concurrently.
-std::vector<EdgeKey> keys_of_job(const KeyMemo& memo, const SubsetJob& job) {
-  const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+// The master's current keys of the job's edges with two free ends (`free`: free_vertices of
+// the job; the only edges it costs), in its local ids, sorted. Const reads of `memo`: jobs may take
+// theirs concurrently.
+std::vector<EdgeKey> keys_of_job(const KeyMemo& memo, const SubsetJob& job,
+                                 const std::vector<uint8_t>& free) {
   const std::vector<VertexId>& global = job.global_vertex;
   std::vector<EdgeKey> keys;
   for (VertexId a = 0; a < global.size(); ++a) {
@@ -322,7 +299,6 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // core per subset, only the slowest job's extraction is on the critical path.
     t = std::chrono::steady_clock::now();
     const std::vector<std::vector<VertexId>> owned = owned_vertices(whole, vertex_subset, subsets);
-    const std::vector<uint64_t> removable = removable_faces(whole, vertex_subset, subsets);
     double sequential_extract = seconds_since(t);
     if (parallel.water_level_factor > 0) {
       const auto ts = std::chrono::steady_clock::now();
@@ -332,6 +308,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       sequential_extract += rs.share_seconds;
     }
     std::vector<SubsetJob> jobs(subsets);
+    std::vector<uint64_t> removable(subsets, 0);
     std::vector<double> job_cpu(jobs.size(), 0);
     run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
       const double cpu = thread_cpu_seconds();
@@ -340,7 +317,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
       jobs[i] = extract_subset(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
                                locked, vertex_subset, owned[i], uint32_t(i), round, subset_options);
       jobs[i].state = export_job_state(*master, jobs[i]);
-      if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i]);
+      const std::vector<uint8_t> free = free_vertices(jobs[i].mesh, jobs[i].owned);
+      removable[i] = removable_faces(jobs[i].mesh, free);
+      if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i], free);
       job_cpu[i] = thread_cpu_seconds() - cpu;
     });
     rs.asked_faces = set_targets(jobs, removable, rs.faces_before, rs.goal_faces);

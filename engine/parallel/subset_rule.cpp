@@ -82,6 +82,12 @@ std::vector<uint8_t> free_vertices(const Mesh& mesh, const std::vector<uint8_t>&
   return result;
 }
 
+uint64_t removable_faces(const Mesh& mesh, const std::vector<uint8_t>& free) {
+  uint64_t removable = 0;
+  for (const Triangle& t : mesh.faces) removable += free[t[0]] + free[t[1]] + free[t[2]] >= 2;
+  return removable;
+}
+
 std::unique_ptr<ConstraintModule> make_subset_constraint(std::vector<uint8_t> owned) {
   return std::make_unique<SubsetConstraint>(std::move(owned));
 }

@@ -44,6 +44,11 @@ namespace parapm {
 // Per local vertex of `mesh`: 1 when it is owned and all its neighbours are owned.
 std::vector<uint8_t> free_vertices(const Mesh& mesh, const std::vector<uint8_t>& owned);
 
+// The faces of `mesh` a job can remove: those with at least two free corners (the third, a
+// neighbour of a free vertex, is owned). A face with two corners next to another subset has no
+// edge with two free ends.
+uint64_t removable_faces(const Mesh& mesh, const std::vector<uint8_t>& free);
+
 // The rule as a constraint module, checked on every pop (after the standard constraints).
 // It tests the adjacency of vs and vt on the present mesh, not the static free flags, so that
 // it checks the rule as stated.

@@ -102,6 +102,34 @@ TEST(SubsetRule, EveryCollapseHasItsWholeStarInItsSubset) {
   }
 }
 
+// The faces a job can remove (the shares count them): every face its collapses remove is one,
+// run with no target, on a real mesh; and the border it cannot touch is not empty.
+TEST(SubsetRule, JobsRemoveOnlyTheirRemovableFaces) {
+  const Round round = run_round("stratocaster-9k.ply", "quadric", 4);
+  for (size_t s = 0; s < round.jobs.size(); ++s) {
+    const SubsetJob& job = round.jobs[s];
+    const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+    const uint64_t removable = removable_faces(job.mesh, free);
+    EXPECT_LT(removable, job.owned_faces) << "subset " << s;
+    std::vector<uint8_t> can_go(job.mesh.face_count(), 0);
+    for (FaceId f = 0; f < job.mesh.face_count(); ++f) {
+      const Triangle& t = job.mesh.faces[f];
+      can_go[f] = free[t[0]] + free[t[1]] + free[t[2]] >= 2;
+    }
+    size_t removed = 0;
+    for (const CollapseRecord& r : round.results[s].records)
+      for (FaceId global : {r.fl, r.fr}) {
+        if (global == kNoId) continue;
+        const auto it = std::lower_bound(job.global_face.begin(), job.global_face.end(), global);
+        ASSERT_TRUE(it != job.global_face.end() && *it == global);
+        EXPECT_TRUE(can_go[it - job.global_face.begin()]) << "subset " << s << " face " << global;
+        ++removed;
+      }
+    EXPECT_GT(removed, removable / 2) << "subset " << s;
+    EXPECT_LE(removed, removable) << "subset " << s;
+  }
+}
+
 // The theorem: any interleaving that keeps each subset's order replays (replay_collapses
 // checks fl, fr, vl, vr of every record against the whole mesh) and ends in the same mesh.
 void expect_interleavings_commute(const std::string& name, const std::string& metric, uint32_t p) {
