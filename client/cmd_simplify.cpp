@@ -242,8 +242,9 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--extra-round-faces", args->extra_round_faces,
                   "With --parallel: past the handover, more rounds at the same ratio while the "
-                  "last one removed at least 90% of what it was asked and the next would leave "
-                  "each subset at least this many faces (0: none)")
+                  "next would leave each subset at least this many faces and the last one removed "
+                  "at least 90% of what it was asked (or at least half, with 2.5x as many faces "
+                  "per subset) (0: none)")
       ->capture_default_str();
   cmd->add_flag("--no-carry-keys", args->no_carry_keys,
                 "With --parallel: every round's jobs cost all their edges again instead of "

@@ -144,7 +144,8 @@ void add_submit_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--extra-round-faces", args->extra_round_faces,
                   "past the handover, more rounds while every subset keeps this many faces and "
-                  "the last round did its share (default 2000; 0: none)")
+                  "the last round did 90% of its share (2.5x as many faces after one that did "
+                  "half) (default 2000; 0: none)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
   cmd->add_option("--seed", args->seed, "seed of the randomised steps")->capture_default_str();
   cmd->add_option("--samples-per-face", args->samples_per_face, "energy: extra sample points")

@@ -50,6 +50,7 @@ class KeyMemo : public PriorityModule {
  public:
   KeyMemo(PriorityModule& inner, size_t vertex_capacity);
   std::string name() const override { return inner_.name(); }
+  bool costly() const override { return inner_.costly(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override;

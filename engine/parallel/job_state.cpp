@@ -15,6 +15,7 @@ class WithoutInitialize : public PriorityModule {
  public:
   explicit WithoutInitialize(PriorityModule& inner) : inner_(inner) {}
   std::string name() const override { return inner_.name(); }
+  bool costly() const override { return inner_.costly(); }
   void initialize(const CollapseMesh&) override {}
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {

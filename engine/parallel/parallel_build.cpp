@@ -152,6 +152,7 @@ class BandPriority : public PriorityModule {
   BandPriority(PriorityModule& inner, std::vector<uint8_t>& touched, double ceiling)
       : inner_(inner), touched_(touched), ceiling_(ceiling) {}
   std::string name() const override { return inner_.name(); }
+  bool costly() const override { return inner_.costly(); }
   void initialize(const CollapseMesh&) override {}
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {
@@ -269,18 +270,24 @@ ProgressiveMesh build_progressive_mesh_parallel(
     } else {
       // An extra round, if the last one's jobs did what they were asked (a mesh whose locked
       // parts stop it short gains nothing from more) and the subsets stay large enough that
-      // their borders do not decide the order.
+      // their borders do not decide the order. A round that did only half of it stopped at its
+      // cost ceiling: the rest is costlier, its order matters more, so the next round's subsets
+      // must be larger (2.5 x the floor; with the floor itself, such rounds made the 203k
+      // dragon's 10% level 7% worse at p = 4 and 8: docs/BENCHMARKS.md, "Extra rounds after a
+      // short round").
       if (parallel.extra_round_subset_faces == 0 || st.round_stats.empty()) break;
       const RoundStats& last = st.round_stats.back();
       const double done = double(last.faces_before) - double(last.faces_after);
-      if (!(done >= 0.9 * double(last.asked_faces))) break;
+      const double asked = double(last.asked_faces);
+      if (!(done >= 0.5 * asked)) break;
+      const uint64_t floor = done >= 0.9 * asked ? parallel.extra_round_subset_faces
+                                                 : parallel.extra_round_subset_faces * 5 / 2;
       rs.goal_faces =
           std::max<uint64_t>(target, uint64_t(std::llround(double(rs.faces_before) * step)));
       if (rs.goal_faces >= rs.faces_before) break;
       // Narrower rounds once p subsets would leave fewer faces each than the floor: the mesh
       // keeps shrinking in parallel, and the sequential final pass stays short at any p.
-      subsets = uint32_t(
-          std::min<uint64_t>(parallel.subsets, rs.goal_faces / parallel.extra_round_subset_faces));
+      subsets = uint32_t(std::min<uint64_t>(parallel.subsets, rs.goal_faces / floor));
       if (subsets < 2) break;
     }
 
@@ -442,7 +449,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // The final pass: the borders and whatever remains down to the target, sequentially.
   t = std::chrono::steady_clock::now();
   // The band pass's keys too, so that the final pass starts from the queue as it is.
-  keys.reset(carry_keys ? keys.current_keys(whole) : std::vector<EdgeKey>{});
+  const std::vector<EdgeKey> carried =
+      carry_keys ? keys.current_keys(whole) : std::vector<EdgeKey>{};
+  keys.reset(carried);
+  const uint64_t reused_before = keys.reused();
   std::unique_ptr<PriorityModule> continued = without_initialize(keys);
   Simplifier final_pass(whole, *continued, standard_constraints(locked));
   SimplifierLimits limits;
@@ -457,6 +467,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
   st.final_pass_collapses = final_records.size();
   st.final_pass_seconds = seconds_since(t);
   st.stop_reason = final_pass.stats().stop_reason;
+  {
+    const SimplifierStats& fs = final_pass.stats();
+    spdlog::debug(
+        "final pass: {} keys carried in, {} answered from them; {} evaluations, {} vetoed, {} "
+        "screened, {} requeued, {} stale",
+        carried.size(), keys.reused() - reused_before, fs.evaluations, fs.rejected, fs.screened,
+        fs.requeued, fs.stale);
+  }
   if (events.final_pass_done)
     events.final_pass_done(st.final_pass_collapses, st.final_pass_seconds);
   records.insert(records.end(), std::make_move_iterator(final_records.begin()),

@@ -33,10 +33,12 @@ struct ParallelOptions {
   double handover_ratio = 0.1;
   // Past the handover, further rounds at the same ratio per round, while the last round
   // removed at least 90% of the faces its jobs were asked to, each with as many subsets (up to p,
-  // at least 2) as leave each subset at least this many faces (0: none). A large mesh gets its
-  // final pass shorter (the 871k dragon at p = 16: 7 rounds, the last ones on 11, 6 and 3
-  // subsets); a mesh whose locked parts stop it early, or a small one, does not
-  // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds").
+  // at least 2) as leave each subset at least this many faces (0: none); after a round that
+  // removed only half of it (stopped at its cost ceiling), 2.5 times this many. A large mesh gets
+  // its final pass shorter (the 871k dragon at p = 16: 7 rounds, the last ones on 11, 6 and 3
+  // subsets; the 203k dragon: one more round on 2 subsets at any p); a small one does not
+  // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds", "Extra
+  // rounds after a short round").
   uint64_t extra_round_subset_faces = 2000;
   // Jobs leave alone edges costing more than this factor times the round's water level
   // (parallel_build.cpp, water_level: the cost below which a sample of the edges would give

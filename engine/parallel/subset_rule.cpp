@@ -9,6 +9,9 @@ class SubsetConstraint : public ConstraintModule {
  public:
   explicit SubsetConstraint(std::vector<uint8_t> owned) : owned_(std::move(owned)) {}
   std::string name() const override { return "subset"; }
+  // Ownership is fixed, the owned count only falls: an edge it vetoes stays vetoed until
+  // its star changes.
+  bool topological() const override { return true; }
 
   // Components of the job's mesh: how many owned vertices each holds and whether it also
   // holds halo vertices (then it continues in other subsets).
@@ -53,6 +56,7 @@ class SubsetPriority : public PriorityModule {
   SubsetPriority(PriorityModule& inner, std::vector<uint8_t> free_vertex, double max_cost)
       : inner_(inner), free_(std::move(free_vertex)), max_cost_(max_cost) {}
   std::string name() const override { return inner_.name(); }
+  bool costly() const override { return inner_.costly(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {

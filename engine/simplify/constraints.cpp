@@ -30,6 +30,7 @@ class LockedVertices : public ConstraintModule {
 class ComponentMinimum : public ConstraintModule {
  public:
   std::string name() const override { return "component-minimum"; }
+  bool topological() const override { return true; }
   void initialize(const CollapseMesh& mesh) override {
     const uint32_t components = connected_components(mesh, component_);
     count_.assign(components, 0);
@@ -57,6 +58,7 @@ class ComponentMinimum : public ConstraintModule {
 class BoundaryRule : public ConstraintModule {
  public:
   std::string name() const override { return "boundary"; }
+  bool topological() const override { return true; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces& edge) const override {
     if (edge.left == kNoId && edge.right == kNoId) return false;  // not an edge any more
@@ -68,6 +70,7 @@ class BoundaryRule : public ConstraintModule {
 class LinkCondition : public ConstraintModule {
  public:
   std::string name() const override { return "link-condition"; }
+  bool topological() const override { return true; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces& edge) const override {
     bool ok = true;

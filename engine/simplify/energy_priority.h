@@ -110,6 +110,7 @@ class EnergyPriority : public PriorityModule {
                  WedgeAttributes attributes = {})
       : locked_(std::move(locked)), options_(options), attributes_(std::move(attributes)) {}
   std::string name() const override { return "energy"; }
+  bool costly() const override { return true; }
   void initialize(const CollapseMesh& mesh) override;
   // With Costing::kQueue each start's solve is costed on the model it was solved on, not
   // measured again (see evaluate()).

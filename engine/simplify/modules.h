@@ -47,6 +47,13 @@ class PriorityModule {
   // collapse (the record takes the refined value).
   virtual void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                          const EdgeFaces& edge) = 0;
+  // Whether a costing costs far more than checking an edge's topological rules (the energy's
+  // take microseconds, a link condition a fraction of one). Then the simplifier checks those
+  // rules before it costs an edge on top of the queue or one vetoed before whose star changed:
+  // one they veto again waits among the vetoed edges, uncosted, instead of being costed twice
+  // (queue key, then on top) only to be vetoed. Not before every costing: most edges pass, and
+  // the checks would cost a tenth of the energy's time (docs/BENCHMARKS.md, "Vetoed edges").
+  virtual bool costly() const { return false; }
 };
 
 class ConstraintModule {
@@ -57,6 +64,9 @@ class ConstraintModule {
   // `edge` holds the faces on the edge (vs, vt) as CollapseMesh::edge_faces(vs, vt).
   virtual bool allows(const CollapseMesh& mesh, const CollapseCandidate& candidate,
                       const EdgeFaces& edge) const = 0;
+  // Whether the answer depends on the edge {vs, vt} only: not on which end survives nor on
+  // the placement. Such a rule can veto an edge before any costing.
+  virtual bool topological() const { return false; }
   virtual void collapsed(const CollapseMesh&, const CollapseCandidate&) {}
 };
 

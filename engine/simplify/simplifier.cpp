@@ -10,11 +10,44 @@ Simplifier::Simplifier(CollapseMesh& mesh, PriorityModule& priority,
     : mesh_(mesh), priority_(priority), constraints_(std::move(constraints)) {}
 
 void Simplifier::push_edge(VertexId a, VertexId b) {
+  Entry entry;
+  if (queue_entry(a, b, entry)) heap_.push(entry);
+}
+
+bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   if (a > b) std::swap(a, b);
   CollapseCandidate candidate;
   ++stats_.evaluations;
-  if (!priority_.evaluate(mesh_, a, b, candidate, Costing::kQueue)) return;
-  heap_.push({static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]});
+  if (!priority_.evaluate(mesh_, a, b, candidate, Costing::kQueue)) return false;
+  entry = {static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]};
+  return true;
+}
+
+void Simplifier::retry_edge(VertexId a, VertexId b) {
+  ++stats_.reevaluated;
+  // Vetoed once, an edge is often vetoed again (near the legal minimum, thousands are, each
+  // star change around them): with a costly module, check the rules that need no costing first.
+  if (screen_ && !topologically_legal(a, b)) {
+    ++stats_.screened;
+    reject(a, b);
+    return;
+  }
+  push_edge(a, b);
+}
+
+void Simplifier::reject(VertexId a, VertexId b) {
+  remember_rejected(a, b);
+  remember_rejected(b, a);
+}
+
+bool Simplifier::topologically_legal(VertexId a, VertexId b) const {
+  CollapseCandidate edge_only;
+  edge_only.vs = a;
+  edge_only.vt = b;
+  const EdgeFaces edge = mesh_.edge_faces(a, b);
+  for (const auto& module : constraints_)
+    if (module->topological() && !module->allows(mesh_, edge_only, edge)) return false;
+  return true;
 }
 
 bool Simplifier::is_stale(const Entry& entry) const {
@@ -102,6 +135,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   collapses_ = 0;
   requeued_.clear();
   rejected_.assign(mesh_.vertex_capacity(), {});
+  screen_ = priority_.costly();
 
   // Every undirected edge once: from the face holding a->b with a < b, or from the only face
   // of a boundary edge. The heap's order does not depend on the order of insertion.
@@ -115,20 +149,18 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     for (int k = 0; k < 3; ++k) {
       const VertexId a = t[k], b = t[(k + 1) % 3];
       if (a > b && mesh_.edge_faces(b, a).left != kNoId) continue;  // counted from b->a
-      CollapseCandidate candidate;
-      if (priority_.evaluate(mesh_, std::min(a, b), std::max(a, b), candidate, Costing::kQueue))
-        heap_.items().push_back(
-            {static_cast<float>(candidate.cost), std::min(a, b), std::max(a, b), 0});
+      Entry entry;
+      if (queue_entry(a, b, entry)) heap_.items().push_back(entry);
     }
   }
   heap_.rebuild();
-  stats_.evaluations = heap_.size();  // (edges the module could not place are not counted)
 
   const size_t start_faces = mesh_.live_faces();
   const uint64_t total = start_faces > limits.target_faces ? start_faces - limits.target_faces : 0;
   std::vector<CollapseRecord> records;
   records.reserve(mesh_.live_vertices());
   std::vector<VertexId> ring;
+  std::vector<std::pair<VertexId, VertexId>> retry;
   stats_.stop_reason = "no legal collapse left";
 
   while (!heap_.empty()) {
@@ -150,6 +182,14 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     // legality depends on the neighbourhood and is checked now (Decimater: re-check on pop).
     CollapseCandidate candidate;
     if (!take_requeued(entry, candidate)) {
+      // Its ends unchanged, a neighbour's collapse may still have broken its link: then no
+      // costing (with a costly module).
+      if (screen_ && !topologically_legal(entry.a, entry.b)) {
+        ++stats_.rejected;
+        ++stats_.screened;
+        reject(entry.a, entry.b);
+        continue;
+      }
       ++stats_.evaluations;
       if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate, Costing::kPerform)) continue;
     }
@@ -160,8 +200,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     }
     if (!legal(candidate, edge)) {
       ++stats_.rejected;
-      remember_rejected(entry.a, entry.b);
-      remember_rejected(entry.b, entry.a);
+      reject(entry.a, entry.b);
       continue;
     }
     // A key is kept until an end of its edge changes, though collapses beside the edge change
@@ -186,10 +225,12 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     ++collapses_;
     star_changed_at_[vs] = star_changed_at_[candidate.vt] = collapses_;
     for (VertexId n : ring) star_changed_at_[n] = collapses_;
-    for (VertexId n : ring) push_edge(vs, n);
-    // Edges vetoed earlier around the changed star may be legal now: cost them again.
+    // Edges vetoed earlier around the changed star may be legal now: cost them again, after
+    // the edges of vs. All are taken off the lists first: a push may veto its edge again, onto
+    // the lists (screening).
     rejected_[candidate.vt].clear();
     rejected_[vs].clear();
+    retry.clear();
     for (VertexId n : ring) {
       auto& list = rejected_[n];
       for (VertexId other : list) {
@@ -197,11 +238,12 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
         // The edge is pushed once, from this side: forget it on the other side too.
         auto& mirror = rejected_[other];
         mirror.erase(std::remove(mirror.begin(), mirror.end(), n), mirror.end());
-        ++stats_.reevaluated;
-        push_edge(n, other);
+        retry.emplace_back(n, other);
       }
       list.clear();
     }
+    for (VertexId n : ring) push_edge(vs, n);
+    for (const auto& [n, other] : retry) retry_edge(n, other);
 
     if ((records.size() & 1023) == 0) {
       // Progress first: a caller may cancel from its callback (a worker polling its call).

@@ -51,7 +51,10 @@ struct SimplifierStats {
   // Popped edges whose cost, costed afresh, was above the next key: queued again with it.
   uint64_t requeued = 0;
   uint64_t requeue_reused = 0;  // of those, taken out again with their star unchanged
-  std::string stop_reason;      // why the loop ended
+  // With a costly priority module: edges the topological rules vetoed before any costing
+  // (retried after their star changed, or on top of the queue: those count as rejected too).
+  uint64_t screened = 0;
+  std::string stop_reason;  // why the loop ended
 };
 
 class Simplifier {
@@ -84,7 +87,13 @@ class Simplifier {
   };
 
   void push_edge(VertexId a, VertexId b);
+  // Costs edge {a, b}; false when the module cannot place it.
+  bool queue_entry(VertexId a, VertexId b, Entry& entry);
+  // Pushes an edge vetoed before, whose star has changed since.
+  void retry_edge(VertexId a, VertexId b);
   void remember_rejected(VertexId v, VertexId other);
+  void reject(VertexId a, VertexId b);
+  bool topologically_legal(VertexId a, VertexId b) const;
   bool is_stale(const Entry& entry) const;
   void compact_heap();
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const;
@@ -94,6 +103,8 @@ class Simplifier {
   PriorityModule& priority_;
   std::vector<std::unique_ptr<ConstraintModule>> constraints_;
   QuadHeap<Entry, Before> heap_;
+  // priority_.costly(): retried and top edges meet the topological rules before any costing.
+  bool screen_ = false;
   std::vector<uint32_t> version_;
   std::vector<std::vector<VertexId>> rejected_;  // per vertex: edges vetoed since its last change
   // Requeued edges' costings, kept while no collapse changes the edge's star (a collapse

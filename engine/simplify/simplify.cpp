@@ -103,11 +103,11 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
     stats->seconds = seconds;
   }
   spdlog::debug(
-      "simplified {} -> {} faces in {:.3f} s ({} collapses, {} vetoed, {} evaluations, {} "
-      "requeued; {})",
+      "simplified {} -> {} faces in {:.3f} s ({} collapses, {} vetoed, {} screened, {} "
+      "evaluations, {} requeued; {})",
       mesh.face_count(), pm.base.face_count(), seconds, simplifier.stats().collapses,
-      simplifier.stats().rejected, simplifier.stats().evaluations, simplifier.stats().requeued,
-      simplifier.stats().stop_reason);
+      simplifier.stats().rejected, simplifier.stats().screened, simplifier.stats().evaluations,
+      simplifier.stats().requeued, simplifier.stats().stop_reason);
   return pm;
 }
 

@@ -112,8 +112,8 @@ TEST(ParallelBuild, ExtraRoundsPastTheHandoverWhileTheyDoTheirShare) {
   for (size_t r = 3; r < extra.round_stats.size(); ++r) {
     const RoundStats& before = extra.round_stats[r - 1];
     const RoundStats& round = extra.round_stats[r];
-    EXPECT_GE(double(before.faces_before - before.faces_after), 0.9 * double(before.asked_faces))
-        << "round " << r << " follows a round that fell short";
+    EXPECT_GE(double(before.faces_before - before.faces_after), 0.5 * double(before.asked_faces))
+        << "round " << r << " follows a round that did less than half of its share";
     EXPECT_GE(round.goal_faces, 2u * 200u) << "round " << r;
   }
   // Jobs are asked for the round's fraction of the faces they can remove: not their borders.
@@ -132,16 +132,23 @@ TEST(ParallelBuild, ExtraRoundsPastTheHandoverWhileTheyDoTheirShare) {
       (unsigned long long)none.final_pass_collapses);
 }
 
+// A quadric build of a committed mesh at p = 4 with an extra rounds' floor; its stats in
+// `stats`.
+ProgressiveMesh build_with_floor(const RepairedMesh& repaired, uint64_t floor,
+                                 ParallelStats& stats) {
+  ParallelOptions parallel = with_p(4);
+  parallel.extra_round_subset_faces = floor;
+  return build_progressive_mesh_parallel(repaired, metric_options("quadric", 0.005), parallel,
+                                         &stats);
+}
+
 // Past the handover, once p subsets would leave fewer faces each than the floor, the extra
 // rounds go on with fewer subsets (at least two): the vessel at p = 4 with a floor of 400 gets
 // a fourth round on 2 subsets, and a lossless PM.
 TEST(ParallelBuild, ExtraRoundsNarrowToKeepTheFloor) {
   const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
-  const SimplifyOptions options = metric_options("quadric", 0.005);
-  ParallelOptions parallel = with_p(4);
-  parallel.extra_round_subset_faces = 400;
   ParallelStats stats;
-  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, parallel, &stats);
+  const ProgressiveMesh pm = build_with_floor(repaired, 400, stats);
   ASSERT_GT(stats.rounds, 3u);
   for (size_t r = 0; r < stats.round_stats.size(); ++r) {
     const RoundStats& round = stats.round_stats[r];
@@ -154,6 +161,33 @@ TEST(ParallelBuild, ExtraRoundsNarrowToKeepTheFloor) {
     EXPECT_LT(subsets, 4u) << "round " << r << ": 4 subsets would hold fewer than 400 faces";
     EXPECT_GE(round.goal_faces, subsets * 400) << "round " << r;
   }
+  const MeshDifference diff =
+      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
+  EXPECT_TRUE(diff.equal) << diff.first_difference;
+}
+
+// After a round that did at least half of its share but less than 90% (its jobs stopped at
+// their cost ceiling), an extra round still follows, on subsets of 2.5 times the floor: the
+// CAD part at p = 4 with a floor of 600, whose third round does 72% of its share, gets a
+// fourth round on 2 subsets of at least 1500 faces (4 of 600 with the floor alone).
+TEST(ParallelBuild, ExtraRoundsAfterAShortRoundTakeLargerSubsets) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("cad-cycloidal-43k.ply");
+  ParallelStats stats;
+  const ProgressiveMesh pm = build_with_floor(repaired, 600, stats);
+  ASSERT_GT(stats.rounds, 3u);
+  bool after_short = false;
+  for (size_t r = 3; r < stats.round_stats.size(); ++r) {
+    const RoundStats& before = stats.round_stats[r - 1];
+    const RoundStats& round = stats.round_stats[r];
+    const double done = double(before.faces_before - before.faces_after);
+    EXPECT_GE(done, 0.5 * double(before.asked_faces)) << "round " << r;
+    const bool short_round = done < 0.9 * double(before.asked_faces);
+    after_short = after_short || short_round;
+    const size_t subsets = round.subsets.size();
+    EXPECT_GE(subsets, 2u) << "round " << r;
+    EXPECT_GE(round.goal_faces, subsets * (short_round ? 1500u : 600u)) << "round " << r;
+  }
+  EXPECT_TRUE(after_short) << "no extra round followed a short one: a weak test";
   const MeshDifference diff =
       compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
   EXPECT_TRUE(diff.equal) << diff.first_difference;
