@@ -14,8 +14,6 @@ void sort_keys(std::vector<EdgeKey>& keys) {
             [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
 }
 
-bool carries_keys(const std::string& metric) { return metric == "energy"; }
-
 KeyMemo::KeyMemo(PriorityModule& inner, size_t vertex_capacity)
     : inner_(inner), head_(vertex_capacity, kEnd), changed_at_(vertex_capacity, 0) {}
 

@@ -33,11 +33,6 @@ struct EdgeKey {
 // By (a, b).
 void sort_keys(std::vector<EdgeKey>& keys);
 
-// Whether keys are worth carrying for a metric: where a costing costs more than remembering
-// and looking it up. The energy's take tens of microseconds; the quadric's take tens of
-// nanoseconds, and on the 871k dragon the memo's bookkeeping cost three times its costings.
-bool carries_keys(const std::string& metric);
-
 // A priority module that remembers the inner module's queue keys, and answers the first queue
 // costing of an edge whose key was carried in (reset()) and whose ends no collapse has changed
 // since, without costing it again. Keys costed here, or answered once, are remembered but not

@@ -238,7 +238,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // The master's queue keys: the water level's sample, the jobs' keys after a round,
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
   KeyMemo keys(*master, whole.vertex_capacity());
-  const bool carry_keys = parallel.carry_keys && carries_keys(options.metric);
+  // Keys are worth carrying only where a costing costs more than remembering it (costly()).
+  const bool carry_keys = parallel.carry_keys && master->costly();
   st.setup_seconds = seconds_since(t);
   st.critical_path_seconds = st.setup_seconds;
 

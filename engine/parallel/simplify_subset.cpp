@@ -81,8 +81,8 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
     imported = without_initialize(*metric);
   }
   PriorityModule& module = imported ? *imported : *metric;
-  std::optional<KeyMemo> memo;  // only for a metric whose keys are worth carrying
-  if (carries_keys(job.options.metric)) {
+  std::optional<KeyMemo> memo;  // only for a metric whose keys are worth carrying (costly())
+  if (metric->costly()) {
     memo.emplace(module, working.vertex_capacity());
     memo->reset(job.keys);
   }

@@ -85,9 +85,11 @@ bool Simplifier::take_requeued(const Entry& entry, CollapseCandidate& out) {
   return unchanged;
 }
 
-bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const {
+bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
+                       bool topology_checked) const {
   for (const auto& module : constraints_)
-    if (!module->allows(mesh_, candidate, edge)) return false;
+    if (!(topology_checked && module->topological()) && !module->allows(mesh_, candidate, edge))
+      return false;
   return true;
 }
 
@@ -181,9 +183,12 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     // The entry is current, so the cost and placement are those of the present mesh; only
     // legality depends on the neighbourhood and is checked now (Decimater: re-check on pop).
     CollapseCandidate candidate;
+    // (topological rules are symmetric in the edge's ends: once passed, they hold for vs, vt)
+    bool topology_checked = false;
     if (!take_requeued(entry, candidate)) {
       // Its ends unchanged, a neighbour's collapse may still have broken its link: then no
       // costing (with a costly module).
+      topology_checked = screen_;
       if (screen_ && !topologically_legal(entry.a, entry.b)) {
         ++stats_.rejected;
         ++stats_.screened;
@@ -198,7 +203,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.stale;
       continue;
     }
-    if (!legal(candidate, edge)) {
+    if (!legal(candidate, edge, topology_checked)) {
       ++stats_.rejected;
       reject(entry.a, entry.b);
       continue;

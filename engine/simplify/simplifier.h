@@ -96,7 +96,9 @@ class Simplifier {
   bool topologically_legal(VertexId a, VertexId b) const;
   bool is_stale(const Entry& entry) const;
   void compact_heap();
-  bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge) const;
+  // All constraints; with topology_checked, those that are not topological().
+  bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
+             bool topology_checked = false) const;
   CollapseRecord perform(CollapseCandidate candidate, const EdgeFaces& edge);
 
   CollapseMesh& mesh_;
