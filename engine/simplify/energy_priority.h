@@ -34,9 +34,10 @@
 // corners; it keeps a bound of how far they moved (drift_), and every distance read from it
 // is stored distance + drift, an upper bound (the error recorded in the PM stays one).
 //
-// Queue keys (Costing::kQueue) are most of the evaluations and most are never used: each start
-// is measured and solved, but the solved position is costed on the model it was solved on,
-// not measured again (see evaluate()).
+// Queue keys (Costing::kQueue) are most of the evaluations and most are never used: they try
+// fewer starts (a young star the two ends, a star costed by moments the midpoint), and each
+// start is measured and solved, but the solved position is costed on the model it was solved
+// on, not measured again (see evaluate()).
 //
 // The sample of a vertex that has not moved lies on the mesh, on that vertex, whatever
 // happens around it: it is "parked" at its vertex (in no face's list) and costs nothing until

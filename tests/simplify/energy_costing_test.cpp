@@ -62,9 +62,11 @@ double median(std::vector<double> v) {
 
 // A key costs each start's solved position on the model it was solved on: each point stays
 // at its barycentric coordinates on its face, a point of the new star, so the measured
-// distance is never larger. Every star projected point by point (no moments) and E_scalar
-// off: the key is never below the measured cost, and it is close to it (when a start wins, as
-// it mostly does, the two are equal).
+// distance is never larger. A young star's key (an end still holds its own sample) starts
+// from the two ends only, where the performed costing also tries the midpoint. Every star
+// projected point by point (no moments) and E_scalar off: the key is never below the measured
+// cost; it is equal on most edges, and above where the midpoint's start wins (by design: such
+// edges come later).
 TEST(EnergyCosting, AQueueKeyIsAnUpperBoundOfTheMeasuredCost) {
   EnergyOptions options;
   options.max_points_per_evaluation = 1u << 30;
@@ -89,10 +91,11 @@ TEST(EnergyCosting, AQueueKeyIsAnUpperBoundOfTheMeasuredCost) {
         "stratocaster-9k at %3.0f%%: %zu edges, key above the measured cost on %zu, by a "
         "median %.3g of the cost\n",
         ratio * 100, edges, above, median(gaps));
-    // 2026-11-22: above on 32% / 32% / 3% of the edges, by 0.0014 / 0.085 / 0.14.
+    // 2026-11-22, young stars' keys from the ends: above on 32% / 32% / 2% of the edges, by
+    // 0.55 / 0.37 / 0.15 (from all three starts it was 0.0014 / 0.085 / 0.14).
     EXPECT_GT(edges, 1000u);
     EXPECT_LT(above, edges / 2);
-    EXPECT_LT(median(gaps), 0.3);
+    EXPECT_LT(median(gaps), 3.0);
   }
 }
 
@@ -191,8 +194,9 @@ Mesh live_mesh(const CollapseMesh& mesh) {
 // Hoppe's spring constants with one point per vertex let a young star's springs outweigh its
 // points' distances, and collapses go by edge length: the default scale (EnergyOptions::
 // spring_scale) gives the scanned vessel a lower RMS distance to its input at 10% and 2% than
-// Hoppe's own values (2026-11-22: 0.70 and 0.95 of it; nine meshes of ../shared/meshes in
-// docs/BENCHMARKS.md, "E_spring's weight").
+// Hoppe's own values (2026-11-22: 0.733 and 0.978 of it; with queue keys from all three starts
+// it was 0.70 and 0.95; nine meshes of ../shared/meshes in docs/BENCHMARKS.md, "E_spring's
+// weight").
 TEST(EnergyCosting, ScaledSpringsKeepTheSurfaceCloserThanHoppesValues) {
   const Mesh input = repair_mesh(read_mesh(testing::test_data("gmsh-aneurysm-20k.stl.gz"))).mesh;
   for (const double ratio : {0.1, 0.02}) {
