@@ -295,7 +295,6 @@ class EnergyPriority : public PriorityModule {
   std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
   std::vector<std::array<double, 3>> moved_bary_;
   mutable std::vector<PreparedTriangle> prepared_;  // star_ with v at the projected position
-  mutable std::vector<uint8_t> prepared_ready_;
 };
 
 }  // namespace parapm

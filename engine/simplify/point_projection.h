@@ -103,8 +103,14 @@ inline Projection project_on_triangle(const Vec3& p, const Vec3& a, const Vec3& 
 class PreparedTriangle {
  public:
   PreparedTriangle() = default;
-  PreparedTriangle(const Vec3& a, const Vec3& b, const Vec3& c)
-      : a_(a), b_(b), c_(c), e1_(sub(b, a)), e2_(sub(c, a)) {
+  PreparedTriangle(const Vec3& a, const Vec3& b, const Vec3& c) { reset(a, b, c); }
+  // In place: the energy re-prepares a star's faces for every position it tries.
+  [[gnu::always_inline]] void reset(const Vec3& a, const Vec3& b, const Vec3& c) {
+    a_ = a;
+    b_ = b;
+    c_ = c;
+    e1_ = sub(b, a);
+    e2_ = sub(c, a);
     d11_ = dot(e1_, e1_);
     d12_ = dot(e1_, e2_);
     d22_ = dot(e2_, e2_);
