@@ -461,9 +461,9 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
                                                    std::vector<Projected>* where) const {
   Fit fit;
   if (where) where->resize(points.size());
+  if (points.empty()) return fit;
   // Every face up front: a star's few points (5 on 8 faces, typically: most samples are
   // parked at their vertices) touch nearly all of them, and the loop below stays small.
-  if (points.empty()) return fit;
   prepared_.resize(star_.size());
   for (size_t j = 0; j < star_.size(); ++j) prepared_[j].reset(v, star_[j].p1, star_[j].p2);
   for (size_t i = 0; i < points.size(); ++i) {
