@@ -15,7 +15,7 @@ void sort_keys(std::vector<EdgeKey>& keys) {
 }
 
 KeyMemo::KeyMemo(PriorityModule& inner, size_t vertex_capacity)
-    : inner_(inner), head_(vertex_capacity, kEnd), changed_at_(vertex_capacity, 0) {}
+    : PriorityWrapper(inner), head_(vertex_capacity, kEnd), changed_at_(vertex_capacity, 0) {}
 
 KeyMemo::Entry* KeyMemo::find(VertexId a, VertexId b) const {
   for (uint32_t i = head_[a]; i != kEnd; i = entries_[i].next)

@@ -41,12 +41,9 @@ void sort_keys(std::vector<EdgeKey>& keys);
 // itself is the run without them (tested). Costing::kPerform always goes to the inner module. Not
 // thread-safe (like the modules it wraps); its const reads (for_each_current*) may run
 // concurrently.
-class KeyMemo : public PriorityModule {
+class KeyMemo : public PriorityWrapper {
  public:
   KeyMemo(PriorityModule& inner, size_t vertex_capacity);
-  std::string name() const override { return inner_.name(); }
-  bool costly() const override { return inner_.costly(); }
-  void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
@@ -81,7 +78,6 @@ class KeyMemo : public PriorityModule {
   // Overwrites `found` (find(a, b)'s answer) or lists a new entry at a.
   void store(Entry* found, VertexId a, VertexId b, double cost, bool carried) const;
 
-  PriorityModule& inner_;
   mutable std::vector<uint32_t> head_;  // per vertex: its first entry, kEnd for none
   mutable std::vector<Entry> entries_;
   std::vector<uint32_t> changed_at_;  // per vertex: the last collapse it was vs or vt of

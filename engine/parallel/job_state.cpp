@@ -11,23 +11,10 @@ IdMaps maps_of(const SubsetJob& job) {
   return {&job.global_vertex, &job.global_face, &job.global_wedge};
 }
 
-class WithoutInitialize : public PriorityModule {
+class WithoutInitialize : public PriorityWrapper {
  public:
-  explicit WithoutInitialize(PriorityModule& inner) : inner_(inner) {}
-  std::string name() const override { return inner_.name(); }
-  bool costly() const override { return inner_.costly(); }
+  using PriorityWrapper::PriorityWrapper;
   void initialize(const CollapseMesh&) override {}
-  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) const override {
-    return inner_.evaluate(mesh, a, b, out, costing);
-  }
-  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
-                 const EdgeFaces& edge) override {
-    inner_.collapsed(mesh, done, edge);
-  }
-
- private:
-  PriorityModule& inner_;
 };
 
 }  // namespace

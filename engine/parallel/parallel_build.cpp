@@ -147,12 +147,10 @@ uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& 
 // The band pass's priority: the master's metric, restricted to edges with an end that no
 // collapse has touched yet (an input vertex, around which input faces may remain) and a cost
 // of at most `ceiling`; an edge above it is left alone until its star changes.
-class BandPriority : public PriorityModule {
+class BandPriority : public PriorityWrapper {
  public:
   BandPriority(PriorityModule& inner, std::vector<uint8_t>& touched, double ceiling)
-      : inner_(inner), touched_(touched), ceiling_(ceiling) {}
-  std::string name() const override { return inner_.name(); }
-  bool costly() const override { return inner_.costly(); }
+      : PriorityWrapper(inner), touched_(touched), ceiling_(ceiling) {}
   void initialize(const CollapseMesh&) override {}
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {
@@ -166,7 +164,6 @@ class BandPriority : public PriorityModule {
   }
 
  private:
-  PriorityModule& inner_;
   std::vector<uint8_t>& touched_;
   double ceiling_;
 };

@@ -51,25 +51,17 @@ class SubsetConstraint : public ConstraintModule {
   std::vector<uint8_t> continues_;
 };
 
-class SubsetPriority : public PriorityModule {
+class SubsetPriority : public PriorityWrapper {
  public:
   SubsetPriority(PriorityModule& inner, std::vector<uint8_t> free_vertex, double max_cost)
-      : inner_(inner), free_(std::move(free_vertex)), max_cost_(max_cost) {}
-  std::string name() const override { return inner_.name(); }
-  bool costly() const override { return inner_.costly(); }
-  void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
+      : PriorityWrapper(inner), free_(std::move(free_vertex)), max_cost_(max_cost) {}
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {
     if (!free_[a] || !free_[b]) return false;
     return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= max_cost_;
   }
-  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
-                 const EdgeFaces& edge) override {
-    inner_.collapsed(mesh, done, edge);
-  }
 
  private:
-  PriorityModule& inner_;
   std::vector<uint8_t> free_;
   double max_cost_;
 };

@@ -59,6 +59,28 @@ class PriorityModule {
   virtual bool costly() const { return false; }
 };
 
+// A module wrapped around another (a restriction, a memo, a step left out): forwards every
+// call to `inner`; a wrapper overrides only what it changes, so that what the inner module
+// tells the engine (its name, costly()) passes through every layer.
+class PriorityWrapper : public PriorityModule {
+ public:
+  explicit PriorityWrapper(PriorityModule& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  bool costly() const override { return inner_.costly(); }
+  void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) const override {
+    return inner_.evaluate(mesh, a, b, out, costing);
+  }
+  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
+                 const EdgeFaces& edge) override {
+    inner_.collapsed(mesh, done, edge);
+  }
+
+ protected:
+  PriorityModule& inner_;
+};
+
 class ConstraintModule {
  public:
   virtual ~ConstraintModule() = default;
