@@ -74,17 +74,33 @@ uint64_t round_seed(uint64_t seed, uint32_t round) {
   return mix.next() >> 1;
 }
 
-// The jobs' cost ceiling of a round: `factor` times its water level. The water level: a
-// sample of the live inner edges (both ends in one subset; every `stride`-th, about 1024 per
-// subset) costed by the master's module, and the cost below which the sampled edges, scaled
-// to all edges, would give the round's collapses. A sequential run, cheapest first, would
-// not go far above it in this round (the costs of the edges it creates grow, hence the
-// factor); a subset whose region holds few
-// cheap collapses would, if it had to remove its share of the faces whatever they cost.
+// What a sample of a round's edges says about its costs: the live inner edges (both ends in
+// one subset; every `stride`-th, about 1024 per subset), costed by the master's module.
+struct RoundCosts {
+  // The jobs' cost ceiling: `factor` times the water level, the cost below which the sampled
+  // edges, scaled to all edges, would give the round's collapses. A sequential run, cheapest
+  // first, would not go far above it in this round (the costs of the edges it creates grow,
+  // hence the factor); a subset whose region holds few cheap collapses would, if it had to
+  // remove its share of the faces whatever they cost. Infinite if `factor` is 0.
+  double ceiling = std::numeric_limits<double>::infinity();
+  // Per subset, the fraction of its sampled edges that are cheap: among the cheapest
+  // kCheapEdgesPerCollapse edges per collapse of the round, all subsets' edges ranked
+  // together (set_targets).
+  std::vector<double> cheap_fraction;
+};
+
+// Cheap edges counted per collapse of the round: a sequential run's costs grow as a region
+// coarsens, so the collapses it makes in a region follow the edges there below a cost a
+// few times the round's first quantile. Measured on the energy (docs/BENCHMARKS.md, "Shares
+// by cheap edges"): 1 and 1.5 left the 50% level of fandisk at p = 8 10% / 4% worse than
+// 2.5, 4 made it 15% worse; the 203k dragon's levels moved by less than 2%.
+constexpr double kCheapEdgesPerCollapse = 2.5;
+
 // Deterministic: the sample depends on the mesh only.
-double water_level(const CollapseMesh& mesh, const PriorityModule& master,
-                   const std::vector<uint32_t>& vertex_subset, uint32_t p, uint64_t remove,
-                   double factor) {
+RoundCosts sample_round_costs(const CollapseMesh& mesh, const PriorityModule& master,
+                              const std::vector<uint32_t>& vertex_subset, uint32_t p,
+                              uint64_t remove, double factor) {
+  RoundCosts out;
   uint64_t total_edges = 0;
   auto inner = [&](VertexId a, VertexId b) {
     return a < b && vertex_subset[a] == vertex_subset[b];
@@ -96,6 +112,7 @@ double water_level(const CollapseMesh& mesh, const PriorityModule& master,
   }
   const uint64_t stride = std::max<uint64_t>(1, total_edges / (1024 * uint64_t(p)));
   std::vector<double> costs;
+  std::vector<std::vector<double>> subset_costs(p);
   uint64_t index = 0;
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     if (!mesh.face_alive(f)) continue;
@@ -107,9 +124,10 @@ double water_level(const CollapseMesh& mesh, const PriorityModule& master,
       costs.push_back(master.evaluate(mesh, a, b, c, Costing::kQueue)
                           ? c.cost
                           : std::numeric_limits<double>::infinity());
+      subset_costs[vertex_subset[a]].push_back(costs.back());
     }
   }
-  if (costs.empty()) return std::numeric_limits<double>::infinity();
+  if (costs.empty()) return out;
   // A collapse removes two faces and about three edges.
   const double fraction = std::min(1.0, double(remove) / 2 / double(total_edges));
   auto quantile = [&](double q) {
@@ -119,23 +137,50 @@ double water_level(const CollapseMesh& mesh, const PriorityModule& master,
   };
   // At least the cost below which twice the round's collapses lie: where most sampled edges
   // cost nothing (coplanar quadrics), factor x 0 would stop every job at once.
-  return std::max(factor * quantile(fraction), quantile(std::min(1.0, 2 * fraction)));
+  if (factor > 0)
+    out.ceiling = std::max(factor * quantile(fraction), quantile(std::min(1.0, 2 * fraction)));
+  const double cheap = quantile(std::min(1.0, kCheapEdgesPerCollapse * fraction));
+  out.cheap_fraction.assign(p, 0.0);
+  for (uint32_t s = 0; s < p; ++s) {
+    const std::vector<double>& own = subset_costs[s];
+    const auto below = std::count_if(own.begin(), own.end(), [&](double c) { return c <= cheap; });
+    out.cheap_fraction[s] = own.empty() ? fraction : double(below) / double(own.size());
+  }
+  return out;
 }
 
-// Each subset removes the round's fraction (faces_before - goal) / faces_before of the faces it
-// can remove, so that its inside leaves the round as coarse as the whole mesh should. Its
-// border stays finer, for the next round's new partition or the final pass to take, cheapest
-// first, as a sequential run would have. (A share of all its faces made a job coarsen its
-// inside further to make up for its border: the level a round left was uneven, up to 11%
-// worse in RMS than the sequential one on a small mesh cut in 8; docs/BENCHMARKS.md,
-// "Shares of the removable faces".) Returns the faces asked of all jobs.
+// Each subset removes a share of the faces it can remove, so that its inside leaves the round
+// as coarse as the whole mesh should. Its border stays finer, for the next round's new
+// partition or the final pass to take, cheapest first, as a sequential run would have. (A
+// share of all its faces made a job coarsen its inside further to make up for its border: the
+// level a round left was uneven, up to 11% worse in RMS than the sequential one on a small
+// mesh cut in 8; docs/BENCHMARKS.md, "Shares of the removable faces".)
+// Without `cheap_fraction`, every share is the round's fraction (faces_before - goal) /
+// faces_before of the subset's removable faces. With it, the same total is divided in
+// proportion to the subset's removable faces times its fraction of cheap edges (at most 95%
+// of its removable faces): a sequential run takes more from a flat region than from a curved
+// one, and equal shares left the 50% level of the energy's PM up to 6% (the 203k dragon at
+// p = 8, 16) and 29% (fandisk at p = 8) worse than the sequential one (docs/BENCHMARKS.md,
+// "Shares by cheap edges"). Returns the faces asked of all jobs.
 uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& removable,
-                     uint64_t faces_before, uint64_t goal) {
+                     uint64_t faces_before, uint64_t goal,
+                     const std::vector<double>& cheap_fraction) {
   const double fraction =
       faces_before > goal ? double(faces_before - goal) / double(faces_before) : 0.0;
+  std::vector<double> fractions(jobs.size(), fraction);
+  if (cheap_fraction.size() == jobs.size()) {
+    double total = 0, weighted = 0;
+    for (size_t s = 0; s < jobs.size(); ++s) {
+      total += fraction * double(removable[s]);
+      weighted += cheap_fraction[s] * double(removable[s]);
+    }
+    if (weighted > 0)
+      for (size_t s = 0; s < jobs.size(); ++s)
+        fractions[s] = std::min(0.95, total * cheap_fraction[s] / weighted);
+  }
   uint64_t asked = 0;
   for (size_t s = 0; s < jobs.size(); ++s) {
-    const auto share = uint64_t(std::llround(fraction * double(removable[s])));
+    const auto share = uint64_t(std::llround(fractions[s] * double(removable[s])));
     const uint64_t faces = jobs[s].mesh.face_count();
     // 0 would mean "as far as legal": a job with nothing to remove keeps one face.
     jobs[s].options.target_faces = std::max<uint64_t>(1, faces > share ? faces - share : 0);
@@ -305,10 +350,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
     t = std::chrono::steady_clock::now();
     const std::vector<std::vector<VertexId>> owned = owned_vertices(whole, vertex_subset, subsets);
     double sequential_extract = seconds_since(t);
-    if (parallel.water_level_factor > 0) {
+    RoundCosts round_costs;
+    if (parallel.water_level_factor > 0 || parallel.cost_shares) {
       const auto ts = std::chrono::steady_clock::now();
-      rs.water_level = water_level(whole, keys, vertex_subset, subsets,
-                                   rs.faces_before - rs.goal_faces, parallel.water_level_factor);
+      round_costs =
+          sample_round_costs(whole, keys, vertex_subset, subsets, rs.faces_before - rs.goal_faces,
+                             parallel.water_level_factor);
+      if (!parallel.cost_shares) round_costs.cheap_fraction.clear();
+      if (parallel.water_level_factor > 0) rs.water_level = round_costs.ceiling;
       rs.share_seconds = seconds_since(ts);
       sequential_extract += rs.share_seconds;
     }
@@ -327,7 +376,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i], free);
       job_cpu[i] = thread_cpu_seconds() - cpu;
     });
-    rs.asked_faces = set_targets(jobs, removable, rs.faces_before, rs.goal_faces);
+    rs.asked_faces =
+        set_targets(jobs, removable, rs.faces_before, rs.goal_faces, round_costs.cheap_fraction);
     if (parallel.water_level_factor > 0)
       for (SubsetJob& job : jobs)
         job.options.max_cost = job.options.max_cost > 0

@@ -41,9 +41,14 @@ struct ParallelOptions {
   // rounds after a short round").
   uint64_t extra_round_subset_faces = 2000;
   // Jobs leave alone edges costing more than this factor times the round's water level
-  // (parallel_build.cpp, water_level: the cost below which a sample of the edges would give
-  // the round's collapses), besides stopping at their share of the faces; 0: shares only.
+  // (parallel_build.cpp, sample_round_costs: the cost below which a sample of the edges
+  // would give the round's collapses), besides stopping at their share of the faces; 0:
+  // shares only.
   double water_level_factor = 8;
+  // The round's faces divided among the jobs in proportion to their removable faces times
+  // their fraction of cheap edges in the same sample (parallel_build.cpp, set_targets); off:
+  // in proportion to their removable faces only.
+  bool cost_shares = true;
   // After each round but the first, a sequential pass over the edges around vertices no
   // collapse has touched, up to the 95th percentile of the round's costs (parallel_build.cpp).
   bool band_pass = true;
@@ -78,7 +83,7 @@ struct RoundStats {
   uint64_t faces_after = 0;
   double partition_seconds = 0;
   double extract_seconds = 0;  // jobs and their state, shares included (wall)
-  double share_seconds = 0;    // of which costing the edge sample for the water level
+  double share_seconds = 0;    // of which costing the edge sample (water level, shares)
   // Each job's mesh and state are built on the pool: the slowest one's CPU, and the
   // extraction's share of the critical path (its sequential steps plus the slowest job).
   double slowest_extract_cpu_seconds = 0;
