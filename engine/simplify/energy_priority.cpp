@@ -482,22 +482,25 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
       // The sample of a (b), at a's old position: v moved away from it, towards the other
       // end, so it lies over the faces that were a's (b's).
       const bool a_side = home == -1;
-      const int begin = a_side ? 0 : a_side_faces_,
-                end = a_side ? a_side_faces_ : int(star_.size());
+      int begin = a_side ? 0 : a_side_faces_, end = a_side ? a_side_faces_ : int(star_.size());
       if (x == v) {
         // At the start where v is that end: on the first face, at distance 0, as projecting
         // onto each face (all meet at v) would find.
         best = {{1, 0, 0}, 0};
         best_j = begin < end ? begin : 0;
       } else {
-        for (int j = begin; j < end; ++j) consider(j);
-        if (begin == end)
-          for (int j = 0; j < int(star_.size()); ++j) consider(j);
+        if (begin == end) begin = 0, end = int(star_.size());
+        for (int j = begin; j < end; ++j)
+          if (prepared_[j].plane_distance_sq(x) <= best.distance_sq) consider(j);
       }
     } else {
       consider(home);
-      if (star_[home].next >= 0) consider(star_[home].next);
-      if (star_[home].previous >= 0) consider(star_[home].previous);
+      // A face beside it whose plane is already farther than the best cannot win.
+      auto beside = [&](int j) {
+        if (j >= 0 && prepared_[j].plane_distance_sq(x) <= best.distance_sq) consider(j);
+      };
+      beside(star_[home].next);
+      beside(star_[home].previous);
     }
     const StarFace* best_face = &star_[best_j];
     if (where) (*where)[i] = {best_j, best.bary};
@@ -515,7 +518,11 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
 
 double EnergyPriority::spring_energy_after(const Vec3& v) const {
   double sum = 0;
-  for (const StarFace& f : star_) sum += half_edges_sq(v, f.p1, f.p2);
+  for (const StarFace& f : star_) {
+    // half_edges_sq(v, p1, p2), with the rim edge's term kept from the star's assembly.
+    const Vec3 to_p1 = sub(f.p1, v), from_p2 = sub(v, f.p2);
+    sum += 0.5 * (dot(to_p1, to_p1) + f.rim_sq + dot(from_p2, from_p2));
+  }
   return sum;
 }
 
@@ -595,6 +602,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       } else {
         star_.push_back({p1, p2, p0, t[(k + 1) % 3], t[(k + 2) % 3]});
         star_.back().source = f;
+        const Vec3 rim = sub(p2, p1);
+        star_.back().rim_sq = dot(rim, rim);
         if (scalar_.enabled()) {
           const auto& w = mesh.corner_wedges(f);
           star_.back().wedges = {w[k], w[(k + 1) % 3], w[(k + 2) % 3]};

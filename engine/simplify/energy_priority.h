@@ -168,6 +168,7 @@ class EnergyPriority : public PriorityModule {
     int next = -1, previous = -1;
     std::array<WedgeId, 3> wedges{};  // of the corners v, p1, p2 (with E_scalar)
     int group = 0;                    // E_scalar's group of the corner at v
+    double rim_sq = 0;                // |p2 - p1|^2: the spring term's part that v leaves alone
   };
   // Where one point projected: a star face and barycentric coordinates on (v, p1, p2).
   struct Projected {

@@ -150,6 +150,12 @@ class PreparedTriangle {
     }
     return project_on_triangle(p, a_, b_, c_);
   }
+  // A lower bound of project(p).distance_sq: the squared distance to the triangle's plane
+  // (0 for a degenerate triangle, which has none). Equal to it where p projects inside.
+  [[gnu::always_inline]] double plane_distance_sq(const Vec3& p) const {
+    const double h = dot(normal_, sub(p, a_));
+    return h * h * inverse_det_;
+  }
 
  private:
   static double clamp01(double t) { return t < 0 ? 0 : t > 1 ? 1 : t; }
