@@ -33,6 +33,7 @@ struct SimplifyArgs {
   double handover = ParallelOptions{}.handover_ratio;
   uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
   bool no_carry_keys = false;
+  bool no_deferred_recosting = false;
   bool json = false;
 };
 
@@ -94,6 +95,7 @@ int run_simplify(const SimplifyArgs& args) {
   options.attribute_weight = args.attribute_weight;
   options.seed = args.seed;
   options.keep_order = args.keep_order;
+  options.defer_recosting = !args.no_deferred_recosting;
   SimplifyStats stats;
   ParallelStats parallel_stats;
   ProgressBar bar("simplify");
@@ -250,6 +252,10 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                 "With --parallel: every round's jobs cost all their edges again instead of "
                 "starting from the queue keys the round before left (for measuring the work "
                 "they save; the PM differs a little, docs/BENCHMARKS.md)");
+  cmd->add_flag("--no-deferred-recosting", args->no_deferred_recosting,
+                "Energy: cost the edges around each collapse at once, not when they reach the "
+                "top of the queue (for measuring the costings deferral saves; the PM differs a "
+                "little, docs/BENCHMARKS.md)");
   cmd->add_flag("--json", args->json,
                 "Print one JSON object on stdout (with --parallel, under \"parallel\": p, rounds "
                 "performed, per round the partition, extraction, subset (per subset wall and "

@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 2;
+constexpr uint8_t kVersion = 3;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -461,6 +461,7 @@ void write_options(ByteWriter& out, const SubsetOptions& o) {
   out.f64(o.reference_diagonal);
   out.varint(o.target_faces);
   out.f64(o.max_cost);
+  out.u8(o.defer_recosting ? 1 : 0);
 }
 
 void read_options(ByteReader& in, SubsetOptions& o) {
@@ -476,6 +477,9 @@ void read_options(ByteReader& in, SubsetOptions& o) {
     in.fail("the reference diagonal must be finite and >= 0");
   o.target_faces = in.varint64();
   o.max_cost = read_not_nan(in, "max cost");
+  const uint8_t defer = in.u8();
+  if (defer > 1) in.fail("the deferred re-costing flag must be 0 or 1");
+  o.defer_recosting = defer == 1;
 }
 
 // Whether the job's energy module will run E_scalar, so that its state must carry the

@@ -378,6 +378,11 @@ ProgressiveMesh build_progressive_mesh_parallel(
     });
     rs.asked_faces =
         set_targets(jobs, removable, rs.faces_before, rs.goal_faces, round_costs.cheap_fraction);
+    // Deferred re-costing as the sequential build has it at these face counts.
+    for (SubsetJob& job : jobs)
+      job.options.defer_recosting =
+          options.defer_recosting &&
+          double(rs.goal_faces) >= kDeferRecostingAboveRatio * double(input_faces);
     if (parallel.water_level_factor > 0)
       for (SubsetJob& job : jobs)
         job.options.max_cost = job.options.max_cost > 0
@@ -505,6 +510,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
   Simplifier final_pass(whole, *continued, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target;
+  if (options.defer_recosting)
+    limits.defer_above_faces =
+        size_t(std::llround(kDeferRecostingAboveRatio * double(input_faces)));
   const uint64_t done_before = input_faces - whole.live_faces();
   std::vector<CollapseRecord> final_records = final_pass.run(
       limits,

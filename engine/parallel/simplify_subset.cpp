@@ -94,6 +94,7 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   Simplifier simplifier(working, *priority, std::move(constraints));
   SimplifierLimits limits;
   limits.target_faces = job.options.target_faces;
+  if (job.options.defer_recosting) limits.defer_above_faces = 0;
   result.records = simplifier.run(limits, progress, cancel);
   for (CollapseRecord& r : result.records) globalise(r, job);
   if (!job.state.empty()) result.state = export_result_state(*metric, working, job);
@@ -105,9 +106,11 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   spdlog::debug(
       "round {} subset {} simplified {}->{} faces ({} owned, {} free vertices) in {:.3f} s"
-      " ({:.3f} s CPU; {})",
+      " ({:.3f} s CPU; {} collapses, {} evaluations, {} deferred, {} keys reused; {})",
       job.round, job.subset, result.faces, working.live_faces(), result.owned_faces,
-      result.free_vertices, result.wall_seconds, result.cpu_seconds, result.stats.stop_reason);
+      result.free_vertices, result.wall_seconds, result.cpu_seconds, result.stats.collapses,
+      result.stats.evaluations, result.stats.deferred, result.keys_reused,
+      result.stats.stop_reason);
   return result;
 }
 

@@ -46,6 +46,9 @@ struct SubsetOptions {
   // remove its share does not change the curves' topology where a sequential run, cheapest
   // first, would not have come to that yet.
   double max_cost = 0;
+  // Edges around a collapse costed when they come to the top of the queue, not at once
+  // (SimplifierLimits::defer_above_faces): set for rounds above the sequential build's line.
+  bool defer_recosting = false;
 };
 
 // The subset options a simplification with `options` gives its jobs, measured against the

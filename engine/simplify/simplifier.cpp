@@ -1,6 +1,9 @@
 #include "simplify/simplifier.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <utility>
 
 namespace parapm {
@@ -20,6 +23,35 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   ++stats_.evaluations;
   if (!priority_.evaluate(mesh_, a, b, candidate, Costing::kQueue)) return false;
   entry = {static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]};
+  if (defer_) remember_key(a, b, entry.cost);
+  return true;
+}
+
+void Simplifier::remember_key(VertexId a, VertexId b, float key) {
+  const EdgeFaces edge = mesh_.edge_faces(a, b);
+  if (edge.left != kNoId)
+    face_keys_[3 * size_t(edge.left) + corner_of(mesh_.face(edge.left), a)] = key;
+  if (edge.right != kNoId)
+    face_keys_[3 * size_t(edge.right) + corner_of(mesh_.face(edge.right), b)] = key;
+}
+
+bool Simplifier::defer_edge(VertexId a, VertexId b) {
+  if (a > b) std::swap(a, b);
+  const EdgeFaces edge = mesh_.edge_faces(a, b);
+  float key = std::numeric_limits<float>::infinity();
+  auto take = [&](FaceId f, VertexId from) {
+    if (f == kNoId) return;
+    const float k = face_keys_[3 * size_t(f) + corner_of(mesh_.face(f), from)];
+    if (!std::isnan(k)) key = std::min(key, k);
+  };
+  take(edge.left, a);
+  take(edge.right, b);
+  if (std::isinf(key)) return false;
+  // Below it: a collapse beside an edge mostly raises its cost (points move into its star),
+  // and an edge that comes out too early only costs one costing.
+  key -= 0.5f * std::abs(key);
+  heap_.push({key, a, b, (version_[a] + version_[b]) | kDeferred});
+  ++stats_.deferred;
   return true;
 }
 
@@ -52,7 +84,7 @@ bool Simplifier::topologically_legal(VertexId a, VertexId b) const {
 
 bool Simplifier::is_stale(const Entry& entry) const {
   return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
-         version_[entry.a] + version_[entry.b] != entry.stamp;
+         version_[entry.a] + version_[entry.b] != (entry.stamp & ~kDeferred);
 }
 
 void Simplifier::compact_heap() {
@@ -137,6 +169,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   collapses_ = 0;
   requeued_.clear();
   rejected_.assign(mesh_.vertex_capacity(), {});
+  defer_ = priority_.costly() && limits.defer_above_faces != SIZE_MAX;
+  face_keys_.assign(defer_ ? 3 * size_t(mesh_.face_capacity()) : 0,
+                    std::numeric_limits<float>::quiet_NaN());
   screen_ = priority_.costly();
 
   // Every undirected edge once: from the face holding a->b with a < b, or from the only face
@@ -178,6 +213,10 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     const Entry entry = heap_.pop();
     if (is_stale(entry)) {
       ++stats_.stale;
+      continue;
+    }
+    if (entry.stamp & kDeferred) {  // costed now, back at its true key
+      push_edge(entry.a, entry.b);
       continue;
     }
     // The entry is current, so the cost and placement are those of the present mesh; only
@@ -247,7 +286,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       }
       list.clear();
     }
-    for (VertexId n : ring) push_edge(vs, n);
+    const bool defer = defer_ && mesh_.live_faces() > limits.defer_above_faces;
+    for (VertexId n : ring)
+      if (!(defer && defer_edge(vs, n))) push_edge(vs, n);
     for (const auto& [n, other] : retry) retry_edge(n, other);
 
     if ((records.size() & 1023) == 0) {

@@ -40,7 +40,20 @@ struct CollapseRecord {
 
 struct SimplifierLimits {
   size_t target_faces = 0;  // stop once the live face count is <= this (0: go as far as legal)
+  // Deferred re-costing, with a costly priority module: while more faces than this are live,
+  // the edges around vs after a collapse are not costed at once. Each goes back into the queue
+  // a little below its last key (the lower of its two faces' remembered keys, less half its
+  // magnitude) and is costed when it comes to the top, then queued again at its true key: most
+  // of them change again before they get there. Below it every one is costed at once, so the
+  // coarse levels, where one collapse out of order costs most, keep the exact order.
+  // SIZE_MAX: never deferred. (Bunny: 402k costings -> 284k; docs/BENCHMARKS.md, "Deferred
+  // re-costing".)
+  size_t defer_above_faces = SIZE_MAX;
 };
+
+// The sequential build defers re-costing down to this fraction of the input's faces (the
+// parallel build's default handover, so that its final pass costs at once, as this does).
+constexpr double kDeferRecostingAboveRatio = 0.1;
 
 struct SimplifierStats {
   uint64_t collapses = 0;
@@ -54,6 +67,7 @@ struct SimplifierStats {
   // With a costly priority module: edges the topological rules vetoed before any costing
   // (retried after their star changed, or on top of the queue: those count as rejected too).
   uint64_t screened = 0;
+  uint64_t deferred = 0;    // edges queued below their last key instead of costed at once
   std::string stop_reason;  // why the loop ended
 };
 
@@ -72,7 +86,9 @@ class Simplifier {
  private:
   // 16 bytes, so that more of the heap stays in cache. The stamp is the sum of the two
   // vertices' versions when the entry was pushed: versions only grow, so the sum is unchanged
-  // exactly when neither end has changed since.
+  // exactly when neither end has changed since. Its top bit marks a deferred entry, whose
+  // edge is to be costed when it comes out (versions count collapses, far below 2^31).
+  static constexpr uint32_t kDeferred = 0x80000000u;
   struct Entry {
     float cost;
     VertexId a, b;
@@ -87,6 +103,11 @@ class Simplifier {
   };
 
   void push_edge(VertexId a, VertexId b);
+  // Queues edge {a, b} below its remembered key, uncosted; false when it has none.
+  bool defer_edge(VertexId a, VertexId b);
+  // The key last computed for edge {a, b} stays with its faces (the two corners' slots of
+  // face_keys_), through collapses that rename an end: the faces keep their ids and corners.
+  void remember_key(VertexId a, VertexId b, float key);
   // Costs edge {a, b}; false when the module cannot place it.
   bool queue_entry(VertexId a, VertexId b, Entry& entry);
   // Pushes an edge vetoed before, whose star has changed since.
@@ -116,6 +137,8 @@ class Simplifier {
   bool take_requeued(const Entry& entry, CollapseCandidate& out);
   std::unordered_map<uint64_t, std::pair<uint32_t, CollapseCandidate>> requeued_;
   std::vector<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
+  bool defer_ = false;                     // costly() and a limit below SIZE_MAX
+  std::vector<float> face_keys_;           // 3 per face: the key of the edge from corner k; NaN
   uint32_t collapses_ = 0;
   SimplifierStats stats_;
 };

@@ -88,6 +88,9 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   Simplifier simplifier(working, *priority, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target_face_count(mesh.face_count(), options);
+  if (options.defer_recosting)
+    limits.defer_above_faces =
+        size_t(std::llround(kDeferRecostingAboveRatio * double(mesh.face_count())));
   const auto records = simplifier.run(limits, progress, cancel);
 
   PmBuildOptions build_options;
@@ -104,10 +107,10 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   }
   spdlog::debug(
       "simplified {} -> {} faces in {:.3f} s ({} collapses, {} vetoed, {} screened, {} "
-      "evaluations, {} requeued; {})",
+      "evaluations, {} deferred, {} requeued; {})",
       mesh.face_count(), pm.base.face_count(), seconds, simplifier.stats().collapses,
       simplifier.stats().rejected, simplifier.stats().screened, simplifier.stats().evaluations,
-      simplifier.stats().requeued, simplifier.stats().stop_reason);
+      simplifier.stats().deferred, simplifier.stats().requeued, simplifier.stats().stop_reason);
   return pm;
 }
 

@@ -30,6 +30,10 @@ struct SimplifyOptions {
   double attribute_weight = 0.01;
   uint64_t seed = 1;        // of the randomised steps (the energy's extra points)
   bool keep_order = false;  // store the input's vertex and face order in the PM
+  // Re-costing deferred above a tenth of the input's faces (SimplifierLimits::
+  // defer_above_faces; the energy only). Off: every edge around a collapse is costed at once
+  // (for measuring what deferral saves; the PM differs a little).
+  bool defer_recosting = true;
 };
 
 struct SimplifyStats {

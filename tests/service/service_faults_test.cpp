@@ -124,7 +124,10 @@ TEST_F(ServiceFaults, CoordinatorRestartResumesJobs) {
 TEST_F(ServiceFaults, SigtermMidJobRerunsAtTheNextStart) {
   start(2, {"--heartbeat-ms", "200"});
   const fs::path file = mesh("gmsh-aneurysm-20k.stl.gz");
-  const parapm::v1::JobOptions o = options(4, parapm::v1::METRIC_ENERGY, 0);
+  // Extra points make the rest of the job outlast the SIGTERM's delivery after the first
+  // subset is done (without them, under a loaded CI, it could finish first).
+  parapm::v1::JobOptions o = options(4, parapm::v1::METRIC_ENERGY, 0);
+  o.set_samples_per_face(2);
   const auto upload = service().upload_file(file);
   const auto submitted = service().submit(upload.mesh_id(), o);
   bool stopped = false;
