@@ -268,6 +268,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
   const uint64_t handover = std::max<uint64_t>(
       target, uint64_t(std::llround(parallel.handover_ratio * double(input_faces))));
   const std::vector<uint8_t> locked = locked_vertices(repaired);
+  // Above it, edges are costed when they reach the top of the queue (SimplifierLimits).
+  const uint64_t defer_line =
+      uint64_t(std::llround(kDeferRecostingAboveRatio * double(input_faces)));
 
   // The whole mesh and the master's metric, initialised once on the whole mesh (so that the
   // sample points are the sequential build's); every round's jobs take their part of its
@@ -378,11 +381,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
     });
     rs.asked_faces =
         set_targets(jobs, removable, rs.faces_before, rs.goal_faces, round_costs.cheap_fraction);
-    // Deferred re-costing as the sequential build has it at these face counts.
+    // Deferred re-costing as the sequential build has it at these face counts: in every round
+    // that ends at the line or above (by default the last scheduled round ends at it).
     for (SubsetJob& job : jobs)
-      job.options.defer_recosting =
-          options.defer_recosting &&
-          double(rs.goal_faces) >= kDeferRecostingAboveRatio * double(input_faces);
+      job.options.defer_recosting = options.defer_recosting && rs.goal_faces >= defer_line;
     if (parallel.water_level_factor > 0)
       for (SubsetJob& job : jobs)
         job.options.max_cost = job.options.max_cost > 0
@@ -510,9 +512,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   Simplifier final_pass(whole, *continued, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target;
-  if (options.defer_recosting)
-    limits.defer_above_faces =
-        size_t(std::llround(kDeferRecostingAboveRatio * double(input_faces)));
+  if (options.defer_recosting) limits.defer_above_faces = defer_line;
   const uint64_t done_before = input_faces - whole.live_faces();
   std::vector<CollapseRecord> final_records = final_pass.run(
       limits,
