@@ -21,7 +21,12 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   if (a > b) std::swap(a, b);
   CollapseCandidate candidate;
   ++stats_.evaluations;
-  if (!priority_.evaluate(mesh_, a, b, candidate, Costing::kQueue)) return false;
+  if (!priority_.evaluate(mesh_, a, b, candidate, Costing::kQueue)) {
+    // Refused (a job's subset rule or cost ceiling, locked ends): once its star changes it is
+    // deferred to the end of the queue, not costed at once to be refused again.
+    if (defer_) remember_key(a, b, std::numeric_limits<float>::infinity());
+    return false;
+  }
   entry = {static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]};
   if (defer_) remember_key(a, b, entry.cost);
   return true;
@@ -38,18 +43,19 @@ void Simplifier::remember_key(VertexId a, VertexId b, float key) {
 bool Simplifier::defer_edge(VertexId a, VertexId b) {
   if (a > b) std::swap(a, b);
   const EdgeFaces edge = mesh_.edge_faces(a, b);
-  float key = std::numeric_limits<float>::infinity();
+  float key = std::numeric_limits<float>::quiet_NaN();
   auto take = [&](FaceId f, VertexId from) {
     if (f == kNoId) return;
     const float k = face_keys_[3 * size_t(f) + corner_of(mesh_.face(f), from)];
-    if (!std::isnan(k)) key = std::min(key, k);
+    if (!std::isnan(k)) key = std::isnan(key) ? k : std::min(key, k);
   };
   take(edge.left, a);
   take(edge.right, b);
-  if (std::isinf(key)) return false;
+  if (std::isnan(key)) return false;
   // Below it: a collapse beside an edge mostly raises its cost (points move into its star),
-  // and an edge that comes out too early only costs one costing.
-  key -= 0.5f * std::abs(key);
+  // and an edge that comes out too early only costs one costing. A refused edge (infinite)
+  // comes out when nothing else is left.
+  if (!std::isinf(key)) key -= 0.5f * std::abs(key);
   heap_.push({key, a, b, (version_[a] + version_[b]) | kDeferred});
   ++stats_.deferred;
   return true;

@@ -43,8 +43,9 @@ struct SimplifierLimits {
   // Deferred re-costing, with a costly priority module: while more faces than this are live,
   // the edges around vs after a collapse are not costed at once. Each goes back into the queue
   // a little below its last key (the lower of its two faces' remembered keys, less half its
-  // magnitude) and is costed when it comes to the top, then queued again at its true key: most
-  // of them change again before they get there. Below it every one is costed at once, so the
+  // magnitude; at the end of the queue if the module refused it last time) and is costed when
+  // it comes to the top, then queued again at its true key: most of them change again before
+  // they get there. Below it every one is costed at once, so the
   // coarse levels, where one collapse out of order costs most, keep the exact order.
   // SIZE_MAX: never deferred. (Bunny: 402k costings -> 284k; docs/BENCHMARKS.md, "Deferred
   // re-costing".)
@@ -138,7 +139,8 @@ class Simplifier {
   std::unordered_map<uint64_t, std::pair<uint32_t, CollapseCandidate>> requeued_;
   std::vector<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
   bool defer_ = false;                     // costly() and a limit below SIZE_MAX
-  std::vector<float> face_keys_;           // 3 per face: the key of the edge from corner k; NaN
+  // 3 per face: the key of the edge from corner k; NaN: none yet, infinite: refused
+  std::vector<float> face_keys_;
   uint32_t collapses_ = 0;
   SimplifierStats stats_;
 };
