@@ -269,8 +269,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       target, uint64_t(std::llround(parallel.handover_ratio * double(input_faces))));
   const std::vector<uint8_t> locked = locked_vertices(repaired);
   // Above it, edges are costed when they reach the top of the queue (SimplifierLimits).
-  const uint64_t defer_line =
-      uint64_t(std::llround(kDeferRecostingAboveRatio * double(input_faces)));
+  const uint64_t defer_line = defer_recosting_line(input_faces);
 
   // The whole mesh and the master's metric, initialised once on the whole mesh (so that the
   // sample points are the sequential build's); every round's jobs take their part of its

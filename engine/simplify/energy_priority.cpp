@@ -477,6 +477,10 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
       const Projection p = prepared_[j].project(x);
       if (p.distance_sq < best.distance_sq) best = p, best_j = j;
     };
+    // A face whose plane is already farther than the best cannot win.
+    auto consider_near = [&](int j) {
+      if (prepared_[j].plane_distance_sq(x) <= best.distance_sq) consider(j);
+    };
     const int home = homes[i];
     if (home < 0) {
       // The sample of a (b), at a's old position: v moved away from it, towards the other
@@ -490,17 +494,12 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
         best_j = begin < end ? begin : 0;
       } else {
         if (begin == end) begin = 0, end = int(star_.size());
-        for (int j = begin; j < end; ++j)
-          if (prepared_[j].plane_distance_sq(x) <= best.distance_sq) consider(j);
+        for (int j = begin; j < end; ++j) consider_near(j);
       }
     } else {
       consider(home);
-      // A face beside it whose plane is already farther than the best cannot win.
-      auto beside = [&](int j) {
-        if (j >= 0 && prepared_[j].plane_distance_sq(x) <= best.distance_sq) consider(j);
-      };
-      beside(star_[home].next);
-      beside(star_[home].previous);
+      if (star_[home].next >= 0) consider_near(star_[home].next);
+      if (star_[home].previous >= 0) consider_near(star_[home].previous);
     }
     const StarFace* best_face = &star_[best_j];
     if (where) (*where)[i] = {best_j, best.bary};

@@ -32,25 +32,24 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   return true;
 }
 
-void Simplifier::remember_key(VertexId a, VertexId b, float key) {
+std::array<float*, 2> Simplifier::key_slots(VertexId a, VertexId b) {
   const EdgeFaces edge = mesh_.edge_faces(a, b);
-  if (edge.left != kNoId)
-    face_keys_[3 * size_t(edge.left) + corner_of(mesh_.face(edge.left), a)] = key;
-  if (edge.right != kNoId)
-    face_keys_[3 * size_t(edge.right) + corner_of(mesh_.face(edge.right), b)] = key;
+  auto slot = [&](FaceId f, VertexId from) {
+    return f == kNoId ? nullptr : &face_keys_[3 * size_t(f) + corner_of(mesh_.face(f), from)];
+  };
+  return {slot(edge.left, a), slot(edge.right, b)};
+}
+
+void Simplifier::remember_key(VertexId a, VertexId b, float key) {
+  for (float* slot : key_slots(a, b))
+    if (slot) *slot = key;
 }
 
 bool Simplifier::defer_edge(VertexId a, VertexId b) {
   if (a > b) std::swap(a, b);
-  const EdgeFaces edge = mesh_.edge_faces(a, b);
   float key = std::numeric_limits<float>::quiet_NaN();
-  auto take = [&](FaceId f, VertexId from) {
-    if (f == kNoId) return;
-    const float k = face_keys_[3 * size_t(f) + corner_of(mesh_.face(f), from)];
-    if (!std::isnan(k)) key = std::isnan(key) ? k : std::min(key, k);
-  };
-  take(edge.left, a);
-  take(edge.right, b);
+  for (const float* slot : key_slots(a, b))
+    if (slot && !std::isnan(*slot)) key = std::isnan(key) ? *slot : std::min(key, *slot);
   if (std::isnan(key)) return false;
   // Below it: a collapse beside an edge mostly raises its cost (points move into its star),
   // and an edge that comes out too early only costs one costing. A refused edge (infinite)

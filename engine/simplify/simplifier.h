@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -55,6 +56,11 @@ struct SimplifierLimits {
 // The sequential build defers re-costing down to this fraction of the input's faces (the
 // parallel build's default handover, so that its final pass costs at once, as this does).
 constexpr double kDeferRecostingAboveRatio = 0.1;
+
+// That fraction of `input_faces`, rounded: the one line both builds compare face counts with.
+inline size_t defer_recosting_line(uint64_t input_faces) {
+  return size_t(std::llround(kDeferRecostingAboveRatio * double(input_faces)));
+}
 
 struct SimplifierStats {
   uint64_t collapses = 0;
@@ -109,6 +115,8 @@ class Simplifier {
   // The key last computed for edge {a, b} stays with its faces (the two corners' slots of
   // face_keys_), through collapses that rename an end: the faces keep their ids and corners.
   void remember_key(VertexId a, VertexId b, float key);
+  // The two faces' slots of edge {a, b} in face_keys_ (null for a missing face).
+  std::array<float*, 2> key_slots(VertexId a, VertexId b);
   // Costs edge {a, b}; false when the module cannot place it.
   bool queue_entry(VertexId a, VertexId b, Entry& entry);
   // Pushes an edge vetoed before, whose star has changed since.

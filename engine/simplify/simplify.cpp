@@ -88,9 +88,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   Simplifier simplifier(working, *priority, standard_constraints(locked));
   SimplifierLimits limits;
   limits.target_faces = target_face_count(mesh.face_count(), options);
-  if (options.defer_recosting)
-    limits.defer_above_faces =
-        size_t(std::llround(kDeferRecostingAboveRatio * double(mesh.face_count())));
+  if (options.defer_recosting) limits.defer_above_faces = defer_recosting_line(mesh.face_count());
   const auto records = simplifier.run(limits, progress, cancel);
 
   PmBuildOptions build_options;
