@@ -55,6 +55,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"asked_faces", r.asked_faces},
                       {"faces_after", r.faces_after},
                       {"partition_seconds", r.partition_seconds},
+                      {"partition_overlap_seconds", r.partition_overlap_seconds},
                       {"extract_seconds", r.extract_seconds},
                       {"slowest_extract_cpu_seconds", r.slowest_extract_cpu_seconds},
                       {"extract_critical_seconds", r.extract_critical_seconds},
@@ -233,8 +234,9 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--rounds", args->rounds,
                   "With --parallel: parallel rounds, each on a new partition (the borders "
-                  "move); they take the mesh geometrically down to the handover")
-      ->check(CLI::Range(1, 64))
+                  "move); they take the mesh geometrically down to the handover (0: by P, 2 up "
+                  "to P = 4, 3 above)")
+      ->check(CLI::Range(0, 64))
       ->capture_default_str();
   cmd->add_option("--handover-ratio", args->handover,
                   "With --parallel: the rounds simplify the mesh down to this fraction of the "

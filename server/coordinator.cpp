@@ -390,8 +390,8 @@ void Coordinator::execute(JobRecord& record, Running& running,
     emit(job_id, event);
   }
   spdlog::info("job {} started (attempt {}): {} faces, p = {}, {} rounds, metric {}", job_id,
-               record.attempts, record.input_faces, spec.parallel.subsets, spec.parallel.rounds,
-               spec.simplify.metric);
+               record.attempts, record.input_faces, spec.parallel.subsets,
+               scheduled_rounds(spec.parallel), spec.simplify.metric);
 
   RemoteOptions remote;
   remote.job_id = job_id;

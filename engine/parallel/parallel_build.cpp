@@ -57,8 +57,9 @@ void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
   if (parallel.subsets > vertices)
     throw_invalid("the subset count p = " + std::to_string(parallel.subsets) +
                   " exceeds the vertex count " + std::to_string(vertices));
-  if (parallel.rounds < 1 || parallel.rounds > 64)
-    throw_invalid("parallel rounds must be in [1, 64], got " + std::to_string(parallel.rounds));
+  if (parallel.rounds > 64)
+    throw_invalid("parallel rounds must be in [1, 64] (0: by p), got " +
+                  std::to_string(parallel.rounds));
   if (!(parallel.handover_ratio > 0 && parallel.handover_ratio <= 1))
     throw_invalid("the handover ratio must be in (0, 1], got " +
                   std::to_string(parallel.handover_ratio));
@@ -245,6 +246,12 @@ std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
   return results;
 }
 
+uint32_t default_rounds(uint32_t p) { return p <= 2 ? 2 : 3; }
+
+uint32_t scheduled_rounds(const ParallelOptions& parallel) {
+  return parallel.rounds ? parallel.rounds : default_rounds(parallel.subsets);
+}
+
 ProgressiveMesh build_progressive_mesh_parallel(
     const RepairedMesh& repaired, const SimplifyOptions& options, const ParallelOptions& parallel,
     ParallelStats* stats, const ProgressCallback& progress, const CancelToken* cancel,
@@ -258,7 +265,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
   ParallelStats& st = stats ? *stats : local_stats;
   st = {};
   st.subsets = parallel.subsets;
-  st.rounds = parallel.rounds;
+  const uint32_t rounds = scheduled_rounds(parallel);
+  st.rounds = rounds;
   st.threads = pool_threads(parallel.threads, parallel.subsets);
   ThreadPoolRunner pool(parallel.threads);
   if (!runner) runner = &pool;
@@ -278,13 +286,39 @@ ProgressiveMesh build_progressive_mesh_parallel(
   auto t = std::chrono::steady_clock::now();
   CollapseMesh whole(mesh);
   std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
-  master->initialize(whole);
+  // The first round's partition needs the mesh only: it is drawn beside the master's
+  // initialisation (both read `whole`, neither through its marks; each writes its own data).
+  std::vector<uint32_t> first_partition;
+  double first_partition_seconds = 0, initialize_seconds = 0;
+  const bool first_round =
+      whole.live_vertices() >= 4 * size_t(parallel.subsets) && whole.live_faces() > handover;
+  auto initialize_master = [&] {
+    const auto ti = std::chrono::steady_clock::now();
+    master->initialize(whole);
+    initialize_seconds = seconds_since(ti);
+  };
+  auto partition_first_round = [&] {
+    const auto tp = std::chrono::steady_clock::now();
+    PartitionOptions partition_options;
+    partition_options.seed = round_seed(options.seed, 0);
+    first_partition = partition_live(whole, parallel.subsets, partition_options);
+    first_partition_seconds = seconds_since(tp);
+  };
+  const auto section = std::chrono::steady_clock::now();
+  if (first_round)
+    run_jobs(2, parallel.threads,
+             [&](size_t i) { i == 0 ? initialize_master() : partition_first_round(); });
+  else
+    initialize_master();
+  const double section_seconds = seconds_since(section);
   // The master's queue keys: the water level's sample, the jobs' keys after a round,
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
   KeyMemo keys(*master, whole.vertex_capacity());
   // Keys are worth carrying only where a costing costs more than remembering it (costly()).
   const bool carry_keys = parallel.carry_keys && master->costly();
-  st.setup_seconds = seconds_since(t);
+  // The setup's own time: the first partition is round 0's (which the critical path counts
+  // only where it outlasts the initialisation: RoundStats::partition_overlap_seconds).
+  st.setup_seconds = seconds_since(t) - section_seconds + initialize_seconds;
   st.critical_path_seconds = st.setup_seconds;
 
   SubsetOptions subset_options = subset_options_of(options, mesh);
@@ -297,21 +331,25 @@ ProgressiveMesh build_progressive_mesh_parallel(
   std::vector<CollapseRecord> records;
   std::vector<uint8_t> touched(whole.vertex_capacity(), 0);  // vs or vt of a collapse so far
   double subsets_cpu = 0;
-  // The scheduled rounds' ratio per round, which extra rounds past the handover keep.
-  const double step =
-      std::pow(double(handover) / double(input_faces), 1.0 / double(parallel.rounds));
+  // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
+  // if that is gentler: after two scheduled rounds (a ratio of 0.32 at the default handover),
+  // a round that left each subset the floor would have to start from 3 x the floor per subset,
+  // and the 203k dragon at p = 2 got none (a final pass of 18k collapses instead of 5k).
+  const double handover_ratio = double(handover) / double(input_faces);
+  const double step = std::max(std::pow(handover_ratio, 1.0 / double(rounds)),
+                               std::pow(handover_ratio, 1.0 / 3.0));
   for (uint32_t round = 0; round < 64; ++round) {
     RoundStats rs;
     rs.round = round;
     uint32_t subsets = parallel.subsets;  // of this round
     rs.faces_before = whole.live_faces();
     if (whole.live_vertices() < 4 * size_t(parallel.subsets)) break;
-    if (round < parallel.rounds) {
+    if (round < rounds) {
       if (rs.faces_before <= handover) break;
       // Geometric steps from the present face count to the handover.
-      rs.goal_faces = uint64_t(std::llround(double(rs.faces_before) *
-                                            std::pow(double(handover) / double(rs.faces_before),
-                                                     1.0 / double(parallel.rounds - round))));
+      rs.goal_faces = uint64_t(std::llround(
+          double(rs.faces_before) *
+          std::pow(double(handover) / double(rs.faces_before), 1.0 / double(rounds - round))));
     } else {
       // An extra round, if the last one's jobs did what they were asked (a mesh whose locked
       // parts stop it short gains nothing from more) and the subsets stay large enough that
@@ -339,10 +377,18 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // A new partition of the current mesh: the previous round's borders, whose vertices could
     // not move, are inside subsets now.
     t = std::chrono::steady_clock::now();
-    PartitionOptions partition_options;
-    partition_options.seed = round_seed(options.seed, round);
-    const std::vector<uint32_t> vertex_subset = partition_live(whole, subsets, partition_options);
-    rs.partition_seconds = seconds_since(t);
+    std::vector<uint32_t> vertex_subset;
+    if (round == 0) {
+      // Drawn during the setup (first_round holds: the checks above are the same).
+      vertex_subset = std::move(first_partition);
+      rs.partition_seconds = first_partition_seconds;
+      rs.partition_overlap_seconds = std::min(first_partition_seconds, initialize_seconds);
+    } else {
+      PartitionOptions partition_options;
+      partition_options.seed = round_seed(options.seed, round);
+      vertex_subset = partition_live(whole, subsets, partition_options);
+      rs.partition_seconds = seconds_since(t);
+    }
     if (events.partitioned) events.partitioned(round, subsets, rs.faces_before);
 
     // The jobs: which vertices each subset owns (sequential, O(vertices)), the water level
@@ -419,49 +465,49 @@ ProgressiveMesh build_progressive_mesh_parallel(
       rs.keys_reused += r.keys_reused;
     }
     std::vector<CollapseRecord> merged = merge_by_cost(std::move(lists));
+    // The records replay on the whole mesh; the jobs' states go into the master, and the
+    // round's water level, touched vertices and keys are taken from the records and results:
+    // disjoint data (the mesh; the module, the memo's own lists, `touched`), so with a second
+    // thread the replay runs beside the rest.
     ReplayReport replay;
-    if (parallel.replay_state) {
-      replay = replay_collapses(whole, merged, master.get());
-    } else {
-      // The records replay on the whole mesh and the jobs' states go into the master: disjoint
-      // data (the mesh, the module), so with a second thread they run side by side.
-      double replay_seconds = 0, import_seconds = 0;
-      auto import_states = [&] {
-        const auto ti = std::chrono::steady_clock::now();
+    double ceiling = 0;  // the round's water level: 95% of its collapses cost less
+    double replay_seconds = 0, bookkeeping_seconds = 0;
+    auto replay_records = [&] {
+      const auto tr = std::chrono::steady_clock::now();
+      replay = replay_collapses(whole, merged, parallel.replay_state ? master.get() : nullptr);
+      replay_seconds = seconds_since(tr);
+    };
+    auto bookkeeping = [&] {
+      const auto tb = std::chrono::steady_clock::now();
+      if (!parallel.replay_state)
         for (const SubsetResult& r : results) import_result_state(*master, r.state);
-        import_seconds = seconds_since(ti);
-      };
-      auto replay_records = [&] {
-        const auto tr = std::chrono::steady_clock::now();
-        replay = replay_collapses(whole, merged, nullptr);
-        replay_seconds = seconds_since(tr);
-      };
-      const bool side_by_side = pool_threads(parallel.threads, 2) >= 2;
-      if (side_by_side) {
-        run_jobs(2, 2, [&](size_t i) { i == 0 ? replay_records() : import_states(); });
-      } else {
-        replay_records();
-        import_states();
-        // With a core to spare (as the critical path assumes), they would overlap.
-        rs.merge_overlap_seconds = std::min(replay_seconds, import_seconds);
+      if (!merged.empty()) {
+        std::vector<double> costs;
+        costs.reserve(merged.size());
+        for (const CollapseRecord& r : merged) costs.push_back(r.cost);
+        const size_t k = costs.size() * 95 / 100;
+        std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
+        ceiling = costs[k];
       }
+      for (const CollapseRecord& r : merged) touched[r.vs] = touched[r.vt] = 1;
+      // The jobs' keys are current on the master (edge_keys.h). (The replay does not tell the
+      // memo of its collapses: the keys stay current whichever runs first.)
+      std::vector<EdgeKey> returned;
+      if (carry_keys)
+        for (SubsetResult& r : results)
+          returned.insert(returned.end(), r.keys.begin(), r.keys.end());
+      keys.reset(returned);
+      bookkeeping_seconds = seconds_since(tb);
+    };
+    // (With replay_state the replay drives the master: the import is left out.)
+    if (pool_threads(parallel.threads, 2) >= 2) {
+      run_jobs(2, 2, [&](size_t i) { i == 0 ? replay_records() : bookkeeping(); });
+    } else {
+      replay_records();
+      bookkeeping();
+      // With a core to spare (as the critical path assumes), they would overlap.
+      rs.merge_overlap_seconds = std::min(replay_seconds, bookkeeping_seconds);
     }
-    // The water level of the round: 95% of its collapses cost less.
-    double ceiling = 0;
-    if (!merged.empty()) {
-      std::vector<double> costs;
-      costs.reserve(merged.size());
-      for (const CollapseRecord& r : merged) costs.push_back(r.cost);
-      const size_t k = costs.size() * 95 / 100;
-      std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
-      ceiling = costs[k];
-    }
-    for (const CollapseRecord& r : merged) touched[r.vs] = touched[r.vt] = 1;
-    // The jobs' keys are current on the master (edge_keys.h).
-    std::vector<EdgeKey> returned;
-    if (carry_keys)
-      for (SubsetResult& r : results) returned.insert(returned.end(), r.keys.begin(), r.keys.end());
-    keys.reset(returned);
     records.insert(records.end(), std::make_move_iterator(merged.begin()),
                    std::make_move_iterator(merged.end()));
     rs.merge_seconds = seconds_since(t);
@@ -483,9 +529,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
     }
     rs.band_pass_seconds = seconds_since(t);
     rs.faces_after = whole.live_faces();
-    st.critical_path_seconds += rs.partition_seconds + rs.extract_critical_seconds +
-                                rs.slowest_subset_cpu_seconds + rs.merge_seconds -
-                                rs.merge_overlap_seconds + rs.band_pass_seconds;
+    st.critical_path_seconds += rs.partition_seconds - rs.partition_overlap_seconds +
+                                rs.extract_critical_seconds + rs.slowest_subset_cpu_seconds +
+                                rs.merge_seconds - rs.merge_overlap_seconds + rs.band_pass_seconds;
     spdlog::debug(
         "parallel round {}: {} subsets {}->{} faces (goal {}), partition {:.3f} s, extract "
         "{:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} replayed), band "

@@ -23,8 +23,9 @@ namespace parapm {
 struct ParallelOptions {
   uint32_t subsets = 2;  // p, in [1, 256]
   // Parallel rounds, in [1, 64], each on a new partition of the current mesh (the borders
-  // move), with the metric's state travelling in the jobs (job_state.h).
-  uint32_t rounds = 3;
+  // move), with the metric's state travelling in the jobs (job_state.h); 0: by p
+  // (default_rounds).
+  uint32_t rounds = 0;
   unsigned threads = 0;  // 0: min(p, hardware threads)
   // The rounds take the mesh from F faces down to max(target, handover_ratio x F) faces,
   // geometrically (round r of R aims at F x ratio^((r + 1) / R)); the final pass, sequential
@@ -82,6 +83,9 @@ struct RoundStats {
   uint64_t asked_faces = 0;
   uint64_t faces_after = 0;
   double partition_seconds = 0;
+  // Round 0's partition is drawn beside the master's initialisation: the shorter of the two,
+  // which the critical path leaves out.
+  double partition_overlap_seconds = 0;
   double extract_seconds = 0;  // jobs and their state, shares included (wall)
   double share_seconds = 0;    // of which costing the edge sample (water level, shares)
   // Each job's mesh and state are built on the pool: the slowest one's CPU, and the
@@ -90,9 +94,9 @@ struct RoundStats {
   double extract_critical_seconds = 0;
   double water_level = 0;      // the jobs' cost ceiling (ParallelOptions::water_level_factor)
   double subsets_seconds = 0;  // wall time of the round's jobs
-  double merge_seconds = 0;    // k-way merge, replay on the whole mesh, state import
-  // Replay and state import run side by side on two threads; on one thread (--threads 1),
-  // the shorter of the two, which the critical path leaves out.
+  double merge_seconds = 0;    // k-way merge, replay on the whole mesh, state import, keys
+  // The replay runs beside the rest (state import, water level, keys) on two threads; on one
+  // thread (--threads 1), the shorter of the two, which the critical path leaves out.
   double merge_overlap_seconds = 0;
   double slowest_subset_cpu_seconds = 0;
   uint64_t keys_carried = 0;         // queue keys given to the jobs (edge_keys.h)
@@ -153,12 +157,23 @@ struct ParallelEvents {
   std::function<void(uint64_t collapses, double seconds)> final_pass_done;
 };
 
+// The rounds of ParallelOptions::rounds = 0: two at p = 2, three above. Fewer, larger rounds
+// leave fewer cuts to mend and less fixed work per round (partition, extraction, merge, band
+// pass); with more subsets a round's shares follow the sequential order less closely the more
+// it removes. 18 meshes, energy, RMS against the sequential PM at 50 / 10 / 2%: p = 2 two
+// rounds 1.011 / 0.996 / 0.996, three 1.028 / 1.017 / 1.061; p = 4 1.013 / 1.003 / 0.986
+// against 1.019 / 0.990 / 1.031, with the textured bunny's 50% level worse at two; p = 16 two
+// rounds 1.105 at 50%, three 1.034 (docs/BENCHMARKS.md, "Two rounds at p = 2").
+uint32_t default_rounds(uint32_t p);
+// The rounds a build with these options schedules: `rounds`, or default_rounds(subsets).
+uint32_t scheduled_rounds(const ParallelOptions& parallel);
+
 // Same contract as build_progressive_mesh (simplify.h), whose options it takes; the result is
 // a valid, lossless PM reaching the same target. Deterministic: the same input, options, p
 // and rounds give the same PM whatever the thread count, timing and `runner` (null: a
 // ThreadPoolRunner of parallel.threads). Throws
 // Error(kInvalidInput) for bad options (p outside [1, 256] or above the vertex count, rounds
-// outside [1, 64], handover_ratio outside (0, 1]).
+// above 64, handover_ratio outside (0, 1]).
 ProgressiveMesh build_progressive_mesh_parallel(
     const RepairedMesh& repaired, const SimplifyOptions& options, const ParallelOptions& parallel,
     ParallelStats* stats = nullptr, const ProgressCallback& progress = {},

@@ -236,7 +236,7 @@ TEST(ParallelBuild, TargetFaceCountIsReached) {
   }
 }
 
-// Three rounds (the default), each on its own partition, with the state travelling.
+// Three rounds, each on its own partition, with the state travelling.
 TEST(ParallelBuild, SameBytesWhateverTheThreadCount) {
   const RepairedMesh repaired = testing::repaired_test_mesh("pymeshlab-colored-airplane-11k.ply");
   for (const char* metric : {"quadric", "energy"}) {
@@ -374,9 +374,25 @@ TEST(ParallelBuild, BadOptionsAreErrors) {
   ParallelOptions handover = with_p(2);
   handover.handover_ratio = 0;
   EXPECT_THROW(build_progressive_mesh_parallel(repaired, {}, handover), Error);
-  EXPECT_THROW(build_progressive_mesh_parallel(repaired, {}, with_p(2, 0, 0)), Error);
   EXPECT_THROW(build_progressive_mesh_parallel(repaired, {}, with_p(2, 0, 65)), Error);
   EXPECT_THROW(build_progressive_mesh_parallel(repaired, metric_options("nope"), with_p(2)), Error);
+}
+
+// Rounds 0 (the default) schedules them by p: two at p = 2, three above (default_rounds).
+TEST(ParallelBuild, DefaultRoundsFollowP) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
+  for (uint32_t p : {2u, 4u}) {
+    ParallelOptions parallel = with_p(p, 0, /*rounds=*/0);
+    parallel.extra_round_subset_faces = 0;  // the scheduled rounds only
+    ParallelStats stats;
+    const ProgressiveMesh pm = build_progressive_mesh_parallel(
+        repaired, metric_options("quadric", 0.05), parallel, &stats);
+    EXPECT_EQ(stats.rounds, p == 2 ? 2u : 3u) << "p = " << p;
+    EXPECT_EQ(stats.rounds, default_rounds(p));
+    const MeshDifference diff =
+        compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
+    EXPECT_TRUE(diff.equal) << "p = " << p << ": " << diff.first_difference;
+  }
 }
 
 }  // namespace
