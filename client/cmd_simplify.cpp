@@ -234,8 +234,8 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--rounds", args->rounds,
                   "With --parallel: parallel rounds, each on a new partition (the borders "
-                  "move); they take the mesh geometrically down to the handover (0: by P, 2 up "
-                  "to P = 4, 3 above)")
+                  "move); they take the mesh geometrically down to the handover (0: by P, 2 at "
+                  "P = 2, 3 above)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
   cmd->add_option("--handover-ratio", args->handover,

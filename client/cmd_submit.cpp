@@ -138,7 +138,7 @@ void add_submit_command(CLI::App& app, int& exit_code) {
                   "subsets p (default: the coordinator's --parallelism)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--rounds", args->rounds,
-                  "parallel rounds (0, the default: by p, 2 up to p = 4, 3 above)")
+                  "parallel rounds (0, the default: by p, 2 at p = 2, 3 above)")
       ->check(CLI::Range(0, 64));
   cmd->add_option("--handover-ratio", args->handover,
                   "the rounds go down to this fraction of the input faces (default 0.1)")

@@ -333,11 +333,11 @@ ProgressiveMesh build_progressive_mesh_parallel(
   double subsets_cpu = 0;
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
   // if that is gentler: after two scheduled rounds (a ratio of 0.32 at the default handover),
-  // a round that left each subset the floor would have to start from 3 x the floor per subset,
-  // and the 203k dragon at p = 2 got none (a final pass of 18k collapses instead of 5k).
+  // an extra round would need 3.2 x the floor per subset to start, and the 203k dragon at p = 2
+  // got none (a final pass of 18k collapses instead of 7k).
   const double handover_ratio = double(handover) / double(input_faces);
-  const double step = std::max(std::pow(handover_ratio, 1.0 / double(rounds)),
-                               std::pow(handover_ratio, 1.0 / 3.0));
+  const double step =
+      std::max(std::pow(handover_ratio, 1.0 / double(rounds)), std::pow(handover_ratio, 1.0 / 3.0));
   for (uint32_t round = 0; round < 64; ++round) {
     RoundStats rs;
     rs.round = round;
