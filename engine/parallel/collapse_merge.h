@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "simplify/collapse_mesh.h"
@@ -20,6 +21,7 @@ std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord
 
 struct ReplayReport {
   uint64_t collapses = 0;
+  double slowest_seconds = 0;  // replay_subsets: the longest subset's replay
   // Records whose wedge changes differ from those `priority` computed on the whole mesh (the
   // module's state then differs from the subset's: extra random points drawn per subset).
   uint64_t attribute_mismatches = 0;
@@ -33,5 +35,20 @@ struct ReplayReport {
 // are kept.
 ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseRecord>& records,
                               PriorityModule* priority);
+
+// Performs each subset's records (lists[s], in its order) on `mesh`, the subsets side by side
+// on up to `threads` threads (0: the hardware's), with `beside`, if given, as one more task
+// beside them. By the subset rule (subset_rule.h) a subset's collapses read and change only
+// its own vertices' face lists, its own faces and the mixed faces no collapse changes: the
+// mesh ends exactly as replay_collapses of any merge of the lists (merge_by_cost) leaves it,
+// whatever the threads. Each record is checked as replay_collapses checks it, after the rule
+// itself on the present mesh (vs, vt and all their neighbours owned by subset s in
+// `vertex_subset`, one entry per vertex of the mesh) and before anything of it is changed: a
+// job that broke the rule is refused (Error(kInvalidInput)), not raced. The mesh is left
+// partly replayed then.
+ReplayReport replay_subsets(CollapseMesh& mesh,
+                            const std::vector<std::vector<CollapseRecord>>& lists,
+                            const std::vector<uint32_t>& vertex_subset, unsigned threads,
+                            const std::function<void()>& beside = {});
 
 }  // namespace parapm

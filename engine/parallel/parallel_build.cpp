@@ -464,32 +464,29 @@ ProgressiveMesh build_progressive_mesh_parallel(
       lists.push_back(std::move(r.records));
       rs.keys_reused += r.keys_reused;
     }
-    std::vector<CollapseRecord> merged = merge_by_cost(std::move(lists));
-    // The records replay on the whole mesh; the jobs' states go into the master, and the
-    // round's water level, touched vertices and keys are taken from the records and results:
-    // disjoint data (the mesh; the module, the memo's own lists, `touched`), so with a second
-    // thread the replay runs beside the rest.
+    // The subsets' records replay on the whole mesh, side by side (replay_subsets: by the
+    // subset rule they change disjoint parts of it, and the mesh ends as a merged replay
+    // leaves it); beside them, the jobs' states go into the master, and the round's water
+    // level, touched vertices and keys are taken from the records and results (the module,
+    // the memo's own lists, `touched`: data the replay does not touch).
     ReplayReport replay;
     double ceiling = 0;  // the round's water level: 95% of its collapses cost less
-    double replay_seconds = 0, bookkeeping_seconds = 0;
-    auto replay_records = [&] {
-      const auto tr = std::chrono::steady_clock::now();
-      replay = replay_collapses(whole, merged, parallel.replay_state ? master.get() : nullptr);
-      replay_seconds = seconds_since(tr);
-    };
+    double bookkeeping_seconds = 0;
     auto bookkeeping = [&] {
       const auto tb = std::chrono::steady_clock::now();
       if (!parallel.replay_state)
         for (const SubsetResult& r : results) import_result_state(*master, r.state);
-      if (!merged.empty()) {
-        std::vector<double> costs;
-        costs.reserve(merged.size());
-        for (const CollapseRecord& r : merged) costs.push_back(r.cost);
+      std::vector<double> costs;
+      for (const std::vector<CollapseRecord>& list : lists)
+        for (const CollapseRecord& r : list) {
+          costs.push_back(r.cost);
+          touched[r.vs] = touched[r.vt] = 1;
+        }
+      if (!costs.empty()) {
         const size_t k = costs.size() * 95 / 100;
         std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
         ceiling = costs[k];
       }
-      for (const CollapseRecord& r : merged) touched[r.vs] = touched[r.vt] = 1;
       // The jobs' keys are current on the master (edge_keys.h). (The replay does not tell the
       // memo of its collapses: the keys stay current whichever runs first.)
       std::vector<EdgeKey> returned;
@@ -499,14 +496,20 @@ ProgressiveMesh build_progressive_mesh_parallel(
       keys.reset(returned);
       bookkeeping_seconds = seconds_since(tb);
     };
-    // (With replay_state the replay drives the master: the import is left out.)
-    if (pool_threads(parallel.threads, 2) >= 2) {
-      run_jobs(2, 2, [&](size_t i) { i == 0 ? replay_records() : bookkeeping(); });
-    } else {
-      replay_records();
+    std::vector<CollapseRecord> merged;
+    if (parallel.replay_state) {
+      // Tests only: the merged sequence drives the master's module, one collapse at a time.
+      merged = merge_by_cost(lists);
+      replay = replay_collapses(whole, merged, master.get());
       bookkeeping();
-      // With a core to spare (as the critical path assumes), they would overlap.
-      rs.merge_overlap_seconds = std::min(replay_seconds, bookkeeping_seconds);
+    } else {
+      const auto tr = std::chrono::steady_clock::now();
+      replay = replay_subsets(whole, lists, vertex_subset, parallel.threads, bookkeeping);
+      // With a core per subset (as the critical path assumes), the slowest subset's replay or
+      // the bookkeeping, whichever is longer.
+      rs.merge_overlap_seconds =
+          std::max(0.0, seconds_since(tr) - std::max(replay.slowest_seconds, bookkeeping_seconds));
+      merged = merge_by_cost(std::move(lists));
     }
     records.insert(records.end(), std::make_move_iterator(merged.begin()),
                    std::make_move_iterator(merged.end()));

@@ -94,9 +94,10 @@ struct RoundStats {
   double extract_critical_seconds = 0;
   double water_level = 0;      // the jobs' cost ceiling (ParallelOptions::water_level_factor)
   double subsets_seconds = 0;  // wall time of the round's jobs
-  double merge_seconds = 0;    // k-way merge, replay on the whole mesh, state import, keys
-  // The replay runs beside the rest (state import, water level, keys) on two threads; on one
-  // thread (--threads 1), the shorter of the two, which the critical path leaves out.
+  double merge_seconds = 0;    // replay on the whole mesh, state import, keys, k-way merge
+  // The subsets' replays run side by side, and beside the rest (state import, water level,
+  // keys), on the pool's threads: what of it would overlap with a core per task (the critical
+  // path leaves it out).
   double merge_overlap_seconds = 0;
   double slowest_subset_cpu_seconds = 0;
   uint64_t keys_carried = 0;         // queue keys given to the jobs (edge_keys.h)

@@ -91,12 +91,18 @@ void CollapseMesh::remove_face_from(VertexId v, FaceId f) {
   list.pop_back();
 }
 
+void CollapseMesh::count_removed(const RemovedCounts& removed) {
+  live_faces_ -= removed.faces;
+  live_vertices_ -= removed.vertices;
+}
+
 void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
-                            const EdgeFaces& removed) {
+                            const EdgeFaces& removed, RemovedCounts* counted) {
+  RemovedCounts here;
   for (FaceId f : {removed.left, removed.right}) {
     if (f == kNoId) continue;
     face_alive_[f] = 0;
-    --live_faces_;
+    ++here.faces;
     for (VertexId v : faces_[f]) remove_face_from(v, f);
   }
   auto& moved = faces_of_[vt];
@@ -108,14 +114,20 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
   moved.clear();
   moved.shrink_to_fit();
   vertex_alive_[vt] = 0;
-  --live_vertices_;
+  ++here.vertices;
   // An apex whose only face was removed is gone too (legal collapses never do this: the
   // component minimum keeps a lone triangle; kept for the invariant alive == has faces).
   for (VertexId apex : {removed.left_apex, removed.right_apex})
     if (apex != kNoId && vertex_alive_[apex] && faces_of_[apex].empty()) {
       vertex_alive_[apex] = 0;
-      --live_vertices_;
+      ++here.vertices;
     }
+  if (counted) {
+    counted->faces += here.faces;
+    counted->vertices += here.vertices;
+  } else {
+    count_removed(here);
+  }
   positions_[vs] = position;
   boundary_[vt] = 0;
   // A legal collapse changes the boundary status of vs and of the apexes only.

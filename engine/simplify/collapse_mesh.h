@@ -64,7 +64,15 @@ class CollapseMesh {
 
   // Merges vt into vs, moves vs to `position`, removes the faces on the edge: `edge` must be
   // edge_faces(vs, vt) of the present mesh (the caller computed it to check legality).
-  void collapse(VertexId vs, VertexId vt, const Vec3& position, const EdgeFaces& edge);
+  // Collapses of disjoint regions may run concurrently (parallel/collapse_merge.h) if each
+  // counts the live faces and vertices it removes in its own `removed` instead of the mesh's
+  // counts, added afterwards with count_removed.
+  struct RemovedCounts {
+    size_t faces = 0, vertices = 0;
+  };
+  void collapse(VertexId vs, VertexId vt, const Vec3& position, const EdgeFaces& edge,
+                RemovedCounts* removed = nullptr);
+  void count_removed(const RemovedCounts& removed);
 
  private:
   void remove_face_from(VertexId v, FaceId f);

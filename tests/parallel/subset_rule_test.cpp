@@ -190,6 +190,87 @@ TEST(SubsetRule, InterleavingsReplayAndCommuteEnergy) {
   expect_interleavings_commute("stratocaster-9k.ply", "energy", 2);
 }
 
+// The subsets replayed side by side (replay_subsets) end in the mesh a merged replay leaves,
+// down to every vertex's face list in its order, whatever the thread count; real meshes, both
+// metrics.
+void expect_side_by_side_replay_is_the_merged_one(const std::string& name,
+                                                  const std::string& metric, uint32_t p) {
+  const Round round = run_round(name, metric, p);
+  CollapseMesh merged(round.repaired.mesh);
+  replay_collapses(merged, merge_by_cost(lists_of(round)), nullptr);
+  for (unsigned threads : {1u, 2u, 4u}) {
+    CollapseMesh side(round.repaired.mesh);
+    bool ran_beside = false;
+    const ReplayReport report = replay_subsets(side, lists_of(round), round.partition.vertex_subset,
+                                               threads, [&] { ran_beside = true; });
+    EXPECT_TRUE(ran_beside);
+    size_t records = 0;
+    for (const SubsetResult& r : round.results) records += r.records.size();
+    EXPECT_EQ(report.collapses, records);
+    EXPECT_EQ(side.live_faces(), merged.live_faces()) << name << " threads " << threads;
+    EXPECT_EQ(side.live_vertices(), merged.live_vertices()) << name << " threads " << threads;
+    EXPECT_EQ(live_faces(side), live_faces(merged)) << name << " threads " << threads;
+    EXPECT_EQ(side.positions(), merged.positions()) << name << " threads " << threads;
+    for (VertexId v = 0; v < side.vertex_capacity(); ++v) {
+      ASSERT_EQ(side.faces_of(v), merged.faces_of(v)) << name << " vertex " << v;
+      ASSERT_EQ(side.is_boundary(v), merged.is_boundary(v)) << name << " vertex " << v;
+    }
+  }
+}
+
+TEST(SubsetRule, SideBySideReplayIsTheMergedReplay) {
+  expect_side_by_side_replay_is_the_merged_one("cad-cycloidal-43k.ply", "quadric", 4);
+  expect_side_by_side_replay_is_the_merged_one("pymeshlab-colored-airplane-11k.ply", "energy", 3);
+}
+
+// A record that breaks the rule (here: subset 0 names an edge of subset 1, which subset 1's
+// own thread may be changing) is refused before the mesh is read around it.
+TEST(SubsetRule, SideBySideReplayRefusesARecordOfAnotherSubset) {
+  const Round round = run_round("stratocaster-9k.ply", "quadric", 2);
+  std::vector<std::vector<CollapseRecord>> lists = lists_of(round);
+  ASSERT_FALSE(lists[1].empty());
+  lists[0].insert(lists[0].begin(), lists[1].front());
+  CollapseMesh whole(round.repaired.mesh);
+  try {
+    replay_subsets(whole, lists, round.partition.vertex_subset, 2);
+    ADD_FAILURE() << "a record of subset 1 replayed as subset 0's";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
+    EXPECT_NE(std::string(e.what()).find("does not own"), std::string::npos) << e.what();
+  }
+  // And an edge of subset 0 next to subset 1 (its border), which the jobs never collapse.
+  const Mesh& mesh = round.repaired.mesh;
+  const std::vector<uint32_t>& subset = round.partition.vertex_subset;
+  CollapseRecord border;
+  bool found = false;
+  for (FaceId f = 0; f < mesh.face_count() && !found; ++f) {
+    const Triangle& t = mesh.faces[f];
+    for (int k = 0; k < 3 && !found; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
+      if (subset[a] == 0 && subset[b] == 0 && subset[c] == 1) {
+        CollapseMesh fresh(mesh);
+        const EdgeFaces edge = fresh.edge_faces(a, b);
+        border.vs = a;
+        border.vt = b;
+        border.fl = edge.left;
+        border.fr = edge.right;
+        border.vl = edge.left_apex;
+        border.vr = edge.right_apex;
+        border.position = mesh.positions[a];
+        found = true;
+      }
+    }
+  }
+  ASSERT_TRUE(found);
+  CollapseMesh again(mesh);
+  try {
+    replay_subsets(again, {{border}, {}}, subset, 2);
+    ADD_FAILURE() << "a border edge replayed";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("subset rule"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SubsetRule, ABrokenOrderIsCaughtByTheReplay) {
   const Round round = run_round("stratocaster-9k.ply", "quadric", 2);
   std::vector<CollapseRecord> records = round.results[0].records;
