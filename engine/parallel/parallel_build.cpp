@@ -329,6 +329,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
                               subset_options.reference_diagonal * subset_options.reference_diagonal;
 
   std::vector<CollapseRecord> records;
+  // At most one collapse per vertex: no round's records move the earlier ones (growing by
+  // doubling moved the 871k dragon's first 190k records at round 1's merge, 0.2 s).
+  records.reserve(whole.live_vertices());
   std::vector<uint8_t> touched(whole.vertex_capacity(), 0);  // vs or vt of a collapse so far
   double subsets_cpu = 0;
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
