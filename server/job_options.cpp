@@ -62,7 +62,7 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
   p.subsets = options.parallelism() ? options.parallelism() : default_parallelism;
   require(p.subsets >= 1 && p.subsets <= 256,
           "parallelism must be in [1, 256], got " + std::to_string(p.subsets));
-  if (options.rounds()) p.rounds = options.rounds();
+  p.rounds = options.rounds();  // 0 in both: by p
   require(p.rounds <= 64, "rounds must be in [1, 64] (0: by p), got " + std::to_string(p.rounds));
   if (options.handover_ratio() != 0) p.handover_ratio = options.handover_ratio();
   require(std::isfinite(p.handover_ratio) && p.handover_ratio > 0 && p.handover_ratio <= 1,

@@ -381,8 +381,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // not move, are inside subsets now.
     t = std::chrono::steady_clock::now();
     std::vector<uint32_t> vertex_subset;
-    if (round == 0) {
-      // Drawn during the setup (first_round holds: the checks above are the same).
+    if (round == 0 && first_round) {
+      // Drawn during the setup (whose first_round repeats the checks above).
       vertex_subset = std::move(first_partition);
       rs.partition_seconds = first_partition_seconds;
       rs.partition_overlap_seconds = std::min(first_partition_seconds, initialize_seconds);
