@@ -153,7 +153,8 @@ void add_submit_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0.0, 64.0));
   // Above 0: the API reads 0 as "the default" (60).
   cmd->add_option("--crease-angle", args->crease_angle,
-                  "energy: crease angle, degrees, in (0, 180]")
+                  "energy: crease angle, degrees, in (0, 180] (creases of fewer than 8 edges and "
+                  "shorter than 5% of the diagonal are noise, not kept)")
       ->check(CLI::Range(1e-6, 180.0))
       ->capture_default_str();
   cmd->add_option("--attribute-weight", args->attribute_weight,

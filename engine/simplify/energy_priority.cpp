@@ -32,6 +32,24 @@ bool has_plane(double n_sq, const Vec3& q0, const Vec3& q1, const Vec3& q2) {
   return n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0;
 }
 
+// The solution of A x = -b for q's symmetric A, by cofactors: for a positive definite A (the
+// solves add a positive multiple of the identity), with no conditioning threshold.
+bool solve_positive_definite(const Quadric& q, Vec3& out) {
+  const double c00 = q.a11 * q.a22 - q.a12 * q.a12;
+  const double c01 = q.a02 * q.a12 - q.a01 * q.a22;
+  const double c02 = q.a01 * q.a12 - q.a02 * q.a11;
+  const double det = q.a00 * c00 + q.a01 * c01 + q.a02 * c02;
+  if (!(det > 0)) return false;
+  const double c11 = q.a00 * q.a22 - q.a02 * q.a02;
+  const double c12 = q.a01 * q.a02 - q.a00 * q.a12;
+  const double c22 = q.a00 * q.a11 - q.a01 * q.a01;
+  const double inv = 1.0 / det;
+  out[0] = -(c00 * q.b0 + c01 * q.b1 + c02 * q.b2) * inv;
+  out[1] = -(c01 * q.b0 + c11 * q.b1 + c12 * q.b2) * inv;
+  out[2] = -(c02 * q.b0 + c12 * q.b1 + c22 * q.b2) * inv;
+  return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
+}
+
 Vec3 rounded(Vec3 v, bool to_float) {
   if (to_float)
     for (double& c : v) c = round_to_float(c);
@@ -432,15 +450,40 @@ Vec3 EnergyPriority::moment_solve(const Vec3& from, double iso_a, const Vec3& is
     if (edge_faces_[e] != kNoId)
       add_face(edge_faces_[e], star_[edge_face_homes_[e]].p1, star_[edge_face_homes_[e]].p2);
   if (!parked_ends_.empty()) planes.ends = project_points(parked_ends_, parked_end_homes_, from);
-  const Eigen::Matrix3d h = planes.h + Eigen::Matrix3d::Identity() * (iso_a + planes.ends.a);
-  const Eigen::Vector3d r =
+  Eigen::Matrix3d h = planes.h + Eigen::Matrix3d::Identity() * (iso_a + planes.ends.a);
+  Eigen::Vector3d r =
       planes.r + Eigen::Vector3d(iso_b[0] + planes.ends.b[0], iso_b[1] + planes.ends.b[1],
                                  iso_b[2] + planes.ends.b[2]);
+  if (star_terms_on_) {
+    const Quadric& q = star_terms_;
+    h(0, 0) += q.a00, h(1, 1) += q.a11, h(2, 2) += q.a22;
+    h(0, 1) += q.a01, h(1, 0) += q.a01, h(0, 2) += q.a02, h(2, 0) += q.a02;
+    h(1, 2) += q.a12, h(2, 1) += q.a12;
+    r -= Eigen::Vector3d(q.b0, q.b1, q.b2);
+  }
   if (model) *model = planes;
   const Eigen::LDLT<Eigen::Matrix3d> solver(h);
   const Eigen::Vector3d v = solver.solve(r);
   if (solver.info() != Eigen::Success || !v.allFinite()) return from;
   return {v[0], v[1], v[2]};
+}
+
+// The minimiser of the projected points' model (fit), iso_a |v|^2 - 2 iso_b.v (the springs'
+// and the curves' terms) and the star's terms; `from` when there is none.
+Vec3 EnergyPriority::projection_solve(const Fit& fit, double iso_a, const Vec3& iso_b,
+                                      const Vec3& from) const {
+  const double diagonal = fit.a + iso_a;
+  if (!(diagonal > 0)) return from;
+  const Vec3 pull = add(fit.b, iso_b);
+  if (star_terms_on_) {
+    Quadric q = star_terms_;
+    q.a00 += diagonal, q.a11 += diagonal, q.a22 += diagonal;
+    q.b0 -= pull[0], q.b1 -= pull[1], q.b2 -= pull[2];
+    Vec3 v;
+    if (solve_positive_definite(q, v)) return v;
+  }
+  // Without the star's terms the model is isotropic: a scalar times the identity.
+  return scale(pull, 1.0 / diagonal);
 }
 
 double EnergyPriority::exact_distance_sq() const {
@@ -575,6 +618,12 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   edge_faces_ = {kNoId, kNoId};
   joined_count_ = 0;
   double spring_before = 0;
+  // The star's planes before the collapse (area weighted), the sum of its faces' normals and
+  // of normal.corner (the tetrahedra between v and the faces have signed volumes summing to
+  // (normals.v - offsets) / 6), and twice its area.
+  Quadric star_planes;
+  Vec3 normals{};
+  double offsets = 0, area2 = 0;
   for (VertexId end : {a, b}) {
     if (end == b) a_side_faces_ = int(star_.size());
     const VertexId other = end == a ? b : a;
@@ -587,6 +636,16 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       const Vec3& p1 = mesh.position(t[(k + 1) % 3]);
       const Vec3& p2 = mesh.position(t[(k + 2) % 3]);
       spring_before += half_edges_sq(p0, p1, p2);
+      if (star_terms_on_) {
+        const Vec3 n = triangle_normal(p0, p1, p2);
+        const double n_length = length(n);
+        const double offset = dot(n, p0);
+        normals = add(normals, n);
+        offsets += offset;
+        area2 += n_length;
+        if (n_length > 0)
+          star_planes += Quadric::from_plane(scale(n, 1 / n_length), -offset / n_length, n_length);
+      }
       if (other_corner >= 0) {
         if (edge_faces < 2) {
           edge_apexes[edge_faces] = t[3 - k - other_corner];
@@ -696,6 +755,26 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   for (const StarFace& f : star_) spring_pull = add(spring_pull, add(f.p1, f.p2));
   spring_pull = scale(spring_pull, 0.5 * kappa);
   const double spring_weight = kappa * double(star_.size());
+  if (star_terms_on_) {
+    // Points spread at density rho = points / area over a face of the star, v moving by h off
+    // its plane, are moved by h times their barycentric coordinate of v: rho area h^2 / 6 in
+    // all. The volume's change over the star's area is a mean displacement of
+    // (normals.v - offsets) / (3 area2), for all the star's points.
+    const double points = std::max(1.0, points_around);
+    star_terms_ = Quadric{};
+    if (area2 > 0 && options_.star_planes_weight > 0) {
+      star_planes *= options_.star_planes_weight * points / (6 * area2);
+      star_terms_ += star_planes;
+    }
+    const double normals_length = length(normals);
+    if (area2 > 0 && normals_length > 0 && options_.volume_weight > 0) {
+      Quadric volume =
+          Quadric::from_plane(scale(normals, 1 / normals_length), -offsets / normals_length,
+                              normals_length * normals_length);
+      volume *= options_.volume_weight * points / (9 * area2 * area2);
+      star_terms_ += volume;
+    }
+  }
 
   static constexpr size_t kNotProjected = ~size_t{0};
   struct Placement {
@@ -721,8 +800,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                                : nullptr);
     }
     curve_fit = curves_.gathered() ? curves_.project(v) : SharpCurves::Fit{};
-    const double spring = kappa * spring_energy_after(v);
-    const double energy = fit.distance_sq + curve_fit.distance_sq + spring;
+    double energy = fit.distance_sq + curve_fit.distance_sq + kappa * spring_energy_after(v);
+    if (star_terms_on_) energy += star_terms_.evaluate(v);
     if (placed < placements.size()) {
       placements[placed] = {v, energy, std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
                             placed};
@@ -736,14 +815,12 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       v = moment_solve(from, curve_fit.a + spring_weight, add(curve_fit.b, spring_pull),
                        &plane_model);
     } else {
-      const double denominator = fit.a + curve_fit.a + spring_weight;
-      if (!(denominator > 0)) return from;
-      v = scale(add(add(fit.b, curve_fit.b), spring_pull), 1.0 / denominator);
+      v = projection_solve(fit, curve_fit.a + spring_weight, add(curve_fit.b, spring_pull), from);
     }
     if (boundary_a && boundary_b && !curves_.has_samples()) {
       // Without curve samples (discontinuities off), a boundary edge keeps its vertex on the
-      // segment, so that the boundary keeps its place (the energy is isotropic in v, so the
-      // constrained optimum is the projection).
+      // segment, so that the boundary keeps its place (the projection: the constrained
+      // optimum of an isotropic energy, near it with the star's terms).
       v = add(pa, scale(sub(pb, pa), project_on_segment(v, pa, pb).t));
     }
     return rounded(v, options_.round_to_float);
@@ -783,7 +860,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
           // model is the reweighted planes'. The collapse is measured when it is performed.
           if (placed < placements.size()) {
             const double distance = by_moments ? plane_model.at(v) : fit.model_at(v);
-            const double energy = distance + curve_fit.model_at(v) + kappa * spring_energy_after(v);
+            double energy = distance + curve_fit.model_at(v) + kappa * spring_energy_after(v);
+            if (star_terms_on_) energy += star_terms_.evaluate(v);
             placements[placed++] = {v, energy, 0, kNotProjected};
           }
           break;
@@ -813,7 +891,11 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   } else if (scalar_.enabled()) {
     project_points(star_points_, star_homes_, chosen->v, &projected_);
   }
-  if (scalar_.enabled()) out.cost += scalar_change();
+  // E_scalar counts the star's points; the star's planes stand for star_planes_weight times as
+  // many between them, which carry attributes too: without this factor the geometry would
+  // outweigh the attributes that much more than before (the airplane's colour RMS at 10%
+  // doubled: 0.0119 -> 0.0232; with it 0.0110, docs/BENCHMARKS.md).
+  if (scalar_.enabled()) out.cost += (1 + options_.star_planes_weight) * scalar_change();
   // Penalised, not forbidden (Hoppe 96): such collapses come after every ordinary one.
   if (topology) out.cost += topology_penalty_;
   return std::isfinite(out.cost);

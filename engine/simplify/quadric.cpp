@@ -28,6 +28,14 @@ Quadric& Quadric::operator+=(const Quadric& q) {
   return *this;
 }
 
+Quadric& Quadric::operator*=(double s) {
+  a00 *= s, a01 *= s, a02 *= s, a11 *= s, a12 *= s, a22 *= s;
+  b0 *= s, b1 *= s, b2 *= s;
+  c *= s;
+  weight *= s;
+  return *this;
+}
+
 double Quadric::evaluate(const Vec3& p) const {
   const double x = p[0], y = p[1], z = p[2];
   return a00 * x * x + 2 * a01 * x * y + 2 * a02 * x * z + a11 * y * y + 2 * a12 * y * z +

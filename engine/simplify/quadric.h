@@ -23,6 +23,7 @@ struct Quadric {
   static Quadric from_plane(const Vec3& n, double d, double weight);
 
   Quadric& operator+=(const Quadric& q);
+  Quadric& operator*=(double s);
   double evaluate(const Vec3& p) const;
   // The minimiser of Q, when A is well conditioned relative to its scale; false otherwise.
   bool minimizer(Vec3& out) const;

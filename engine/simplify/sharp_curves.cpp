@@ -20,11 +20,47 @@ void erase_value(std::vector<VertexId>& list, VertexId v) {
   list.erase(std::remove(list.begin(), list.end(), v), list.end());
 }
 
+// Drops the creases that are noise: a crease (a connected set of crease edges, not counting
+// boundaries and seams) of fewer than min_crease_edges edges and shorter than
+// long_crease_diagonals of the bounding-box diagonal. A scan's noise makes hundreds of such
+// fragments (nefertiti-100k: 597 creases at 60 degrees, 535 of them of 1 to 3 edges), and a
+// curve's ends never merge but through a penalised collapse, so each fragment would hold two
+// or more vertices until every ordinary collapse is done: at 2% of the faces those vertices
+// were most of the mesh (docs/BENCHMARKS.md, "The star's planes and its volume; noise
+// creases").
+void keep_long_creases(const CollapseMesh& mesh, const SharpEdgeOptions& options,
+                       std::vector<std::pair<VertexId, VertexId>>& creases) {
+  if (options.min_crease_edges <= 1 || creases.empty()) return;
+  std::vector<VertexId> parent(mesh.vertex_capacity());
+  for (VertexId v = 0; v < parent.size(); ++v) parent[v] = v;
+  auto root = [&](VertexId x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const auto& [a, b] : creases) parent[root(a)] = root(b);
+  struct Extent {
+    uint32_t edges = 0;
+    double length = 0;
+  };
+  std::unordered_map<VertexId, Extent> extent;
+  for (const auto& [a, b] : creases) {
+    Extent& e = extent[root(a)];
+    ++e.edges;
+    e.length += length(sub(mesh.position(a), mesh.position(b)));
+  }
+  const double long_enough =
+      options.long_crease_diagonals * bounding_box(mesh.positions()).diagonal();
+  std::erase_if(creases, [&](const std::pair<VertexId, VertexId>& edge) {
+    const Extent& e = extent[root(edge.first)];
+    return e.edges < options.min_crease_edges && e.length < long_enough;
+  });
+}
+
 }  // namespace
 
 std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& mesh,
                                                             const SharpEdgeOptions& options) {
-  std::vector<std::pair<VertexId, VertexId>> edges;
+  std::vector<std::pair<VertexId, VertexId>> edges, creases;
   const double crease_cos = std::cos(options.crease_angle_degrees * M_PI / 180.0);
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     if (!mesh.face_alive(f)) continue;
@@ -43,18 +79,21 @@ std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& 
         sharp = mesh.corner_wedges(f)[k] != mesh.corner_wedges(g)[corner_of(u, a)] ||
                 mesh.corner_wedges(f)[(k + 1) % 3] != mesh.corner_wedges(g)[corner_of(u, b)];
       }
-      if (!sharp) {
+      if (sharp) {
+        edges.emplace_back(a, b);
+      } else {
         const Triangle& u = mesh.face(g);
         const Vec3 nf =
             triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
         const Vec3 ng =
             triangle_normal(mesh.position(u[0]), mesh.position(u[1]), mesh.position(u[2]));
         const double lengths = length(nf) * length(ng);
-        sharp = lengths > 0 && dot(nf, ng) < crease_cos * lengths;
+        if (lengths > 0 && dot(nf, ng) < crease_cos * lengths) creases.emplace_back(a, b);
       }
-      if (sharp) edges.emplace_back(a, b);
     }
   }
+  keep_long_creases(mesh, options, creases);
+  edges.insert(edges.end(), creases.begin(), creases.end());
   std::sort(edges.begin(), edges.end());
   return edges;
 }

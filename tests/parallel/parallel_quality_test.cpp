@@ -133,6 +133,11 @@ TEST(ParallelQuality, EnergyLevelsMatchTheSequentialOnes) {
 // with the energy's keys the sequential build coarsens fandisk's flat sides long before its
 // curved parts, and equal shares made each of 8 jobs coarsen its region alike (metro RMS at
 // 50%, 2026-11-22: 1.29 of the sequential level's in three draws, 0.99 by cheap edges).
+// Since the energy's star planes (energy_priority.h) the sequential level is 5x closer to the
+// input (RMS 8.3e-6 against 4.1e-5): its flat sides now cost nothing at all, and a round
+// cannot take the flat faces along its borders, so the jobs take costlier ones inside
+// instead: 1.11 by cheap edges, 1.30 equal shares (1.01 at p = 2, 1.23 at p = 16; the
+// parallel level is still 4x closer than the sequential one was; docs/BENCHMARKS.md).
 TEST(ParallelQuality, SharesByCheapEdgesFollowTheSequentialOrder) {
   const std::filesystem::path path = shared_meshes_dir() / "fandisk-13k.obj";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/meshes is not present";
@@ -154,7 +159,7 @@ TEST(ParallelQuality, SharesByCheapEdgesFollowTheSequentialOrder) {
       rms_at_half(build_progressive_mesh_parallel(repaired, options, parallel)) / sequential;
   std::printf("fandisk-13k energy p=8 50%%: rms by cheap edges %.3f, equal shares %.3f\n",
               by_cheap_edges, equal);
-  EXPECT_LE(by_cheap_edges, 1.08);
+  EXPECT_LE(by_cheap_edges, 1.15);
   EXPECT_LT(by_cheap_edges, equal);
 }
 

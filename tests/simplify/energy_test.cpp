@@ -201,6 +201,51 @@ TEST(EnergyPriority, PointsFollowTheirFacesThroughCollapses) {
   EXPECT_LT(parked, cm.live_vertices()) << "most survivors moved";
 }
 
+// The volume term (EnergyOptions::volume_weight), weighted far above the rest, places every
+// collapse of a closed sphere where the enclosed volume does not change; without it the
+// points and springs pull each merged vertex inwards, onto the chords.
+TEST(EnergyPriority, VolumeTermKeepsTheEnclosedVolume) {
+  const Mesh sphere = testing::uv_sphere(14, 20);
+  const CollapseMesh cm(sphere);
+  auto volume = [](const CollapseMesh& m) {
+    double sum = 0;
+    for (FaceId f = 0; f < m.face_capacity(); ++f)
+      if (m.face_alive(f)) {
+        const Triangle& t = m.face(f);
+        sum += dot(m.position(t[0]), cross(m.position(t[1]), m.position(t[2]))) / 6;
+      }
+    return sum;
+  };
+  const double before = volume(cm);
+  auto change = [&](double volume_weight) {
+    EnergyOptions options;
+    options.star_planes_weight = 0;
+    options.volume_weight = volume_weight;
+    EnergyPriority energy({}, options);
+    energy.initialize(cm);
+    double sum = 0;
+    int collapses = 0;
+    std::vector<VertexId> around;
+    for (VertexId a = 0; a < 60; ++a) {
+      cm.neighbors(a, around);
+      for (VertexId b : around) {
+        if (b < a) continue;
+        CollapseCandidate c;
+        if (!energy.evaluate(cm, a, b, c, Costing::kPerform)) continue;
+        CollapseMesh after = cm;
+        after.collapse(c.vs, c.vt, c.position, after.edge_faces(c.vs, c.vt));
+        sum += std::abs(volume(after) - before);
+        ++collapses;
+      }
+    }
+    EXPECT_GT(collapses, 100);
+    return sum;
+  };
+  const double free_change = change(0), kept_change = change(1e6);
+  EXPECT_GT(free_change, 1e-4 * before) << "the points and springs alone lose volume";
+  EXPECT_LT(kept_change, 1e-3 * free_change);
+}
+
 }  // namespace
 }  // namespace parapm
 
@@ -217,6 +262,23 @@ TEST(SharpCurves, BoundariesAndCreasesAboveTheAngle) {
   EXPECT_EQ(find_sharp_edges(cm, options).size(), 20u) << "and the 4 ridge edges";
   options.boundaries = false;
   EXPECT_EQ(find_sharp_edges(cm, options).size(), 4u);
+}
+
+TEST(SharpCurves, ShortCreasesAreNoiseUnlessLong) {
+  const Mesh mesh = roof();
+  const CollapseMesh cm(mesh);
+  SharpEdgeOptions options;
+  options.crease_angle_degrees = 45;
+  // The ridge is one crease of 4 edges: fewer than 8, but 4 long in a diagonal of 5.8.
+  EXPECT_EQ(find_sharp_edges(cm, options).size(), 20u);
+  options.long_crease_diagonals = 1;  // now short as well: noise; the boundary stays
+  EXPECT_EQ(find_sharp_edges(cm, options).size(), 16u);
+  options.min_crease_edges = 4;  // enough edges
+  EXPECT_EQ(find_sharp_edges(cm, options).size(), 20u);
+  options.min_crease_edges = 5;
+  EXPECT_EQ(find_sharp_edges(cm, options).size(), 16u);
+  options.min_crease_edges = 1;  // every crease
+  EXPECT_EQ(find_sharp_edges(cm, options).size(), 20u);
 }
 
 TEST(SharpCurves, TopologyChangesAreFlagged) {
