@@ -455,11 +455,13 @@ Vec3 EnergyPriority::moment_solve(const Vec3& from, double iso_a, const Vec3& is
       planes.r + Eigen::Vector3d(iso_b[0] + planes.ends.b[0], iso_b[1] + planes.ends.b[1],
                                  iso_b[2] + planes.ends.b[2]);
   if (star_terms_on_) {
+    // The star's quadric is about star_origin_: (v - o)^T A (v - o) + 2 b.(v - o) + c.
     const Quadric& q = star_terms_;
-    h(0, 0) += q.a00, h(1, 1) += q.a11, h(2, 2) += q.a22;
-    h(0, 1) += q.a01, h(1, 0) += q.a01, h(0, 2) += q.a02, h(2, 0) += q.a02;
-    h(1, 2) += q.a12, h(2, 1) += q.a12;
-    r -= Eigen::Vector3d(q.b0, q.b1, q.b2);
+    Eigen::Matrix3d a;
+    a << q.a00, q.a01, q.a02, q.a01, q.a11, q.a12, q.a02, q.a12, q.a22;
+    const Eigen::Vector3d o(star_origin_[0], star_origin_[1], star_origin_[2]);
+    h += a;
+    r += a * o - Eigen::Vector3d(q.b0, q.b1, q.b2);
   }
   if (model) *model = planes;
   const Eigen::LDLT<Eigen::Matrix3d> solver(h);
@@ -476,11 +478,15 @@ Vec3 EnergyPriority::projection_solve(const Fit& fit, double iso_a, const Vec3& 
   if (!(diagonal > 0)) return from;
   const Vec3 pull = add(fit.b, iso_b);
   if (star_terms_on_) {
+    // In coordinates about star_origin_ (u = v - o), where the star's quadric is kept: the
+    // isotropic part d |u + o|^2 - 2 pull.(u + o) adds d to A's diagonal and d o - pull to b.
     Quadric q = star_terms_;
+    const Vec3& o = star_origin_;
     q.a00 += diagonal, q.a11 += diagonal, q.a22 += diagonal;
-    q.b0 -= pull[0], q.b1 -= pull[1], q.b2 -= pull[2];
-    Vec3 v;
-    if (solve_positive_definite(q, v)) return v;
+    q.b0 += diagonal * o[0] - pull[0], q.b1 += diagonal * o[1] - pull[1];
+    q.b2 += diagonal * o[2] - pull[2];
+    Vec3 u;
+    if (solve_positive_definite(q, u)) return add(u, o);
   }
   // Without the star's terms the model is isotropic: a scalar times the identity.
   return scale(pull, 1.0 / diagonal);
@@ -620,7 +626,9 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   double spring_before = 0;
   // The star's planes before the collapse (area weighted), the sum of its faces' normals and
   // of normal.corner (the tetrahedra between v and the faces have signed volumes summing to
-  // (normals.v - offsets) / 6), and twice its area.
+  // (normals.v - offsets) / 6), and twice its area; about a's position, so that the quadric's
+  // value, a small difference of large terms far from the model's origin, stays exact.
+  star_origin_ = pa;
   Quadric star_planes;
   Vec3 normals{};
   double offsets = 0, area2 = 0;
@@ -639,7 +647,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       if (star_terms_on_) {
         const Vec3 n = triangle_normal(p0, p1, p2);
         const double n_length = length(n);
-        const double offset = dot(n, p0);
+        const double offset = dot(n, sub(p0, star_origin_));
         normals = add(normals, n);
         offsets += offset;
         area2 += n_length;
@@ -801,7 +809,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     }
     curve_fit = curves_.gathered() ? curves_.project(v) : SharpCurves::Fit{};
     double energy = fit.distance_sq + curve_fit.distance_sq + kappa * spring_energy_after(v);
-    if (star_terms_on_) energy += star_terms_.evaluate(v);
+    if (star_terms_on_) energy += star_terms_.evaluate(sub(v, star_origin_));
     if (placed < placements.size()) {
       placements[placed] = {v, energy, std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
                             placed};
@@ -861,7 +869,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
           if (placed < placements.size()) {
             const double distance = by_moments ? plane_model.at(v) : fit.model_at(v);
             double energy = distance + curve_fit.model_at(v) + kappa * spring_energy_after(v);
-            if (star_terms_on_) energy += star_terms_.evaluate(v);
+            if (star_terms_on_) energy += star_terms_.evaluate(sub(v, star_origin_));
             placements[placed++] = {v, energy, 0, kNotProjected};
           }
           break;

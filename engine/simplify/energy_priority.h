@@ -287,9 +287,10 @@ class EnergyPriority : public PriorityModule {
   // collapsed(): the index among vs's faces of its old face's image (-1: an unparked sample).
   mutable std::vector<int> star_homes_;
   mutable double star_point_weight_ = 1;  // how many points each of star_points_ stands for
-  // The star's planes and volume terms of one evaluation, as one quadric in v (star_terms_on_:
-  // either weight is non-zero).
+  // The star's planes and volume terms of one evaluation, as one quadric in v - star_origin_
+  // (star_terms_on_: either weight is non-zero).
   mutable Quadric star_terms_;
+  mutable Vec3 star_origin_{};
   bool star_terms_on_ = false;
   mutable int a_side_faces_ = 0;
   mutable std::array<FaceId, 2> edge_faces_{kNoId, kNoId};  // the two faces the collapse removes
