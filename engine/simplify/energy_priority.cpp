@@ -32,24 +32,6 @@ bool has_plane(double n_sq, const Vec3& q0, const Vec3& q1, const Vec3& q2) {
   return n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0;
 }
 
-// The solution of A x = -b for q's symmetric A, by cofactors: for a positive definite A (the
-// solves add a positive multiple of the identity), with no conditioning threshold.
-bool solve_positive_definite(const Quadric& q, Vec3& out) {
-  const double c00 = q.a11 * q.a22 - q.a12 * q.a12;
-  const double c01 = q.a02 * q.a12 - q.a01 * q.a22;
-  const double c02 = q.a01 * q.a12 - q.a02 * q.a11;
-  const double det = q.a00 * c00 + q.a01 * c01 + q.a02 * c02;
-  if (!(det > 0)) return false;
-  const double c11 = q.a00 * q.a22 - q.a02 * q.a02;
-  const double c12 = q.a01 * q.a02 - q.a00 * q.a12;
-  const double c22 = q.a00 * q.a11 - q.a01 * q.a01;
-  const double inv = 1.0 / det;
-  out[0] = -(c00 * q.b0 + c01 * q.b1 + c02 * q.b2) * inv;
-  out[1] = -(c01 * q.b0 + c11 * q.b1 + c12 * q.b2) * inv;
-  out[2] = -(c02 * q.b0 + c12 * q.b1 + c22 * q.b2) * inv;
-  return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
-}
-
 Vec3 rounded(Vec3 v, bool to_float) {
   if (to_float)
     for (double& c : v) c = round_to_float(c);
@@ -486,7 +468,7 @@ Vec3 EnergyPriority::projection_solve(const Fit& fit, double iso_a, const Vec3& 
     q.b0 += diagonal * o[0] - pull[0], q.b1 += diagonal * o[1] - pull[1];
     q.b2 += diagonal * o[2] - pull[2];
     Vec3 u;
-    if (solve_positive_definite(q, u)) return add(u, o);
+    if (q.minimizer(u, 0)) return add(u, o);  // positive definite: no threshold
   }
   // Without the star's terms the model is isotropic: a scalar times the identity.
   return scale(pull, 1.0 / diagonal);

@@ -42,7 +42,7 @@ double Quadric::evaluate(const Vec3& p) const {
          a22 * z * z + 2 * (b0 * x + b1 * y + b2 * z) + c;
 }
 
-bool Quadric::minimizer(Vec3& out) const {
+bool Quadric::minimizer(Vec3& out, double relative_threshold) const {
   // Cofactors of the symmetric A; A p = -b.
   const double c00 = a11 * a22 - a12 * a12;
   const double c01 = a02 * a12 - a01 * a22;
@@ -51,7 +51,7 @@ bool Quadric::minimizer(Vec3& out) const {
   const double scale = a00 + a11 + a22;
   // A nearly singular A (flat or cylindrical neighbourhood) has no reliable minimiser: the
   // relative threshold keeps the test independent of the model's units.
-  if (!(std::fabs(det) > 1e-9 * scale * scale * scale)) return false;
+  if (!(std::fabs(det) > relative_threshold * scale * scale * scale)) return false;
   const double c11 = a00 * a22 - a02 * a02;
   const double c12 = a01 * a02 - a00 * a12;
   const double c22 = a00 * a11 - a01 * a01;

@@ -25,8 +25,10 @@ struct Quadric {
   Quadric& operator+=(const Quadric& q);
   Quadric& operator*=(double s);
   double evaluate(const Vec3& p) const;
-  // The minimiser of Q, when A is well conditioned relative to its scale; false otherwise.
-  bool minimizer(Vec3& out) const;
+  // The minimiser of Q, when A is well conditioned relative to its scale (|det A| above
+  // relative_threshold x trace^3); false otherwise. A positive definite A (a caller that adds a
+  // positive multiple of the identity) needs no threshold: 0.
+  bool minimizer(Vec3& out, double relative_threshold = 1e-9) const;
 };
 
 }  // namespace parapm

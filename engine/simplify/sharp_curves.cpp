@@ -8,6 +8,7 @@
 #include "simplify/point_projection.h"
 #include "simplify/sample_thinning.h"
 #include "util/error.h"
+#include "util/union_find.h"
 
 namespace parapm {
 namespace {
@@ -31,27 +32,22 @@ void erase_value(std::vector<VertexId>& list, VertexId v) {
 void keep_long_creases(const CollapseMesh& mesh, const SharpEdgeOptions& options,
                        std::vector<std::pair<VertexId, VertexId>>& creases) {
   if (options.min_crease_edges <= 1 || creases.empty()) return;
-  std::vector<VertexId> parent(mesh.vertex_capacity());
-  for (VertexId v = 0; v < parent.size(); ++v) parent[v] = v;
-  auto root = [&](VertexId x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const auto& [a, b] : creases) parent[root(a)] = root(b);
+  UnionFind sets(mesh.vertex_capacity());
+  for (const auto& [a, b] : creases) sets.unite(a, b);
   struct Extent {
     uint32_t edges = 0;
     double length = 0;
   };
   std::unordered_map<VertexId, Extent> extent;
   for (const auto& [a, b] : creases) {
-    Extent& e = extent[root(a)];
+    Extent& e = extent[sets.find(a)];
     ++e.edges;
     e.length += length(sub(mesh.position(a), mesh.position(b)));
   }
   const double long_enough =
       options.long_crease_diagonals * bounding_box(mesh.positions()).diagonal();
   std::erase_if(creases, [&](const std::pair<VertexId, VertexId>& edge) {
-    const Extent& e = extent[root(edge.first)];
+    const Extent& e = extent[sets.find(edge.first)];
     return e.edges < options.min_crease_edges && e.length < long_enough;
   });
 }
