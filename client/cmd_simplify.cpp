@@ -31,6 +31,7 @@ struct SimplifyArgs {
   unsigned threads = 0;   // 0: min(p, hardware threads)
   uint32_t rounds = ParallelOptions{}.rounds;
   double handover = ParallelOptions{}.handover_ratio;
+  double border_excess = ParallelOptions{}.border_excess;
   uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
   bool no_carry_keys = false;
   bool no_deferred_recosting = false;
@@ -52,6 +53,8 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
     rounds.push_back({{"round", r.round},
                       {"faces_before", r.faces_before},
                       {"goal_faces", r.goal_faces},
+                      {"border_faces", r.border_faces},
+                      {"border_limited", r.border_limited},
                       {"asked_faces", r.asked_faces},
                       {"faces_after", r.faces_after},
                       {"partition_seconds", r.partition_seconds},
@@ -107,6 +110,7 @@ int run_simplify(const SimplifyArgs& args) {
     parallel.threads = args.threads;
     parallel.rounds = args.rounds;
     parallel.handover_ratio = args.handover;
+    parallel.border_excess = args.border_excess;
     parallel.extra_round_subset_faces = args.extra_round_faces;
     parallel.carry_keys = !args.no_carry_keys;
     pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
@@ -237,7 +241,7 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--rounds", args->rounds,
                   "With --parallel: parallel rounds, each on a new partition (the borders "
                   "move); they take the mesh geometrically down to the handover (0: by P, 2 at "
-                  "P = 2, 3 above)")
+                  "P = 2, 3 above); rounds shortened by --border-excess come on top")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
   cmd->add_option("--handover-ratio", args->handover,
@@ -245,6 +249,12 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                   "input faces (or the target if larger); the sequential final pass does the "
                   "rest")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--border-excess", args->border_excess,
+                  "With --parallel: a round ends where the faces along its cut, which it cannot "
+                  "remove, hold at most this fraction of the faces in excess of the rest's "
+                  "resolution; it removes at least 15% (0: geometric rounds only)")
+      ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
   cmd->add_option("--extra-round-faces", args->extra_round_faces,
                   "With --parallel: past the handover, more rounds at the same ratio while the "

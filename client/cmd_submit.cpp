@@ -26,6 +26,7 @@ struct SubmitArgs {
   double attribute_weight = 0.01;
   double handover = 0;
   int64_t extra_round_faces = -1;  // -1: not given (the coordinator's default)
+  double border_excess = -1;       // negative: not given (the coordinator's default)
   bool keep_order = false;
   bool wait = false;
   bool json = false;
@@ -58,6 +59,8 @@ int run_submit(SubmitArgs& args) {
   o.set_attribute_weight(args.attribute_weight > 0 ? args.attribute_weight : -1);
   o.set_handover_ratio(args.handover);
   // The API reads 0 as "the default" and a negative count as "none".
+  if (args.border_excess >= 0)
+    o.set_border_excess(args.border_excess == 0 ? -1 : args.border_excess);
   if (args.extra_round_faces >= 0)
     o.set_extra_round_faces(args.extra_round_faces == 0 ? -1 : args.extra_round_faces);
   o.set_keep_order(args.keep_order);
@@ -143,6 +146,10 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--handover-ratio", args->handover,
                   "the rounds go down to this fraction of the input faces (default 0.1)")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--border-excess", args->border_excess,
+                  "a round ends where the faces along its cut hold at most this fraction of the "
+                  "faces in excess (default 0.05; 0: none, geometric rounds only)")
+      ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--extra-round-faces", args->extra_round_faces,
                   "past the handover, more rounds while every subset keeps this many faces and "
                   "the last round did 90% of its share (2.5x as many faces after one that did "

@@ -389,8 +389,8 @@ void Coordinator::execute(JobRecord& record, Running& running,
     started->set_target_faces(target_face_count(record.input_faces, spec.simplify));
     emit(job_id, event);
   }
-  spdlog::info("job {} started (attempt {}): {} faces, p = {}, {} rounds, metric {}", job_id,
-               record.attempts, record.input_faces, spec.parallel.subsets,
+  spdlog::info("job {} started (attempt {}): {} faces, p = {}, {} scheduled rounds, metric {}",
+               job_id, record.attempts, record.input_faces, spec.parallel.subsets,
                scheduled_rounds(spec.parallel), spec.simplify.metric);
 
   RemoteOptions remote;

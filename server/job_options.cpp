@@ -67,6 +67,10 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
   if (options.handover_ratio() != 0) p.handover_ratio = options.handover_ratio();
   require(std::isfinite(p.handover_ratio) && p.handover_ratio > 0 && p.handover_ratio <= 1,
           "handover_ratio must be in (0, 1]");
+  require(std::isfinite(options.border_excess()) && options.border_excess() <= 0.5,
+          "border_excess must be at most 0.5 (0: the default, 0.05; negative: none)");
+  if (options.border_excess() < 0) p.border_excess = 0;
+  if (options.border_excess() > 0) p.border_excess = options.border_excess();
   if (options.extra_round_faces() < 0) p.extra_round_subset_faces = 0;
   if (options.extra_round_faces() > 0)
     p.extra_round_subset_faces = uint64_t(options.extra_round_faces());

@@ -60,6 +60,9 @@ void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
   if (parallel.rounds > 64)
     throw_invalid("parallel rounds must be in [1, 64] (0: by p), got " +
                   std::to_string(parallel.rounds));
+  if (!(parallel.border_excess >= 0 && parallel.border_excess <= 0.5))
+    throw_invalid("the border excess must be in [0, 0.5] (0: geometric rounds only), got " +
+                  std::to_string(parallel.border_excess));
   if (!(parallel.handover_ratio > 0 && parallel.handover_ratio <= 1))
     throw_invalid("the handover ratio must be in (0, 1], got " +
                   std::to_string(parallel.handover_ratio));
@@ -190,27 +193,28 @@ uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& 
   return asked;
 }
 
-// The band pass's priority: the master's metric, restricted to edges with an end that no
-// collapse has touched yet (an input vertex, around which input faces may remain) and a cost
-// of at most `ceiling`; an edge above it is left alone until its star changes.
+// The band pass's priority: the master's metric, restricted to edges with a lagging end (bound
+// in this round and the one before, so not moved by either: where two cuts cross, around it
+// faces may remain from two rounds ago) and a cost of at most `ceiling`; an edge above it is
+// left alone until its star changes. A collapse's ends no longer lag.
 class BandPriority : public PriorityWrapper {
  public:
-  BandPriority(PriorityModule& inner, std::vector<uint8_t>& touched, double ceiling)
-      : PriorityWrapper(inner), touched_(touched), ceiling_(ceiling) {}
+  BandPriority(PriorityModule& inner, std::vector<uint8_t> lagging, double ceiling)
+      : PriorityWrapper(inner), lagging_(std::move(lagging)), ceiling_(ceiling) {}
   void initialize(const CollapseMesh&) override {}
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {
-    if (touched_[a] && touched_[b]) return false;
+    if (!lagging_[a] && !lagging_[b]) return false;
     return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= ceiling_;
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                  const EdgeFaces& edge) override {
-    touched_[done.vs] = touched_[done.vt] = 1;
+    lagging_[done.vs] = lagging_[done.vt] = 0;
     inner_.collapsed(mesh, done, edge);
   }
 
  private:
-  std::vector<uint8_t>& touched_;
+  std::vector<uint8_t> lagging_;
   double ceiling_;
 };
 
@@ -244,6 +248,20 @@ std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
     jobs[i] = SubsetJob{};  // its memory is not needed any more
   });
   return results;
+}
+
+// A round shortened by its border band still removes this fraction of its faces: on a small
+// mesh cut in many subsets the band is a fifth of the faces or more, and the bound alone would
+// ask for rounds of a few percent (fandisk at p = 16: 13 rounds to the handover).
+constexpr double kMinRoundRemoval = 0.15;
+
+// The face count a round from `faces` may end at so that its border band of `border` faces
+// holds back at most `excess` x that count (ParallelOptions::border_excess); 0 without a bound.
+uint64_t border_bounded_goal(uint64_t faces, uint64_t border, double excess) {
+  if (excess <= 0 || border == 0 || faces == 0) return 0;
+  const double band = double(border) / double(faces);
+  const double ratio = std::min(1.0 - kMinRoundRemoval, 1.0 / (1.0 + excess / band));
+  return uint64_t(std::llround(ratio * double(faces)));
 }
 
 uint32_t default_rounds(uint32_t p) { return p <= 2 ? 2 : 3; }
@@ -332,7 +350,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // At most one collapse per vertex: no round's records move the earlier ones (growing by
   // doubling moved the 871k dragon's first 190k records at round 1's merge, 0.2 s).
   records.reserve(whole.live_vertices());
-  std::vector<uint8_t> touched(whole.vertex_capacity(), 0);  // vs or vt of a collapse so far
+  std::vector<uint8_t> bound_before;  // the previous round's bound vertices (subset_rule.h)
   double subsets_cpu = 0;
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
   // if that is gentler: after two scheduled rounds (a ratio of 0.32 at the default handover),
@@ -341,18 +359,23 @@ ProgressiveMesh build_progressive_mesh_parallel(
   const double handover_ratio = double(handover) / double(input_faces);
   const double step =
       std::max(std::pow(handover_ratio, 1.0 / double(rounds)), std::pow(handover_ratio, 1.0 / 3.0));
+  // Scheduled rounds still to come: geometric steps to the handover; a round shortened by its
+  // border band does not count, unless its jobs did not do half of it (locked parts: more
+  // rounds would not get further).
+  uint32_t scheduled_left = rounds;
   for (uint32_t round = 0; round < 64; ++round) {
     RoundStats rs;
     rs.round = round;
     uint32_t subsets = parallel.subsets;  // of this round
     rs.faces_before = whole.live_faces();
     if (whole.live_vertices() < 4 * size_t(parallel.subsets)) break;
-    if (round < rounds) {
+    const bool scheduled = scheduled_left > 0;
+    if (scheduled) {
       if (rs.faces_before <= handover) break;
       // Geometric steps from the present face count to the handover.
       rs.goal_faces = uint64_t(std::llround(
           double(rs.faces_before) *
-          std::pow(double(handover) / double(rs.faces_before), 1.0 / double(rounds - round))));
+          std::pow(double(handover) / double(rs.faces_before), 1.0 / double(scheduled_left))));
     } else {
       // An extra round, if the last one's jobs did what they were asked (a mesh whose locked
       // parts stop it short gains nothing from more) and the subsets stay large enough that
@@ -393,6 +416,19 @@ ProgressiveMesh build_progressive_mesh_parallel(
       rs.partition_seconds = seconds_since(t);
     }
     if (events.partitioned) events.partitioned(round, subsets, rs.faces_before);
+    // The partition's border (sequential, O(faces), counted with the partition).
+    t = std::chrono::steady_clock::now();
+    std::vector<uint8_t> bound = bound_vertices(whole, vertex_subset);
+    rs.border_faces = border_faces(whole, bound);
+    rs.partition_seconds += seconds_since(t);
+    if (scheduled && parallel.border_excess > 0) {
+      const uint64_t bounded =
+          border_bounded_goal(rs.faces_before, rs.border_faces, parallel.border_excess);
+      if (bounded > rs.goal_faces) {
+        rs.goal_faces = bounded;
+        rs.border_limited = true;
+      }
+    }
 
     // The jobs: which vertices each subset owns (sequential, O(vertices)), the water level
     // (sequential, on the master), then each job's mesh and the master's state over it, one
@@ -470,8 +506,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // The subsets' records replay on the whole mesh, side by side (replay_subsets: by the
     // subset rule they change disjoint parts of it, and the mesh ends as a merged replay
     // leaves it); beside them, the jobs' states go into the master, and the round's water
-    // level, touched vertices and keys are taken from the records and results (the module,
-    // the memo's own lists, `touched`: data the replay does not touch).
+    // level and keys are taken from the records and results (the module, the memo's own
+    // lists: data the replay does not touch).
     ReplayReport replay;
     double ceiling = 0;  // the round's water level: 95% of its collapses cost less
     double bookkeeping_seconds = 0;
@@ -481,10 +517,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
         for (const SubsetResult& r : results) import_result_state(*master, r.state);
       std::vector<double> costs;
       for (const std::vector<CollapseRecord>& list : lists)
-        for (const CollapseRecord& r : list) {
-          costs.push_back(r.cost);
-          touched[r.vs] = touched[r.vt] = 1;
-        }
+        for (const CollapseRecord& r : list) costs.push_back(r.cost);
       if (!costs.empty()) {
         const size_t k = costs.size() * 95 / 100;
         std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
@@ -519,12 +552,16 @@ ProgressiveMesh build_progressive_mesh_parallel(
     rs.merge_seconds = seconds_since(t);
 
     // The band pass, after every round but the first: what two rounds' borders both kept
-    // (vertices next to both cuts, at full resolution) and is below the round's water level,
-    // sequentially on the whole mesh, cheapest first. (After the first round the next round's
-    // new partition takes its band in parallel.)
+    // (vertices bound in both partitions, at the resolution of two rounds before) and is below
+    // the round's water level, sequentially on the whole mesh, cheapest first. (After the
+    // first round the next round's new partition takes its band in parallel.) Only those: a
+    // vertex no collapse has touched yet may just be inside a region a short round did not
+    // reach, which the next round takes in parallel.
     t = std::chrono::steady_clock::now();
     if (parallel.band_pass && round >= 1) {
-      BandPriority band(keys, touched, ceiling);
+      std::vector<uint8_t> lagging(bound.size());
+      for (size_t v = 0; v < bound.size(); ++v) lagging[v] = bound[v] && bound_before[v];
+      BandPriority band(keys, std::move(lagging), ceiling);
       Simplifier pass(whole, band, standard_constraints(locked));
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
@@ -534,18 +571,23 @@ ProgressiveMesh build_progressive_mesh_parallel(
                      std::make_move_iterator(band_records.end()));
     }
     rs.band_pass_seconds = seconds_since(t);
+    bound_before = std::move(bound);
     rs.faces_after = whole.live_faces();
     st.critical_path_seconds += rs.partition_seconds - rs.partition_overlap_seconds +
                                 rs.extract_critical_seconds + rs.slowest_subset_cpu_seconds +
                                 rs.merge_seconds - rs.merge_overlap_seconds + rs.band_pass_seconds;
     spdlog::debug(
-        "parallel round {}: {} subsets {}->{} faces (goal {}), partition {:.3f} s, extract "
-        "{:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} replayed), band "
-        "pass {} collapses in {:.3f} s",
-        round, subsets, rs.faces_before, rs.faces_after, rs.goal_faces, rs.partition_seconds,
-        rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds, rs.merge_seconds,
-        replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
+        "parallel round {}: {} subsets {}->{} faces (goal {}{}; {} border faces), partition "
+        "{:.3f} s, extract {:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} "
+        "replayed), band pass {} collapses in {:.3f} s",
+        round, subsets, rs.faces_before, rs.faces_after, rs.goal_faces,
+        rs.border_limited ? ", bounded by the border band" : "", rs.border_faces,
+        rs.partition_seconds, rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds,
+        rs.merge_seconds, replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
     if (events.merged) events.merged(rs);
+    if (scheduled &&
+        (!rs.border_limited || 2 * (rs.faces_before - rs.faces_after) < rs.asked_faces))
+      --scheduled_left;
     st.round_stats.push_back(std::move(rs));
     if (progress) progress(input_faces - whole.live_faces(), input_faces - target);
   }

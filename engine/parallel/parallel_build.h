@@ -41,6 +41,20 @@ struct ParallelOptions {
   // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds", "Extra
   // rounds after a short round").
   uint64_t extra_round_subset_faces = 2000;
+  // The most a round's border band may hold back, as a fraction of the faces the round ends
+  // with. A round cannot remove the faces along its cut (subset_rule.h, border_faces); they
+  // stay at the resolution the round started from while the rest goes on, so every level
+  // inside the round has that many faces too many where they are not needed, and less
+  // precision elsewhere (error falls about as 1 / faces). A band of b x the faces, in a round
+  // from S to E faces, holds b S (1 - E / S) faces in excess at its end, so a round ends at
+  // E >= S / (1 + border_excess / b), and removes at least kMinRoundRemoval of its faces
+  // (parallel_build.cpp). A round shortened this way does not count against `rounds`. The
+  // band is a larger part of a small mesh cut in many subsets: the 12k-17k-face meshes at
+  // p = 16 have 22-24%, the 871k dragon 0.7% at p = 2 and 4.3% at p = 16. 0: the geometric
+  // rounds only. On 18 meshes the 50% level went from 1.03-1.07 of the sequential RMS to
+  // 1.02-1.03 with 0.05 and 1.00-1.02 with 0.02, which takes half as many rounds again
+  // (docs/BENCHMARKS.md, "Rounds bounded by their border band").
+  double border_excess = 0.05;
   // Jobs leave alone edges costing more than this factor times the round's water level
   // (parallel_build.cpp, sample_round_costs: the cost below which a sample of the edges
   // would give the round's collapses), besides stopping at their share of the faces; 0:
@@ -82,7 +96,7 @@ struct RoundStats {
   // their borders), so it ends above its goal (parallel_build.cpp, set_targets).
   uint64_t asked_faces = 0;
   uint64_t faces_after = 0;
-  double partition_seconds = 0;
+  double partition_seconds = 0;  // with finding its border (bound_vertices, border_faces)
   // Round 0's partition is drawn beside the master's initialisation: the shorter of the two,
   // which the critical path leaves out.
   double partition_overlap_seconds = 0;
@@ -92,7 +106,11 @@ struct RoundStats {
   // extraction's share of the critical path (its sequential steps plus the slowest job).
   double slowest_extract_cpu_seconds = 0;
   double extract_critical_seconds = 0;
-  double water_level = 0;      // the jobs' cost ceiling (ParallelOptions::water_level_factor)
+  double water_level = 0;  // the jobs' cost ceiling (ParallelOptions::water_level_factor)
+  // Faces no job could remove (subset_rule.h, border_faces); with the goal raised to keep them
+  // within ParallelOptions::border_excess when `border_limited`.
+  uint64_t border_faces = 0;
+  bool border_limited = false;
   double subsets_seconds = 0;  // wall time of the round's jobs
   double merge_seconds = 0;    // replay on the whole mesh, state import, keys, k-way merge
   // The subsets' replays run side by side, and beside the rest (state import, water level,
@@ -109,7 +127,9 @@ struct RoundStats {
 
 struct ParallelStats {
   uint32_t subsets = 0;
-  uint32_t rounds = 0;  // performed (fewer than asked at the handover, more with extra rounds)
+  // Performed: fewer than asked at the handover, more with rounds shortened by their border
+  // band (ParallelOptions::border_excess) and extra rounds.
+  uint32_t rounds = 0;
   unsigned threads = 0;
   std::vector<RoundStats> round_stats;
   double setup_seconds = 0;  // the master's metric, initialised once on the whole mesh

@@ -84,6 +84,28 @@ uint64_t removable_faces(const Mesh& mesh, const std::vector<uint8_t>& free) {
   return removable;
 }
 
+std::vector<uint8_t> bound_vertices(const CollapseMesh& mesh,
+                                    const std::vector<uint32_t>& vertex_subset) {
+  std::vector<uint8_t> bound(mesh.vertex_capacity(), 0);
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    if (vertex_subset[t[0]] != vertex_subset[t[1]] || vertex_subset[t[1]] != vertex_subset[t[2]])
+      bound[t[0]] = bound[t[1]] = bound[t[2]] = 1;
+  }
+  return bound;
+}
+
+uint64_t border_faces(const CollapseMesh& mesh, const std::vector<uint8_t>& bound) {
+  uint64_t count = 0;
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    count += bound[t[0]] + bound[t[1]] + bound[t[2]] >= 2;
+  }
+  return count;
+}
+
 std::unique_ptr<ConstraintModule> make_subset_constraint(std::vector<uint8_t> owned) {
   return std::make_unique<SubsetConstraint>(std::move(owned));
 }

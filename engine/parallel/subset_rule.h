@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "simplify/collapse_mesh.h"
 #include "simplify/modules.h"
 
 namespace parapm {
@@ -48,6 +49,18 @@ std::vector<uint8_t> free_vertices(const Mesh& mesh, const std::vector<uint8_t>&
 // neighbour of a free vertex, is owned). A face with two corners next to another subset has no
 // edge with two free ends.
 uint64_t removable_faces(const Mesh& mesh, const std::vector<uint8_t>& free);
+
+// Per vertex of the whole `mesh`, 1 when it is "bound" in the partition `vertex_subset` (one
+// entry per vertex): a neighbour of it lies in another subset, so it is not free and no job
+// moves it this round. A vertex with a neighbour in another subset shares a face with it (the
+// mesh is manifold after the repair), so a face with corners in two subsets marks all three.
+std::vector<uint8_t> bound_vertices(const CollapseMesh& mesh,
+                                    const std::vector<uint32_t>& vertex_subset);
+
+// The live faces that no subset can remove in the round whose bound vertices are `bound`
+// (bound_vertices): those with two or more bound corners, removable_faces' complement, counted
+// without extracting the jobs.
+uint64_t border_faces(const CollapseMesh& mesh, const std::vector<uint8_t>& bound);
 
 // The rule as a constraint module, checked on every pop (after the standard constraints).
 // It tests the adjacency of vs and vt on the present mesh, not the static free flags, so that

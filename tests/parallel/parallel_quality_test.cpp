@@ -100,12 +100,18 @@ Ratios compare(const std::string& name, const RepairedMesh& repaired,
   return worst;
 }
 
+// The CAD part's worst cell is guarded at 1.45: its 2% level is below its legal minimum (about
+// 3k faces: locked copies of non-manifold vertices), so it is the base, whose last hundred
+// collapses, the dearest legal ones, double its error; which of them remain moves with the
+// rounds. At p = 16, 2026-11-24: 0.98 / 1.16 / 1.36 / 1.35 with border_excess 0 / 0.02 / 0.05
+// (the default) / 0.1, while its 3100-face level is 0.98 / - / 1.03 / -.
 TEST(ParallelQuality, QuadricLevelsMatchTheSequentialOnes) {
   for (const char* name :
        {"cad-cycloidal-43k.ply", "gmsh-aneurysm-20k.stl.gz", "pymeshlab-bunny-textured-10k.obj"}) {
     SimplifyOptions options;
     options.target_ratio = 0.01;
-    expect_near_sequential(compare(name, repaired_test_mesh(name), options, {2, 4, 8, 16}), name);
+    expect_near_sequential(compare(name, repaired_test_mesh(name), options, {2, 4, 8, 16}), name,
+                           name == std::string("cad-cycloidal-43k.ply") ? 1.45 : 1.35);
   }
 }
 
@@ -137,7 +143,11 @@ TEST(ParallelQuality, EnergyLevelsMatchTheSequentialOnes) {
 // input (RMS 8.3e-6 against 4.1e-5): its flat sides now cost nothing at all, and a round
 // cannot take the flat faces along its borders, so the jobs take costlier ones inside
 // instead: 1.11 by cheap edges, 1.30 equal shares (1.01 at p = 2, 1.23 at p = 16; the
-// parallel level is still 4x closer than the sequential one was; docs/BENCHMARKS.md).
+// parallel level is still 4x closer than the sequential one was; docs/BENCHMARKS.md). The
+// rounds are the geometric ones (border_excess 0), so that the 50% level lies inside round 0,
+// whose shares this is about: rounds bounded by their border band put it in round 2 of 14,
+// where it is 1.17 by cheap edges and 1.16 equal shares (fandisk's near-exact 50% level is
+// the one the bound does not help: docs/BENCHMARKS.md, "Rounds bounded by their border band").
 TEST(ParallelQuality, SharesByCheapEdgesFollowTheSequentialOrder) {
   const std::filesystem::path path = shared_meshes_dir() / "fandisk-13k.obj";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/meshes is not present";
@@ -152,6 +162,7 @@ TEST(ParallelQuality, SharesByCheapEdgesFollowTheSequentialOrder) {
   const double sequential = rms_at_half(build_progressive_mesh(repaired, options));
   ParallelOptions parallel;
   parallel.subsets = 8;
+  parallel.border_excess = 0;
   const double by_cheap_edges =
       rms_at_half(build_progressive_mesh_parallel(repaired, options, parallel)) / sequential;
   parallel.cost_shares = false;

@@ -130,6 +130,35 @@ TEST(SubsetRule, JobsRemoveOnlyTheirRemovableFaces) {
   }
 }
 
+// The border the round's bound counts without extracting the jobs (border_faces over
+// bound_vertices) is exactly what the jobs cannot remove: with their removable faces it makes
+// every live face of the mesh, on a real mesh cut in 2 and 8.
+TEST(SubsetRule, BorderFacesAreWhatNoJobCanRemove) {
+  for (uint32_t p : {2u, 8u}) {
+    const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
+    const Mesh& mesh = repaired.mesh;
+    const Partition partition = partition_mesh(mesh, p);
+    const CollapseMesh whole(mesh);
+    SubsetOptions options;
+    options.metric = "quadric";
+    const std::vector<SubsetJob> jobs =
+        extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
+                        locked_vertices(repaired), partition.vertex_subset, p, 0, options);
+    uint64_t removable = 0;
+    for (const SubsetJob& job : jobs)
+      removable += removable_faces(job.mesh, free_vertices(job.mesh, job.owned));
+    const std::vector<uint8_t> bound = bound_vertices(whole, partition.vertex_subset);
+    const uint64_t border = border_faces(whole, bound);
+    EXPECT_GT(border, 0u) << "p = " << p;
+    EXPECT_EQ(border + removable, whole.live_faces()) << "p = " << p;
+    for (const SubsetJob& job : jobs) {
+      const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+      for (VertexId v = 0; v < job.mesh.vertex_count(); ++v)
+        if (job.owned[v]) EXPECT_EQ(bound[job.global_vertex[v]], !free[v]) << "p = " << p;
+    }
+  }
+}
+
 // The theorem: any interleaving that keeps each subset's order replays (replay_collapses
 // checks fl, fr, vl, vr of every record against the whole mesh) and ends in the same mesh.
 void expect_interleavings_commute(const std::string& name, const std::string& metric, uint32_t p) {

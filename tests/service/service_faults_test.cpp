@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <thread>
@@ -272,6 +273,14 @@ TEST_F(ServiceFaults, BadUploadsAreRefusedAndTheServerKeepsServing) {
                 .try_submit(mesh_id, options(300, parapm::v1::METRIC_QUADRIC, 0.5), &job)
                 .error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
+  for (double excess : {0.7, std::nan("")}) {
+    parapm::v1::JobOptions bad_excess = options(2, parapm::v1::METRIC_QUADRIC, 0.5);
+    bad_excess.set_border_excess(excess);
+    const grpc::Status status = service().try_submit(mesh_id, bad_excess, &job);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << excess;
+    EXPECT_NE(status.error_message().find("border_excess"), std::string::npos)
+        << status.error_message();
+  }
   parapm::v1::JobOptions bad_metric = options(2, parapm::v1::METRIC_QUADRIC, 0.5);
   bad_metric.set_metric(parapm::v1::Metric(7));
   EXPECT_EQ(service().try_submit(mesh_id, bad_metric, &job).error_code(),

@@ -199,6 +199,8 @@ std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
   if (o.attribute_weight() < 0) number("--attribute-weight", 0);
   if (o.attribute_weight() > 0) number("--attribute-weight", o.attribute_weight());
   if (o.handover_ratio() > 0) number("--handover-ratio", o.handover_ratio());
+  if (o.border_excess() != 0)
+    number("--border-excess", o.border_excess() < 0 ? 0 : o.border_excess());
   if (o.extra_round_faces() != 0)
     args.insert(args.end(),
                 {"--extra-round-faces",

@@ -102,9 +102,11 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   build_and_compare("pymeshlab-colored-airplane-11k.ply",
                     options(4, parapm::v1::METRIC_ENERGY, 0.02, 3), names);
   // Extra rounds past the handover (the vessel gets two with a floor of 200 faces a subset),
-  // as `parapm simplify --extra-round-faces 200` builds them.
+  // and rounds bounded by a tighter border band, as `parapm simplify --extra-round-faces 200
+  // --border-excess 0.02` builds them.
   parapm::v1::JobOptions extra = options(2, parapm::v1::METRIC_QUADRIC, 0.005);
   extra.set_extra_round_faces(200);
+  extra.set_border_excess(0.02);
   build_and_compare("gmsh-aneurysm-20k.stl.gz", extra, names);
 
   // The same bytes again: the same mesh.
