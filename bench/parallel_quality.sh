@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# bench/parallel_quality.sh MESH... : how close the parallel PM's levels are to the sequential
+# PM's (issue 5's quality target), over many meshes at once.
+#
+# For every MESH it builds the sequential PM of METRIC (default energy) once (kept in BENCH_OUT
+# and reused by later runs with the same LABEL-free name), then the parallel PM for every p of
+# PS (default "2 4 8 16") with the extra options PAR_ARGS (e.g. "--border-excess 0"), and
+# prints one TSV row per mesh and p: metro's RMS and Hausdorff of the parallel level over the
+# sequential level of the same face count at 50%, 10% and 2% of the input faces (1.000: as
+# good), the rounds performed and the parallel build's seconds. A summary per p follows on
+# stderr and in BENCH_OUT/LABEL.summary: geometric means over the meshes, cells above 1.05
+# (RMS) and 1.10 (Hausdorff), the worst cell.
+# Timing is not the point here (see bench/parallel.sh): meshes run JOBS at a time (default 2).
+# Environment: METRIC, PS, RATIO (default 0.01), PAR_ARGS, LABEL (default "default"), JOBS,
+# BENCH_OUT (default ./bench-out-quality), PARAPM_BUILD_DIR (default build/), METRO (default
+# $PEERS_BUILD/metro, PEERS_BUILD defaulting to ./.peers-build).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+[[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
+export METRIC="${METRIC:-energy}" PS="${PS:-2 4 8 16}" RATIO="${RATIO:-0.01}"
+export PAR_ARGS="${PAR_ARGS:-}" LABEL="${LABEL:-default}"
+export OUT="${BENCH_OUT:-$PWD/bench-out-quality}"
+export BIN="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
+export METRO="${METRO:-${PEERS_BUILD:-$PWD/.peers-build}/metro}"
+[[ -x "$BIN" ]] || { echo "no $BIN (build the parapm target)" >&2; exit 2; }
+[[ -x "$METRO" ]] || { echo "no metro (set METRO, or build ../shared/tools)" >&2; exit 2; }
+mkdir -p "$OUT"
+
+one_mesh() {
+  set -euo pipefail
+  local mesh="$1" name
+  name="$(basename "$mesh")"; name="${name%.[gG][zZ]}"; name="${name%.*}"
+  # "rms hausdorff" of level N of a PM against the mesh
+  level_error() {
+    "$BIN" --log-level warn lod "$1" --faces "$2" -o "$3" > /dev/null
+    "$METRO" "$mesh" "$3" 2> /dev/null | jq -r '"\(.rms_rel) \(.hausdorff_rel)"'
+  }
+  local seq_pm="$OUT/$name.$METRIC.seq.pm" seq_json="$OUT/$name.$METRIC.seq.json"
+  if [[ ! -s "$seq_json" ]]; then
+    "$BIN" --log-level warn simplify "$mesh" -o "$seq_pm" --metric "$METRIC" --ratio "$RATIO" \
+      --json > "$seq_json.tmp"
+    mv "$seq_json.tmp" "$seq_json"
+  fi
+  local in_faces level n
+  in_faces="$(jq -r .in_faces "$seq_json")"
+  declare -A seq_err
+  for level in 50 10 2; do
+    n=$(( in_faces * level / 100 ))
+    local cache="$OUT/$name.$METRIC.seq.$level.err"
+    [[ -s "$cache" ]] || level_error "$seq_pm" "$n" "$OUT/$name.$METRIC.seq.$level.ply" > "$cache"
+    seq_err[$level]="$(cat "$cache")"
+  done
+  local p
+  for p in $PS; do
+    local par_pm="$OUT/$name.$METRIC.$LABEL.p$p.pm" pj
+    # shellcheck disable=SC2086
+    pj="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$METRIC" --ratio "$RATIO" \
+      --parallel "$p" --threads 1 $PAR_ARGS --json)"
+    local row
+    row="$(printf '%s\t%s\t%s\t%s\t%.2f' "$name" "$LABEL" "$p" "$(jq -r .parallel.rounds <<< "$pj")" \
+      "$(jq -r .seconds <<< "$pj")")"
+    for level in 50 10 2; do
+      n=$(( in_faces * level / 100 ))
+      local prms phd srms shd
+      read -r prms phd <<< "$(level_error "$par_pm" "$n" "$OUT/$name.$METRIC.$LABEL.p$p.$level.ply")"
+      read -r srms shd <<< "${seq_err[$level]}"
+      row+="$(awk -v a="$prms" -v b="$srms" -v c="$phd" -v d="$shd" \
+        'BEGIN { printf "\t%.3f\t%.3f", (b > 0 ? a / b : 1), (d > 0 ? c / d : 1) }')"
+    done
+    printf '%s\n' "$row"
+    rm -f "$par_pm" "$OUT/$name.$METRIC.$LABEL.p$p".*.ply
+  done
+}
+export -f one_mesh
+
+tsv="$OUT/$LABEL.tsv"
+printf 'mesh\tlabel\tp\trounds\tseconds\trms_50\thd_50\trms_10\thd_10\trms_2\thd_2\n' | tee "$tsv"
+printf '%s\n' "$@" | xargs -P "${JOBS:-2}" -I{} bash -c 'one_mesh "$1"' _ {} | tee -a "$tsv"
+
+# Geometric means per p and level; cells above 1.05 (RMS) / 1.10 (Hausdorff); the worst.
+awk -F'\t' 'NR > 1 {
+    p = $3; n[p]++
+    for (k = 0; k < 3; k++) {
+      r = $(6 + 2 * k); h = $(7 + 2 * k)
+      lr[p, k] += log(r); lh[p, k] += log(h)
+      if (r > 1.05) cr[p, k]++
+      if (h > 1.10) ch[p, k]++
+      if (r > wr[p, k]) { wr[p, k] = r; wm[p, k] = $1 }
+    }
+  }
+  END {
+    split("50 10 2", lv, " ")
+    for (p in n) {
+      line = sprintf("p = %s (%d meshes):", p, n[p])
+      for (k = 0; k < 3; k++)
+        line = line sprintf("  %s%% RMS %.3f (%d above 1.05, worst %.3f %s), Hausdorff %.3f (%d above 1.1)",
+          lv[k + 1], exp(lr[p, k] / n[p]), cr[p, k], wr[p, k], wm[p, k], exp(lh[p, k] / n[p]), ch[p, k])
+      print line
+    }
+  }' "$tsv" | sort | tee "$OUT/$LABEL.summary" >&2
