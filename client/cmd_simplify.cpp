@@ -25,6 +25,7 @@ struct SimplifyArgs {
   double samples_per_face = 0;
   double crease_angle = 60;
   double attribute_weight = 0.01;
+  EnergyTuning energy;
   uint64_t seed = 1;
   bool keep_order = false;
   uint32_t parallel = 1;  // subsets p; 1: the sequential build
@@ -97,6 +98,7 @@ int run_simplify(const SimplifyArgs& args) {
   options.samples_per_face = args.samples_per_face;
   options.crease_angle_degrees = args.crease_angle;
   options.attribute_weight = args.attribute_weight;
+  options.energy = args.energy;
   options.seed = args.seed;
   options.keep_order = args.keep_order;
   options.defer_recosting = !args.no_deferred_recosting;
@@ -211,9 +213,35 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--crease-angle", args->crease_angle,
                   "Energy metric: degrees between face normals above which an edge is a crease, "
                   "kept as a curve like boundaries and attribute seams (180: none); a crease of "
-                  "fewer than 8 edges and shorter than 5% of the bounding-box diagonal is taken "
-                  "for a scan's noise and not kept")
+                  "fewer than --crease-min-edges edges and shorter than --crease-min-length is "
+                  "taken for a scan's noise and not kept")
       ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  cmd->add_option("--crease-min-edges", args->energy.min_crease_edges,
+                  "Energy metric: a crease of fewer edges than this (and shorter than "
+                  "--crease-min-length) is noise, not kept (1: every crease is kept)")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  cmd->add_option("--crease-min-length", args->energy.crease_min_length,
+                  "Energy metric: a crease shorter than this, in bounding-box diagonals (and of "
+                  "fewer than --crease-min-edges edges), is noise, not kept (0: by edges alone)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option("--star-planes-weight", args->energy.star_planes_weight,
+                  "Energy metric: weight of the collapse's distance to the planes of its star "
+                  "(Lindstrom-Turk's term, as points this many times as dense as the star's "
+                  "would measure it) against the sample points' distances (0: off)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  cmd->add_option("--volume-weight", args->energy.volume_weight,
+                  "Energy metric: weight of the enclosed volume's change (Lindstrom-Turk's "
+                  "term, as a mean displacement of the star's points) (0: off)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  cmd->add_option("--spring-scale", args->energy.spring_scale,
+                  "Energy metric: E_spring's kappa is Hoppe's schedule (from the points per "
+                  "face around the edge) times this (0: no springs)")
+      ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   cmd->add_option("--attribute-weight", args->attribute_weight,
                   "Energy metric: weight of colours, normals and texture coordinates against "

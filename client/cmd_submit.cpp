@@ -27,6 +27,9 @@ struct SubmitArgs {
   double handover = 0;
   int64_t extra_round_faces = -1;  // -1: not given (the coordinator's default)
   double border_excess = -1;       // negative: not given (the coordinator's default)
+  // The energy's tuning; negative: not given (the coordinator's default).
+  double star_planes_weight = -1, volume_weight = -1, spring_scale = -1, crease_min_length = -1;
+  int64_t crease_min_edges = -1;
   bool keep_order = false;
   bool wait = false;
   bool json = false;
@@ -63,6 +66,16 @@ int run_submit(SubmitArgs& args) {
     o.set_border_excess(args.border_excess == 0 ? -1 : args.border_excess);
   if (args.extra_round_faces >= 0)
     o.set_extra_round_faces(args.extra_round_faces == 0 ? -1 : args.extra_round_faces);
+  // The energy's tuning: 0 is the default to the API, a negative number asks for 0.
+  parapm::v1::EnergyTuning& e = *o.mutable_energy();
+  auto tuning = [](double given, auto set) {
+    if (given >= 0) set(given == 0 ? -1 : given);
+  };
+  tuning(args.star_planes_weight, [&](double v) { e.set_star_planes_weight(v); });
+  tuning(args.volume_weight, [&](double v) { e.set_volume_weight(v); });
+  tuning(args.spring_scale, [&](double v) { e.set_spring_scale(v); });
+  tuning(args.crease_min_length, [&](double v) { e.set_crease_min_length(v); });
+  if (args.crease_min_edges > 0) e.set_min_crease_edges(uint32_t(args.crease_min_edges));
   o.set_keep_order(args.keep_order);
   parapm::v1::Job job;
   {
@@ -168,6 +181,23 @@ void add_submit_command(CLI::App& app, int& exit_code) {
                   "energy: weight of attributes against geometry (0: not optimised)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--crease-min-edges", args->crease_min_edges,
+                  "energy: creases of fewer edges (and shorter than --crease-min-length) are "
+                  "noise (default 8; 1: every crease kept)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1000000}));
+  cmd->add_option("--crease-min-length", args->crease_min_length,
+                  "energy: creases shorter than this many bounding-box diagonals (and of fewer "
+                  "than --crease-min-edges edges) are noise (default 0.05)")
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--star-planes-weight", args->star_planes_weight,
+                  "energy: weight of the star's planes against the points (default 10; 0: off)")
+      ->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--volume-weight", args->volume_weight,
+                  "energy: weight of the enclosed volume's change (default 4; 0: off)")
+      ->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--spring-scale", args->spring_scale,
+                  "energy: E_spring's kappa times this (default 0.03; 0: no springs)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_flag("--keep-order", args->keep_order, "store the input's vertex and face order");
   cmd->add_flag("--wait", args->wait, "follow the job to its end with a progress bar");
   cmd->add_flag("--json", args->json, "print the job as one JSON object");

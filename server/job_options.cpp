@@ -55,6 +55,17 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
     s.attribute_weight = 0;
   else if (options.attribute_weight() > 0)
     s.attribute_weight = options.attribute_weight();
+  const parapm::v1::EnergyTuning& e = options.energy();
+  auto tuning = [&](double value, double& out, const char* name) {
+    require(std::isfinite(value), std::string("energy.") + name + " must be finite");
+    if (value < 0) out = 0;
+    if (value > 0) out = value;
+  };
+  tuning(e.star_planes_weight(), s.energy.star_planes_weight, "star_planes_weight");
+  tuning(e.volume_weight(), s.energy.volume_weight, "volume_weight");
+  tuning(e.spring_scale(), s.energy.spring_scale, "spring_scale");
+  tuning(e.crease_min_length(), s.energy.crease_min_length, "crease_min_length");
+  if (e.min_crease_edges() > 0) s.energy.min_crease_edges = e.min_crease_edges();
   s.seed = options.seed() ? options.seed() : 1;
   s.keep_order = options.keep_order();
   check_simplify_options(s);

@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 3;
+constexpr uint8_t kVersion = 4;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -457,6 +457,11 @@ void write_options(ByteWriter& out, const SubsetOptions& o) {
   out.f64(o.samples_per_face);
   out.f64(o.crease_angle_degrees);
   out.f64(o.attribute_weight);
+  out.f64(o.energy.star_planes_weight);
+  out.f64(o.energy.volume_weight);
+  out.f64(o.energy.spring_scale);
+  out.varint(o.energy.min_crease_edges);
+  out.f64(o.energy.crease_min_length);
   out.u64(o.seed);
   out.f64(o.reference_diagonal);
   out.varint(o.target_faces);
@@ -471,6 +476,13 @@ void read_options(ByteReader& in, SubsetOptions& o) {
   o.samples_per_face = read_not_nan(in, "samples per face");
   o.crease_angle_degrees = read_not_nan(in, "crease angle");
   o.attribute_weight = read_not_nan(in, "attribute weight");
+  o.energy.star_planes_weight = read_not_nan(in, "star planes' weight");
+  o.energy.volume_weight = read_not_nan(in, "volume weight");
+  o.energy.spring_scale = read_not_nan(in, "spring scale");
+  const uint64_t crease_edges = in.varint64();
+  if (crease_edges > UINT32_MAX) in.fail("the minimum crease edges overflow");
+  o.energy.min_crease_edges = uint32_t(crease_edges);
+  o.energy.crease_min_length = read_not_nan(in, "minimum crease length");
   o.seed = in.u64();
   o.reference_diagonal = in.f64();
   if (!(std::isfinite(o.reference_diagonal) && o.reference_diagonal >= 0))

@@ -8,10 +8,13 @@
 // id then each gap minus one). Every message starts with a 4-byte magic naming its kind and a
 // version byte, so that one kind is never decoded as another.
 //
-//   job     "PPJB" 2 | round v, subset v | V v, F v, W v (counts first: checked before
+//   (The version byte is 4 for every kind: 4 added the energy's tuning to the job's options.)
+//   job     "PPJB" 4 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
-//           samples_per_face f64, crease_angle f64, attribute_weight f64, seed u64,
-//           reference_diagonal f64, target_faces v, max_cost f64 | mesh flags u8 (1
+//           samples_per_face f64, crease_angle f64, attribute_weight f64, star_planes_weight
+//           f64, volume_weight f64, spring_scale f64, min_crease_edges v, crease_min_length
+//           f64, seed u64, reference_diagonal f64, target_faces v, max_cost f64,
+//           defer_recosting u8 (0/1) | mesh flags u8 (1
 //           positions_are_float, 2 normals, 4 texcoords, 8 colours, 16 corner wedges, 32
 //           positions stored as f32: set when every coordinate is exactly a float) | per
 //           vertex: position (3 f32 or 3 f64), owned | locked << 1 u8 | global_vertex ids+ |
@@ -30,11 +33,11 @@
 //           k f32; its face or vertex is the one it is written under (export order).
 //   keys    n v, then per key (sorted by (a, b), a < b: edge_keys.h) a minus the previous
 //           key's a v, b - a - 1 v, cost f64 (NaN: the edge cannot be placed).
-//   records "PPCR" 2 | n v | k u8 (floats per changed wedge) | per record: flags u8 (1:
+//   records "PPCR" 4 | n v | k u8 (floats per changed wedge) | per record: flags u8 (1:
 //           positions as f32), vs v, vt v, vl fl vr fr id+1, vs_position vt_position position
 //           (3 f32 or 3 f64 each), corner_wedges 6 x id+1, cost f64, error f32, changed n v,
 //           n ids v, n x k f32.
-//   summary "PPSS" 2 | round v, subset v | state | keys | keys_reused v | faces v,
+//   summary "PPSS" 4 | round v, subset v | state | keys | keys_reused v | faces v,
 //           owned_faces v, free_vertices v | collapses rejected stale reevaluated evaluations
 //           v, stop_reason (length v <= 4096, bytes) | wall_seconds f64, cpu_seconds f64.
 //

@@ -60,6 +60,7 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   options.samples_per_face = job.options.samples_per_face;
   options.crease_angle_degrees = job.options.crease_angle_degrees;
   options.attribute_weight = job.options.attribute_weight;
+  options.energy = job.options.energy;
   options.seed = job.options.seed;
   check_simplify_options(options);
 

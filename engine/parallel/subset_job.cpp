@@ -187,6 +187,7 @@ SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh
   s.samples_per_face = options.samples_per_face;
   s.crease_angle_degrees = options.crease_angle_degrees;
   s.attribute_weight = options.attribute_weight;
+  s.energy = options.energy;
   s.seed = options.seed;
   s.reference_diagonal = bounding_box(mesh).diagonal();
   return s;

@@ -34,6 +34,7 @@ struct SubsetOptions {
   double samples_per_face = 0;
   double crease_angle_degrees = 60;
   double attribute_weight = 0.01;
+  EnergyTuning energy;
   uint64_t seed = 1;  // already mixed with the round and subset index by the extraction
   // The whole mesh's bounding-box diagonal: energy costs are measured against it, so that
   // the costs of different subsets compare (quadric costs are absolute already).

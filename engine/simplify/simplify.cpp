@@ -25,6 +25,22 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
   return 0;
 }
 
+void check_energy_tuning(const EnergyTuning& energy) {
+  auto weight = [](double w, const char* what) {
+    if (!(w >= 0 && w <= 1000))
+      throw_invalid(std::string("the ") + what + " must be in [0, 1000], got " + std::to_string(w));
+  };
+  weight(energy.star_planes_weight, "star planes' weight");
+  weight(energy.volume_weight, "volume weight");
+  weight(energy.spring_scale, "spring scale");
+  if (!(energy.min_crease_edges >= 1 && energy.min_crease_edges <= 1000000))
+    throw_invalid("the minimum crease edges must be in [1, 1000000] (1: every crease), got " +
+                  std::to_string(energy.min_crease_edges));
+  if (!(energy.crease_min_length >= 0 && energy.crease_min_length <= 10))
+    throw_invalid("the minimum crease length must be in [0, 10] bounding-box diagonals, got " +
+                  std::to_string(energy.crease_min_length));
+}
+
 void check_simplify_options(const SimplifyOptions& options) {
   if (options.metric != "quadric" && options.metric != "energy")
     throw_invalid("unknown metric '" + options.metric + "' (available: quadric, energy)");
@@ -37,6 +53,7 @@ void check_simplify_options(const SimplifyOptions& options) {
   if (!(options.samples_per_face >= 0 && options.samples_per_face <= 1000))
     throw_invalid("samples per face must be in [0, 1000], got " +
                   std::to_string(options.samples_per_face));
+  check_energy_tuning(options.energy);
 }
 
 std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired) {
@@ -63,6 +80,11 @@ std::unique_ptr<PriorityModule> make_priority_module(const SimplifyOptions& opti
     energy_options.seed = options.seed;
     energy_options.round_to_float = mesh.positions_are_float;
     energy_options.sharp.crease_angle_degrees = options.crease_angle_degrees;
+    energy_options.sharp.min_crease_edges = options.energy.min_crease_edges;
+    energy_options.sharp.long_crease_diagonals = options.energy.crease_min_length;
+    energy_options.star_planes_weight = options.energy.star_planes_weight;
+    energy_options.volume_weight = options.energy.volume_weight;
+    energy_options.spring_scale = options.energy.spring_scale;
     energy_options.attribute_weight = options.attribute_weight;
     energy_options.reference_diagonal = reference_diagonal;
     return std::make_unique<EnergyPriority>(locked, energy_options,

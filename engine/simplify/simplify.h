@@ -13,6 +13,21 @@
 
 namespace parapm {
 
+// The energy metric's weights and its rule for noise creases, as the build's options (the
+// reasons for each default: EnergyOptions in energy_priority.h, SharpEdgeOptions in
+// sharp_curves.h). They travel in the parallel build's jobs.
+struct EnergyTuning {
+  // The star's planes and volume preservation (Lindstrom-Turk's terms), against E_dist.
+  double star_planes_weight = 10;
+  double volume_weight = 4;
+  // E_spring's kappa: Hoppe's schedule times this.
+  double spring_scale = 0.03;
+  // A crease of fewer edges than this and shorter than crease_min_length x the bounding-box
+  // diagonal is a scan's noise, not a curve to keep (boundaries and seams always are).
+  uint32_t min_crease_edges = 8;
+  double crease_min_length = 0.05;
+};
+
 struct SimplifyOptions {
   // Target size of the base mesh: target_faces when non-zero, else target_ratio of the input
   // faces when non-zero, else as far as collapses stay legal.
@@ -28,6 +43,7 @@ struct SimplifyOptions {
   // geometry: an attribute difference of 1 costs as much as this fraction of the bounding-box
   // diagonal in distance. 0: attributes are not optimised (each wedge keeps its input value).
   double attribute_weight = 0.01;
+  EnergyTuning energy;      // energy: the terms' weights, the noise creases
   uint64_t seed = 1;        // of the randomised steps (the energy's extra points)
   bool keep_order = false;  // store the input's vertex and face order in the PM
   // Re-costing deferred above a tenth of the input's faces (SimplifierLimits::
@@ -55,6 +71,7 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
 // The steps of build_progressive_mesh that the parallel build (engine/parallel) shares.
 // Throws Error(kInvalidInput) for an unknown metric or an option out of range.
 void check_simplify_options(const SimplifyOptions& options);
+void check_energy_tuning(const EnergyTuning& energy);
 // Per vertex of repaired.mesh: 1 when the repair step made copies of its input vertex (such
 // vertices never move, so that the copies of one input vertex never crack apart).
 std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired);

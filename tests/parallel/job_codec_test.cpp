@@ -110,7 +110,13 @@ void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& 
   const SubsetOptions &o = a.options, &p = b.options;
   ASSERT_TRUE(o.metric == p.metric && same_bits(o.samples_per_face, p.samples_per_face) &&
               same_bits(o.crease_angle_degrees, p.crease_angle_degrees) &&
-              same_bits(o.attribute_weight, p.attribute_weight) && o.seed == p.seed &&
+              same_bits(o.attribute_weight, p.attribute_weight) &&
+              same_bits(o.energy.star_planes_weight, p.energy.star_planes_weight) &&
+              same_bits(o.energy.volume_weight, p.energy.volume_weight) &&
+              same_bits(o.energy.spring_scale, p.energy.spring_scale) &&
+              o.energy.min_crease_edges == p.energy.min_crease_edges &&
+              same_bits(o.energy.crease_min_length, p.energy.crease_min_length) &&
+              o.defer_recosting == p.defer_recosting && o.seed == p.seed &&
               same_bits(o.reference_diagonal, p.reference_diagonal) &&
               o.target_faces == p.target_faces && same_bits(o.max_cost, p.max_cost))
       << what;
@@ -157,6 +163,7 @@ std::vector<SubsetJob> jobs_of(const std::string& name, const std::string& metri
   SimplifyOptions options;
   options.metric = metric;
   options.samples_per_face = metric == "energy" ? 1 : 0;  // points on faces, not only parked
+  options.energy = {3.5, 0.25, 0.01, 5, 0.125};           // not the defaults: each must travel
   testing::RoundZero round(name, options, p);
   for (SubsetJob& job : round.jobs) {
     job.options.target_faces = job.mesh.face_count() * 2 / 5;
@@ -332,27 +339,27 @@ TEST(JobCodec, HugeCountsAreRefusedBeforeAllocating) {
   // A job of 3 vertices and 2^40 faces, and one of 2^40 vertices.
   std::string message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(3);  // the codec's version
+    out.u8(4);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), uint64_t(3), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 faces"), std::string::npos) << message;
   EXPECT_NE(message.find("subset job: byte "), std::string::npos) << message;
   message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(3);  // the codec's version
+    out.u8(4);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 vertices"), std::string::npos) << message;
   message = message_of(Kind::kRecords, [&](ByteWriter& out) {
     out.bytes("PPCR", 4);
-    out.u8(3);
+    out.u8(4);
     out.varint(kHuge);
   });
   EXPECT_NE(message.find("1099511627776 records"), std::string::npos) << message;
   // A summary whose energy state claims 2^40 faces.
   message = message_of(Kind::kSummary, [&](ByteWriter& out) {
     out.bytes("PPSS", 4);
-    out.u8(3);
+    out.u8(4);
     out.varint(0);
     out.varint(0);
     out.u8(2);  // energy

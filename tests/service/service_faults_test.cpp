@@ -273,6 +273,12 @@ TEST_F(ServiceFaults, BadUploadsAreRefusedAndTheServerKeepsServing) {
                 .try_submit(mesh_id, options(300, parapm::v1::METRIC_QUADRIC, 0.5), &job)
                 .error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
+  parapm::v1::JobOptions bad_tuning = options(2, parapm::v1::METRIC_ENERGY, 0.5);
+  bad_tuning.mutable_energy()->set_spring_scale(2000);
+  const grpc::Status tuning_status = service().try_submit(mesh_id, bad_tuning, &job);
+  EXPECT_EQ(tuning_status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(tuning_status.error_message().find("spring scale"), std::string::npos)
+      << tuning_status.error_message();
   for (double excess : {0.7, std::nan("")}) {
     parapm::v1::JobOptions bad_excess = options(2, parapm::v1::METRIC_QUADRIC, 0.5);
     bad_excess.set_border_excess(excess);

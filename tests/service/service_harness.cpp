@@ -205,6 +205,16 @@ std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
     args.insert(args.end(),
                 {"--extra-round-faces",
                  std::to_string(o.extra_round_faces() < 0 ? 0 : o.extra_round_faces())});
+  const parapm::v1::EnergyTuning& e = o.energy();
+  auto tuning = [&](const char* flag, double value) {
+    if (value != 0) number(flag, value < 0 ? 0 : value);
+  };
+  tuning("--star-planes-weight", e.star_planes_weight());
+  tuning("--volume-weight", e.volume_weight());
+  tuning("--spring-scale", e.spring_scale());
+  tuning("--crease-min-length", e.crease_min_length());
+  if (e.min_crease_edges() > 0)
+    args.insert(args.end(), {"--crease-min-edges", std::to_string(e.min_crease_edges())});
   if (o.keep_order()) args.push_back("--keep-order");
   return args;
 }

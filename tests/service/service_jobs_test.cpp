@@ -98,9 +98,17 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   const std::set<std::string> names = {"w1", "w2", "w3"};
   build_and_compare("stratocaster-9k.ply", options(4, parapm::v1::METRIC_QUADRIC, 0.05, 7), names);
   // The energy metric's state (points, curves, wedge classes) travels in the subset jobs;
-  // the airplane has colours, so the wedge changes do too.
-  build_and_compare("pymeshlab-colored-airplane-11k.ply",
-                    options(4, parapm::v1::METRIC_ENERGY, 0.02, 3), names);
+  // the airplane has colours, so the wedge changes do too. So does its tuning, here not the
+  // defaults: `--star-planes-weight 3 --volume-weight 0 --spring-scale 0.01
+  // --crease-min-edges 2 --crease-min-length 0.02`.
+  parapm::v1::JobOptions tuned = options(4, parapm::v1::METRIC_ENERGY, 0.02, 3);
+  parapm::v1::EnergyTuning& tuning = *tuned.mutable_energy();
+  tuning.set_star_planes_weight(3);
+  tuning.set_volume_weight(-1);
+  tuning.set_spring_scale(0.01);
+  tuning.set_min_crease_edges(2);
+  tuning.set_crease_min_length(0.02);
+  build_and_compare("pymeshlab-colored-airplane-11k.ply", tuned, names);
   // Extra rounds past the handover (the vessel gets two with a floor of 200 faces a subset),
   // and rounds bounded by a tighter border band, as `parapm simplify --extra-round-faces 200
   // --border-excess 0.02` builds them.
