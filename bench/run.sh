@@ -9,7 +9,8 @@
 #     through ../shared/tools/bench-peers.sh, with metro on their outputs;
 # and prints one TSV table on stdout: mesh, tool, ratio, out_faces, seconds (simplification
 # only, single thread), hausdorff_rel, rms_rel (metro, relative to the bbox diagonal),
-# normal_mean_deg, and for ParaPM the peak memory in bytes per input face.
+# normal_mean_deg, for ParaPM the peak memory in bytes per input face, and the fraction of the
+# output's triangles whose least angle is below 10 degrees (slivers; parapm-triangle-quality).
 # Environment: RATIOS, REPEATS (default 3), METRICS, PEERS (default "meshopt openmesh cgal-gh
 # cgal-lt"; "none" skips them),
 # PEERS_BUILD (default ./.peers-build; built with ../shared/tools/build.sh when missing),
@@ -36,7 +37,11 @@ mkdir -p "$out"
 jget() { sed -nE "s/.*\"$2\":(\"?)([^,\"}]*)\1.*/\2/p" <<< "$1"; }
 median() { tr ' ' '\n' | grep -v '^$' | sort -g | awk '{a[NR]=$1} END{if(NR%2)print a[(NR+1)/2]; else printf "%.6f\n",(a[NR/2]+a[NR/2+1])/2}'; }
 
-printf 'mesh\ttool\tratio\tout_faces\tseconds\thausdorff_rel\trms_rel\tnormal_mean_deg\tbytes_per_face\n'
+quality="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm-triangle-quality"
+[[ -x "$quality" ]] || { echo "no $quality (build the parapm-triangle-quality target)" >&2; exit 2; }
+slivers() { "$quality" "$1" 2> /dev/null | sed -nE 's/.*"below_10_deg":([^,}]*).*/\1/p' || echo NA; }
+
+printf 'mesh\ttool\tratio\tout_faces\tseconds\thausdorff_rel\trms_rel\tnormal_mean_deg\tbytes_per_face\tbelow_10_deg\n'
 for mesh in "$@"; do
   name="$(basename "$mesh")"; name="${name%.[gG][zZ]}"; name="${name%.*}"
   for metric in $metrics; do
@@ -52,14 +57,17 @@ for mesh in "$@"; do
       "$bin" --log-level warn lod "$pm" --faces "$(jget "$js" base_faces)" -o "$base" > /dev/null
       m="$("$peers_build/metro" "$mesh" "$base" 2>/dev/null || echo '{}')"
       bpf=$(( $(jget "$js" peak_memory_bytes) / $(jget "$js" in_faces) ))
-      printf '%s\tparapm-%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$metric" "$ratio" \
+      printf '%s\tparapm-%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$metric" "$ratio" \
         "$(jget "$js" base_faces)" "$(echo $secs | median)" "$(jget "$m" hausdorff_rel)" \
-        "$(jget "$m" rms_rel)" "$(jget "$m" normal_mean_deg)" "$bpf"
+        "$(jget "$m" rms_rel)" "$(jget "$m" normal_mean_deg)" "$bpf" "$(slivers "$base")"
     done
   done
   [[ "$PEERS" == none ]] && continue
   # shellcheck disable=SC2086
   PEERS_BUILD="$peers_build" PEERS_OUT="$out" REPEATS="$repeats" \
     "$shared/tools/bench-peers.sh" "$mesh" $peer_ratios |
-    awk -F'\t' 'NR > 1 { printf "%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t-\n", $1, $2, $3, $4, $5, $6, $7, $11 }'
+    tail -n +2 | while IFS=$'\t' read -r -a f; do
+      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t-\t%s\n' "${f[0]}" "${f[1]}" "${f[2]}" "${f[3]}" \
+        "${f[4]}" "${f[5]}" "${f[6]}" "${f[10]}" "$(slivers "$out/${f[0]}.${f[1]}.r${f[2]}.ply")"
+    done
 done
