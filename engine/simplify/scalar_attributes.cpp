@@ -22,6 +22,7 @@ void ScalarAttributes::initialize(const AttributeLayout& layout, std::vector<flo
   layout_ = layout;
   floats_ = layout.any() && weight > 0 ? layout.floats_per_wedge() : 0;
   if (floats_ > kMaxFloats) throw_internal("scalar attributes: too many floats per wedge");
+  first_costed_ = layout.normals ? layout.normal_offset() + 3 : 0;
   weight_sq_ = weight * weight;
   point_values_.clear();
   residual_.clear();
@@ -52,7 +53,7 @@ double ScalarAttributes::residual_against(uint32_t point, const std::array<Wedge
                                           const std::array<double, 3>& b) const {
   const float* x = point_values_.data() + size_t(point) * size_t(floats_);
   double sum = 0;
-  for (int k = 0; k < floats_; ++k) {
+  for (int k = first_costed_; k < floats_; ++k) {
     const double d = x[k] - (b[0] * value(w[0])[k] + b[1] * value(w[1])[k] + b[2] * value(w[2])[k]);
     sum += d * d;
   }
@@ -150,7 +151,8 @@ std::array<double, ScalarAttributes::kMaxFloats> ScalarAttributes::solve(const G
 double ScalarAttributes::energy(const Group& g, const std::array<double, kMaxFloats>& v) const {
   // sum |rest - b0 v|^2 expanded: c - 2 v b + a v^2, exact for any v.
   double sum = 0;
-  for (int k = 0; k < floats_; ++k) sum += g.c[k] - 2 * v[k] * g.b[k] + g.a * v[k] * v[k];
+  for (int k = first_costed_; k < floats_; ++k)
+    sum += g.c[k] - 2 * v[k] * g.b[k] + g.a * v[k] * v[k];
   return weight_sq_ * std::max(0.0, sum);
 }
 

@@ -17,6 +17,14 @@
 // Only wedges still used by a live corner ever change value, so a wedge's last value is the
 // one it had when its last face was collapsed away: the value the PM's split that brings it
 // back must introduce (pm_builder.cpp).
+//
+// Normals are solved like the rest (the unit direction of the least-squares fit) but their
+// error is not part of the energy, so it does not order the collapses: normals follow the
+// geometry, and costing them made both worse. On horse-97k (normals only) E_scalar's normal
+// term at the default weight ruled the order: 13x / 9x / 10x the geometric RMS at 50 / 10 /
+// 2% of the faces, 18% slivers against 0.3%, and normals 5.2 / 10.2 / 20.1 degrees off against
+// 2.0 / 4.1 / 10.0 with them fitted but not costed (docs/BENCHMARKS.md, "Normals follow the
+// geometry").
 #pragma once
 
 #include <array>
@@ -99,6 +107,9 @@ class ScalarAttributes {
 
   AttributeLayout layout_;
   int floats_ = 0;
+  // The first float that E_scalar costs: normals (the first three when present) are solved
+  // like the other attributes but cost nothing (see the top).
+  int first_costed_ = 0;
   double weight_sq_ = 0;
   std::vector<float> values_;        // per wedge, the current values
   std::vector<WedgeId> parent_;      // union-find of wedge classes
