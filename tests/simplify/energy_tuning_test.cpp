@@ -10,6 +10,7 @@
 #include "io/mesh_io.h"
 #include "mesh/repair.h"
 #include "pm/pm_file.h"
+#include "simplify/energy_priority.h"
 #include "simplify/simplify.h"
 #include "test_support.h"
 
@@ -47,6 +48,18 @@ TEST(EnergyTuning, EveryKnobReachesTheMetric) {
     change(changed.energy);
     EXPECT_NE(pm_bytes(build_progressive_mesh(repaired, changed)), defaults) << name;
   }
+}
+
+// The build options' defaults are the metric's own (two places hold them: the options a user
+// sees, and the module's, which its header explains).
+TEST(EnergyTuning, DefaultsAreTheMetricsDefaults) {
+  const EnergyTuning tuning;
+  const EnergyOptions energy;
+  EXPECT_EQ(tuning.star_planes_weight, energy.star_planes_weight);
+  EXPECT_EQ(tuning.volume_weight, energy.volume_weight);
+  EXPECT_EQ(tuning.spring_scale, energy.spring_scale);
+  EXPECT_EQ(tuning.min_crease_edges, energy.sharp.min_crease_edges);
+  EXPECT_EQ(tuning.crease_min_length, energy.sharp.long_crease_diagonals);
 }
 
 TEST(EnergyTuning, ValuesOutOfRangeAreErrorsNamingTheKnob) {
