@@ -559,9 +559,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // reach, which the next round takes in parallel.
     t = std::chrono::steady_clock::now();
     if (parallel.band_pass && round >= 1) {
-      std::vector<uint8_t> lagging(bound.size());
-      for (size_t v = 0; v < bound.size(); ++v) lagging[v] = bound[v] && bound_before[v];
-      BandPriority band(keys, std::move(lagging), ceiling);
+      // The last round's bound vertices become the lagging ones: bound in this round too.
+      for (size_t v = 0; v < bound.size(); ++v) bound_before[v] &= bound[v];
+      BandPriority band(keys, std::move(bound_before), ceiling);
       Simplifier pass(whole, band, standard_constraints(locked));
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
