@@ -221,10 +221,9 @@ parapm::v1::Job Coordinator::cancel(const std::string& job_id) {
   if (cancelled_queued) {
     record.status = JobStatus::kCancelled;
     record.updated_unix_ms = unix_ms_now();
-    store_.update_job(record);
     parapm::v1::JobEvent event;
     event.mutable_cancelled();
-    emit(job_id, event);
+    end_job(record, event);
     spdlog::info("job {}: cancelled while queued", job_id);
   }
   return to_proto(load_job(job_id));
@@ -234,6 +233,13 @@ void Coordinator::emit(const std::string& job_id, parapm::v1::JobEvent event) {
   event.set_job_id(job_id);
   event.set_unix_ms(unix_ms_now());
   store_.append_event(job_id, event.unix_ms(), event.SerializeAsString());
+  events_changed_.notify_all();
+}
+
+void Coordinator::end_job(const JobRecord& record, parapm::v1::JobEvent terminal) {
+  terminal.set_job_id(record.job_id);
+  terminal.set_unix_ms(unix_ms_now());
+  store_.end_job(record, terminal.unix_ms(), terminal.SerializeAsString());
   events_changed_.notify_all();
 }
 
@@ -317,7 +323,6 @@ void Coordinator::run_job(const std::string& job_id) {
     record.status = JobStatus::kDone;
     record.seconds = seconds_since(start);
     record.updated_unix_ms = unix_ms_now();
-    store_.update_job(record);
     parapm::v1::JobEvent event;
     auto* done = event.mutable_finished();
     done->set_base_faces(record.base_faces);
@@ -325,7 +330,7 @@ void Coordinator::run_job(const std::string& job_id) {
     done->set_seconds(record.seconds);
     done->set_pm_sha256(record.pm_sha256);
     *done->mutable_transport() = transport;
-    emit(job_id, event);
+    end_job(record, event);
     spdlog::info("job {} done: {} -> {} faces, {} vsplits in {:.3f} s", job_id, record.input_faces,
                  record.base_faces, record.vsplits, record.seconds);
   } catch (const Error& e) {
@@ -351,17 +356,15 @@ void Coordinator::run_job(const std::string& job_id) {
       }
       record.seconds = seconds_since(start);
       record.updated_unix_ms = unix_ms_now();
-      store_.update_job(record);
-      emit(job_id, event);
+      end_job(record, event);
     }
   } catch (const std::exception& e) {
     record.status = JobStatus::kFailed;
     record.failure_reason = std::string("internal error: ") + e.what();
     record.updated_unix_ms = unix_ms_now();
-    store_.update_job(record);
     parapm::v1::JobEvent event;
     event.mutable_failed()->set_reason(record.failure_reason);
-    emit(job_id, event);
+    end_job(record, event);
     spdlog::error("job {} failed: {}", job_id, record.failure_reason);
   }
   std::lock_guard lock(mutex_);

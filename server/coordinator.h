@@ -105,6 +105,8 @@ class Coordinator {
   void run_job(const std::string& job_id);
   void execute(JobRecord& record, Running& running, parapm::v1::JobEvent::Transport& transport);
   void emit(const std::string& job_id, parapm::v1::JobEvent event);
+  // Stores the job's final state and its terminal event together (JobStore::end_job).
+  void end_job(const JobRecord& record, parapm::v1::JobEvent terminal);
   parapm::v1::Job to_proto(const JobRecord& record);
   JobRecord load_job(const std::string& job_id);  // kNotFound
   JobRecord done_job(const std::string& job_id);  // kFailedPrecondition unless done

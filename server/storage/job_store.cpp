@@ -183,6 +183,19 @@ std::optional<JobRecord> JobStore::find_job(const std::string& job_id) const {
 
 void JobStore::update_job(const JobRecord& job) {
   std::lock_guard lock(mutex_);
+  update_job_locked(job);
+}
+
+uint64_t JobStore::end_job(const JobRecord& job, int64_t unix_ms, std::string_view terminal_event) {
+  std::lock_guard lock(mutex_);
+  sqlite::Transaction transaction(*db_, "ending job " + job.job_id);
+  update_job_locked(job);
+  const uint64_t seq = append_event_locked(job.job_id, unix_ms, terminal_event);
+  transaction.commit();
+  return seq;
+}
+
+void JobStore::update_job_locked(const JobRecord& job) {
   sqlite::Statement update(*db_,
                            "UPDATE jobs SET mesh_id = ?2, options = ?3, status = ?4, "
                            "failure_reason = ?5, pm_sha256 = ?6, input_faces = ?7, "
@@ -229,6 +242,11 @@ std::vector<JobRecord> JobStore::jobs_with_status(std::initializer_list<JobStatu
 uint64_t JobStore::append_event(const std::string& job_id, int64_t unix_ms,
                                 std::string_view payload) {
   std::lock_guard lock(mutex_);
+  return append_event_locked(job_id, unix_ms, payload);
+}
+
+uint64_t JobStore::append_event_locked(const std::string& job_id, int64_t unix_ms,
+                                       std::string_view payload) {
   // One statement picks the next seq and inserts it, atomically: even a second process on
   // the same file could not take the same seq (the primary key would refuse it).
   sqlite::Statement insert(*db_,

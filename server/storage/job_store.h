@@ -61,8 +61,16 @@ class JobStore {
   uint64_t append_event(const std::string& job_id, int64_t unix_ms, std::string_view payload);
   // The job's events with seq > after_seq, ascending (after_seq 0: all of them).
   std::vector<EventRecord> events(const std::string& job_id, uint64_t after_seq) const;
+  // update_job and append_event in one transaction: a job's final state and its terminal
+  // event (finished, failed, cancelled), so that no reader sees one without the other (a
+  // watcher that finds the job ended must find its last event too). Returns the event's seq.
+  uint64_t end_job(const JobRecord& job, int64_t unix_ms, std::string_view terminal_event);
 
  private:
+  void update_job_locked(const JobRecord& job);
+  uint64_t append_event_locked(const std::string& job_id, int64_t unix_ms,
+                               std::string_view payload);
+
   mutable std::mutex mutex_;
   std::unique_ptr<sqlite::Database> db_;  // guarded by mutex_
 };

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <set>
 #include <string>
 #include <thread>
@@ -98,6 +99,55 @@ TEST_F(JobEventsTest, ConcurrentAppendsGetDistinctIncreasingSeqs) {
   const std::vector<EventRecord> stored = store_.events("job-a", 0);
   ASSERT_EQ(stored.size(), all.size());
   for (size_t i = 0; i < stored.size(); ++i) EXPECT_EQ(stored[i].seq, i + 1);
+}
+
+// A job's end (its final status and its terminal event) is one transaction: the event takes
+// the next seq, and a reader never sees the status without the event. A watcher that found a
+// job done but not its "finished" event used to end its stream without it (seen once in eight
+// concurrent service jobs, when the status was written before the event).
+TEST_F(JobEventsTest, EndingAJobStoresItsStatusAndLastEventTogether) {
+  EXPECT_EQ(store_.append_event("job-a", 10, "started"), 1u);
+  JobRecord job = *store_.find_job("job-a");
+  job.status = JobStatus::kDone;
+  EXPECT_EQ(store_.end_job(job, 11, "finished"), 2u);
+  EXPECT_EQ(store_.find_job("job-a")->status, JobStatus::kDone);
+  const std::vector<EventRecord> events = store_.events("job-a", 0);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[1].payload, "finished");
+  EXPECT_EQ(events[1].unix_ms, 11);
+
+  JobRecord ghost = job;
+  ghost.job_id = "job-ghost";
+  expect_error([&] { store_.end_job(ghost, 12, "finished"); }, ErrorCode::kNotFound, {"job-ghost"});
+  EXPECT_TRUE(store_.events("job-ghost", 0).empty());
+
+  // Many jobs ended on one thread while another reads each job's status, then its events.
+  constexpr int kJobs = 300;
+  for (int i = 0; i < kJobs; ++i) {
+    JobRecord j;
+    j.job_id = "job-" + std::to_string(i);
+    j.mesh_id = "mesh-1";
+    store_.add_job(j);
+  }
+  std::atomic<bool> writing{true};
+  std::thread writer([&] {
+    for (int i = 0; i < kJobs; ++i) {
+      JobRecord j = *store_.find_job("job-" + std::to_string(i));
+      j.status = JobStatus::kDone;
+      store_.end_job(j, 20, "finished");
+    }
+    writing = false;
+  });
+  int seen_done = 0, missing = 0;
+  while (writing)
+    for (int i = 0; i < kJobs; ++i) {
+      const std::string id = "job-" + std::to_string(i);
+      if (store_.find_job(id)->status != JobStatus::kDone) continue;
+      ++seen_done;
+      if (store_.events(id, 0).empty()) ++missing;
+    }
+  writer.join();
+  EXPECT_EQ(missing, 0) << "of " << seen_done << " jobs read as done";
 }
 
 }  // namespace
