@@ -7,7 +7,8 @@
 # PS (default "2 4 8 16") with the extra options PAR_ARGS (e.g. "--border-excess 0"), and
 # prints one TSV row per mesh and p: metro's RMS and Hausdorff of the parallel level over the
 # sequential level of the same face count at 50%, 10% and 2% of the input faces (1.000: as
-# good), the rounds performed and the parallel build's seconds. A summary per p follows on
+# good), the rounds performed, the parallel build's seconds and its work (CPU over the sequential
+# build's seconds). A summary per p follows on
 # stderr and in BENCH_OUT/LABEL.summary: geometric means over the meshes, cells above 1.05
 # (RMS) and 1.10 (Hausdorff), the worst cell.
 # Timing is not the point here (see bench/parallel.sh): meshes run JOBS at a time (default 2).
@@ -57,8 +58,11 @@ one_mesh() {
     pj="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$METRIC" --ratio "$RATIO" \
       --parallel "$p" --threads 1 $PAR_ARGS --json)"
     local row
-    row="$(printf '%s\t%s\t%s\t%s\t%.2f' "$name" "$LABEL" "$p" "$(jq -r .parallel.rounds <<< "$pj")" \
-      "$(jq -r .seconds <<< "$pj")")"
+    # work: the parallel build's CPU (jobs, merges, passes) over the sequential build's seconds
+    row="$(printf '%s\t%s\t%s\t%s\t%.2f\t%.2f' "$name" "$LABEL" "$p" \
+      "$(jq -r .parallel.rounds <<< "$pj")" "$(jq -r .seconds <<< "$pj")" \
+      "$(jq -n --argjson a "$(jq .parallel.cpu_seconds <<< "$pj")" \
+        --argjson b "$(jq .seconds "$seq_json")" '$a / $b')")"
     for level in 50 10 2; do
       n=$(( in_faces * level / 100 ))
       local prms phd srms shd
@@ -74,14 +78,14 @@ one_mesh() {
 export -f one_mesh
 
 tsv="$OUT/$LABEL.tsv"
-printf 'mesh\tlabel\tp\trounds\tseconds\trms_50\thd_50\trms_10\thd_10\trms_2\thd_2\n' | tee "$tsv"
+printf 'mesh\tlabel\tp\trounds\tseconds\twork\trms_50\thd_50\trms_10\thd_10\trms_2\thd_2\n' | tee "$tsv"
 printf '%s\n' "$@" | xargs -P "${JOBS:-2}" -I{} bash -c 'one_mesh "$1"' _ {} | tee -a "$tsv"
 
 # Geometric means per p and level; cells above 1.05 (RMS) / 1.10 (Hausdorff); the worst.
 awk -F'\t' 'NR > 1 {
-    p = $3; n[p]++
+    p = $3; n[p]++; lw[p] += log($6); sr[p] += $4
     for (k = 0; k < 3; k++) {
-      r = $(6 + 2 * k); h = $(7 + 2 * k)
+      r = $(7 + 2 * k); h = $(8 + 2 * k)
       lr[p, k] += log(r); lh[p, k] += log(h)
       if (r > 1.05) cr[p, k]++
       if (h > 1.10) ch[p, k]++
@@ -91,7 +95,7 @@ awk -F'\t' 'NR > 1 {
   END {
     split("50 10 2", lv, " ")
     for (p in n) {
-      line = sprintf("p = %s (%d meshes):", p, n[p])
+      line = sprintf("p = %s (%d meshes): rounds %.1f, work %.2f;", p, n[p], sr[p] / n[p], exp(lw[p] / n[p]))
       for (k = 0; k < 3; k++)
         line = line sprintf("  %s%% RMS %.3f (%d above 1.05, worst %.3f %s), Hausdorff %.3f (%d above 1.1)",
           lv[k + 1], exp(lr[p, k] / n[p]), cr[p, k], wr[p, k], wm[p, k], exp(lh[p, k] / n[p]), ch[p, k])

@@ -34,6 +34,7 @@ struct SimplifyArgs {
   double handover = ParallelOptions{}.handover_ratio;
   double border_excess = ParallelOptions{}.border_excess;
   uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
+  uint64_t min_subset_faces = ParallelOptions{}.min_subset_faces;
   bool no_carry_keys = false;
   bool no_deferred_recosting = false;
   bool json = false;
@@ -114,6 +115,7 @@ int run_simplify(const SimplifyArgs& args) {
     parallel.handover_ratio = args.handover;
     parallel.border_excess = args.border_excess;
     parallel.extra_round_subset_faces = args.extra_round_faces;
+    parallel.min_subset_faces = args.min_subset_faces;
     parallel.carry_keys = !args.no_carry_keys;
     pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
                                          bar.callback(), nullptr);
@@ -289,6 +291,11 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                   "next would leave each subset at least this many faces and the last one removed "
                   "at least 90% of what it was asked (or at least half, with 2.5x as many faces "
                   "per subset) (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--min-subset-faces", args->min_subset_faces,
+                  "With --parallel: every round cuts the mesh into at most (its faces / this) "
+                  "subsets, so a small mesh gets fewer than P (below 2, the rounds end and the "
+                  "final pass does the rest); 0: P subsets in every scheduled round")
       ->capture_default_str();
   cmd->add_flag("--no-carry-keys", args->no_carry_keys,
                 "With --parallel: every round's jobs cost all their edges again instead of "

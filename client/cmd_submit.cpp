@@ -26,6 +26,7 @@ struct SubmitArgs {
   double attribute_weight = 0.01;
   double handover = 0;
   int64_t extra_round_faces = -1;  // -1: not given (the coordinator's default)
+  int64_t min_subset_faces = -1;   // -1: not given (the coordinator's default)
   double border_excess = -1;       // negative: not given (the coordinator's default)
   // The energy's tuning; negative: not given (the coordinator's default).
   double star_planes_weight = -1, volume_weight = -1, spring_scale = -1, crease_min_length = -1;
@@ -66,6 +67,8 @@ int run_submit(SubmitArgs& args) {
     o.set_border_excess(args.border_excess == 0 ? -1 : args.border_excess);
   if (args.extra_round_faces >= 0)
     o.set_extra_round_faces(args.extra_round_faces == 0 ? -1 : args.extra_round_faces);
+  if (args.min_subset_faces >= 0)
+    o.set_min_subset_faces(args.min_subset_faces == 0 ? -1 : args.min_subset_faces);
   // The energy's tuning: 0 is the default to the API, a negative number asks for 0.
   parapm::v1::EnergyTuning& e = *o.mutable_energy();
   auto tuning = [](double given, auto set) {
@@ -167,6 +170,10 @@ void add_submit_command(CLI::App& app, int& exit_code) {
                   "past the handover, more rounds while every subset keeps this many faces and "
                   "the last round did 90% of its share (2.5x as many faces after one that did "
                   "half) (default 2000; 0: none)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
+  cmd->add_option("--min-subset-faces", args->min_subset_faces,
+                  "every round cuts the mesh into at most (its faces / this) subsets (default "
+                  "2000; 0: P subsets in every scheduled round)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
   cmd->add_option("--seed", args->seed, "seed of the randomised steps")->capture_default_str();
   cmd->add_option("--samples-per-face", args->samples_per_face, "energy: extra sample points")

@@ -85,6 +85,8 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
   if (options.extra_round_faces() < 0) p.extra_round_subset_faces = 0;
   if (options.extra_round_faces() > 0)
     p.extra_round_subset_faces = uint64_t(options.extra_round_faces());
+  if (options.min_subset_faces() < 0) p.min_subset_faces = 0;
+  if (options.min_subset_faces() > 0) p.min_subset_faces = uint64_t(options.min_subset_faces());
   return spec;
 }
 

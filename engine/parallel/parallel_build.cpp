@@ -50,6 +50,13 @@ std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
   return vertex_subset;
 }
 
+// The subsets of a round starting at `faces` (ParallelOptions::min_subset_faces); below 2 (with
+// p >= 2), no round.
+uint32_t round_subsets(const ParallelOptions& parallel, uint64_t faces) {
+  if (parallel.min_subset_faces == 0 || parallel.subsets < 2) return parallel.subsets;
+  return uint32_t(std::min<uint64_t>(parallel.subsets, faces / parallel.min_subset_faces));
+}
+
 void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
   if (parallel.subsets < 1 || parallel.subsets > kMaxPartitionSubsets)
     throw_invalid("the subset count p must be in [1, 256], got " +
@@ -308,8 +315,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // initialisation (both read `whole`, neither through its marks; each writes its own data).
   std::vector<uint32_t> first_partition;
   double first_partition_seconds = 0, initialize_seconds = 0;
-  const bool first_round =
-      whole.live_vertices() >= 4 * size_t(parallel.subsets) && whole.live_faces() > handover;
+  const uint32_t first_subsets = round_subsets(parallel, whole.live_faces());
+  const bool first_round = first_subsets >= std::min(2u, parallel.subsets) &&
+                           whole.live_vertices() >= 4 * size_t(first_subsets) &&
+                           whole.live_faces() > handover;
   auto initialize_master = [&] {
     const auto ti = std::chrono::steady_clock::now();
     master->initialize(whole);
@@ -319,7 +328,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     const auto tp = std::chrono::steady_clock::now();
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options.seed, 0);
-    first_partition = partition_live(whole, parallel.subsets, partition_options);
+    first_partition = partition_live(whole, first_subsets, partition_options);
     first_partition_seconds = seconds_since(tp);
   };
   const auto section = std::chrono::steady_clock::now();
@@ -366,9 +375,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
   for (uint32_t round = 0; round < 64; ++round) {
     RoundStats rs;
     rs.round = round;
-    uint32_t subsets = parallel.subsets;  // of this round
     rs.faces_before = whole.live_faces();
-    if (whole.live_vertices() < 4 * size_t(parallel.subsets)) break;
+    uint32_t subsets = round_subsets(parallel, rs.faces_before);  // of this round
+    if (subsets < std::min(2u, parallel.subsets)) break;
+    if (whole.live_vertices() < 4 * size_t(subsets)) break;
     const bool scheduled = scheduled_left > 0;
     if (scheduled) {
       if (rs.faces_before <= handover) break;
@@ -396,7 +406,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (rs.goal_faces >= rs.faces_before) break;
       // Narrower rounds once p subsets would leave fewer faces each than the floor: the mesh
       // keeps shrinking in parallel, and the sequential final pass stays short at any p.
-      subsets = uint32_t(std::min<uint64_t>(parallel.subsets, rs.goal_faces / floor));
+      subsets = uint32_t(std::min<uint64_t>(subsets, rs.goal_faces / floor));
       if (subsets < 2) break;
     }
 

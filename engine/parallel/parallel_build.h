@@ -41,6 +41,13 @@ struct ParallelOptions {
   // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds", "Extra
   // rounds after a short round").
   uint64_t extra_round_subset_faces = 2000;
+  // Every round cuts the mesh into at most (its faces / this) subsets (at least 2, else the
+  // rounds end and the final pass does the rest): a subset of few faces is mostly border, which
+  // its job cannot touch, and a round whose border band is a large part of the mesh is shortened
+  // by border_excess, so that a small mesh cut in many subsets took many short rounds of fixed
+  // work (partition, extraction, merge) for few collapses each. 0: p subsets in every scheduled
+  // round.
+  uint64_t min_subset_faces = 2000;
   // The most a round's border band may hold back, as a fraction of the faces the round ends
   // with. A round cannot remove the faces along its cut (subset_rule.h, border_faces); they
   // stay at the resolution the round started from while the rest goes on, so every level

@@ -30,6 +30,9 @@ ParallelOptions with_p(uint32_t p, unsigned threads = 0, uint32_t rounds = 3) {
   parallel.subsets = p;
   parallel.threads = threads;
   parallel.rounds = rounds;
+  // p subsets in every round: the committed meshes are small, and these tests are about the
+  // rounds (SmallMeshesTakeFewerSubsets is about the cap).
+  parallel.min_subset_faces = 0;
   return parallel;
 }
 
@@ -431,6 +434,39 @@ TEST(ParallelBuild, RoundsBoundedByTheirBorderBand) {
                 bounded_inputs, stats.round_stats.size(), geometric_inputs);
     EXPECT_LT(bounded_inputs, geometric_inputs) << "p = " << p;
   }
+}
+
+// A round cuts the mesh into at most (its faces / min_subset_faces) subsets: the 20k-face
+// vessel at p = 16 gets 10 subsets in its first round and fewer as it shrinks (never below 2),
+// and it takes fewer rounds (each of fixed work: partition,
+// extraction, merge) than with 16 subsets of 1.2k faces, a fifth of which are border band.
+TEST(ParallelBuild, SmallMeshesTakeFewerSubsets) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
+  const SimplifyOptions options = metric_options("energy", 0.01);
+  ParallelOptions capped;  // the defaults
+  capped.subsets = 16;
+  ASSERT_EQ(capped.min_subset_faces, 2000u);
+  ParallelStats stats, uncapped_stats;
+  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, capped, &stats);
+  ASSERT_FALSE(stats.round_stats.empty());
+  EXPECT_EQ(stats.round_stats[0].subsets.size(), repaired.mesh.face_count() / 2000);
+  for (const RoundStats& r : stats.round_stats) {
+    EXPECT_GE(r.subsets.size(), 2u) << "round " << r.round;
+    EXPECT_LE(r.subsets.size(), r.faces_before / 2000) << "round " << r.round;
+  }
+  const MeshDifference diff =
+      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
+  EXPECT_TRUE(diff.equal) << diff.first_difference;
+
+  ParallelOptions uncapped = capped;
+  uncapped.min_subset_faces = 0;
+  const ProgressiveMesh all =
+      build_progressive_mesh_parallel(repaired, options, uncapped, &uncapped_stats);
+  EXPECT_EQ(uncapped_stats.round_stats[0].subsets.size(), 16u);
+  std::printf("gmsh-aneurysm-20k p=16: %zu rounds capped (first on %zu subsets), %zu with 16\n",
+              stats.round_stats.size(), stats.round_stats[0].subsets.size(),
+              uncapped_stats.round_stats.size());
+  EXPECT_LT(stats.round_stats.size(), uncapped_stats.round_stats.size());
 }
 
 // Rounds 0 (the default) schedules them by p: two at p = 2, three above (default_rounds).

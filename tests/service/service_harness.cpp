@@ -205,6 +205,9 @@ std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
     args.insert(args.end(),
                 {"--extra-round-faces",
                  std::to_string(o.extra_round_faces() < 0 ? 0 : o.extra_round_faces())});
+  if (o.min_subset_faces() != 0)
+    args.insert(args.end(), {"--min-subset-faces",
+                             std::to_string(o.min_subset_faces() < 0 ? 0 : o.min_subset_faces())});
   const parapm::v1::EnergyTuning& e = o.energy();
   auto tuning = [&](const char* flag, double value) {
     if (value != 0) number(flag, value < 0 ? 0 : value);

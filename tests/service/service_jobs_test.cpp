@@ -64,7 +64,8 @@ class ServiceJobs : public ServiceTest {
   // Uploads `file`, builds with `options`, and checks the job, its events and its PM against
   // the in-process build. Returns the PM.
   std::string build_and_compare(const std::string& file, const parapm::v1::JobOptions& options,
-                                const std::set<std::string>& worker_names) {
+                                const std::set<std::string>& worker_names,
+                                WatchResult* events = nullptr) {
     const parapm::v1::UploadReply upload = service().upload_file(mesh(file));
     EXPECT_GT(upload.faces(), 0u);
     EXPECT_EQ(upload.content_sha256().size(), 64u);
@@ -89,6 +90,7 @@ class ServiceJobs : public ServiceTest {
                                 << " bytes) differs from parapm simplify's (" << expected.size()
                                 << " bytes)";
     EXPECT_EQ(lossless_failure(pm, mesh(file), dir()), "");
+    if (events) *events = std::move(watched);
     return pm;
   }
 };
@@ -116,6 +118,30 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   extra.set_extra_round_faces(200);
   extra.set_border_excess(0.02);
   build_and_compare("gmsh-aneurysm-20k.stl.gz", extra, names);
+  // At p = 12 the 20k-face vessel's rounds take at most one subset per 2000 faces (the
+  // default, as `parapm simplify` builds it: 10 in round 0), or 12 in every round with
+  // `--min-subset-faces 0` (negative in the message).
+  for (const int64_t min_subset_faces : {0, -1}) {
+    parapm::v1::JobOptions capped = options(12, parapm::v1::METRIC_QUADRIC, 0.01);
+    capped.set_min_subset_faces(min_subset_faces);
+    WatchResult watched;
+    build_and_compare("gmsh-aneurysm-20k.stl.gz", capped, names, &watched);
+    size_t rounds = 0;
+    for (const JobEvent& e : watched.events) {
+      if (!e.has_partitioned()) continue;
+      const auto& partitioned = e.partitioned();
+      if (min_subset_faces < 0) {
+        EXPECT_EQ(partitioned.subsets(), 12u) << describe(e);
+      } else {
+        EXPECT_LE(partitioned.subsets(), partitioned.faces() / 2000) << describe(e);
+        if (partitioned.round() == 0) {
+          EXPECT_EQ(partitioned.subsets(), 10u) << describe(e);
+        }
+      }
+      ++rounds;
+    }
+    EXPECT_GT(rounds, 0u);
+  }
 
   // The same bytes again: the same mesh.
   const auto first = service().upload_file(mesh("stratocaster-9k.ply"));
