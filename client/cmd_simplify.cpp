@@ -28,6 +28,7 @@ struct SimplifyArgs {
   EnergyTuning energy;
   uint64_t seed = 1;
   bool keep_order = false;
+  bool free_copies = false;
   uint32_t parallel = 1;  // subsets p; 1: the sequential build
   unsigned threads = 0;   // 0: min(p, hardware threads)
   uint32_t rounds = ParallelOptions{}.rounds;
@@ -102,6 +103,7 @@ int run_simplify(const SimplifyArgs& args) {
   options.energy = args.energy;
   options.seed = args.seed;
   options.keep_order = args.keep_order;
+  options.free_copies = args.free_copies;
   options.defer_recosting = !args.no_deferred_recosting;
   SimplifyStats stats;
   ParallelStats parallel_stats;
@@ -257,6 +259,13 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_flag("--keep-order", args->keep_order,
                 "Store the input's vertex and face order, and keep unreferenced vertices");
+  cmd->add_flag("--free-copies", args->free_copies,
+                "Let the copies the repair makes of a non-manifold input vertex (one per sheet "
+                "meeting there) simplify like any vertex: coarser levels reach further and stay "
+                "closer to the input, but the sheets part at coarse levels (cracks, far wider "
+                "than the level's distance error: docs/BENCHMARKS.md). Default: the copies never "
+                "move, and are most of what remains at coarse levels of a mesh with many of "
+                "them");
   cmd->add_option("--parallel", args->parallel,
                   "Build with P subsets simplified in parallel (Langis 1999): --rounds rounds, "
                   "each partitioning the current mesh anew and simplifying the subsets in "

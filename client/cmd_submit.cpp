@@ -32,6 +32,7 @@ struct SubmitArgs {
   double star_planes_weight = -1, volume_weight = -1, spring_scale = -1, crease_min_length = -1;
   int64_t crease_min_edges = -1;
   bool keep_order = false;
+  bool free_copies = false;
   bool wait = false;
   bool json = false;
 };
@@ -80,6 +81,7 @@ int run_submit(SubmitArgs& args) {
   tuning(args.crease_min_length, [&](double v) { e.set_crease_min_length(v); });
   if (args.crease_min_edges > 0) e.set_min_crease_edges(uint32_t(args.crease_min_edges));
   o.set_keep_order(args.keep_order);
+  o.set_free_copies(args.free_copies);
   parapm::v1::Job job;
   {
     auto context = client.context();
@@ -206,6 +208,9 @@ void add_submit_command(CLI::App& app, int& exit_code) {
                   "energy: E_spring's kappa times this (default 0.03; 0: no springs)")
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_flag("--keep-order", args->keep_order, "store the input's vertex and face order");
+  cmd->add_flag("--free-copies", args->free_copies,
+                "the repair's copies of a non-manifold input vertex simplify like any vertex "
+                "(coarser levels; the sheets part at coarse levels: cracks)");
   cmd->add_flag("--wait", args->wait, "follow the job to its end with a progress bar");
   cmd->add_flag("--json", args->json, "print the job as one JSON object");
   add_connection_options(cmd, args->connection);

@@ -68,6 +68,7 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
   if (e.min_crease_edges() > 0) s.energy.min_crease_edges = e.min_crease_edges();
   s.seed = options.seed() ? options.seed() : 1;
   s.keep_order = options.keep_order();
+  s.free_copies = options.free_copies();
   check_simplify_options(s);
 
   p.subsets = options.parallelism() ? options.parallelism() : default_parallelism;

@@ -300,7 +300,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   const uint64_t target = target_face_count(input_faces, options);
   const uint64_t handover = std::max<uint64_t>(
       target, uint64_t(std::llround(parallel.handover_ratio * double(input_faces))));
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const std::vector<uint8_t> locked = locked_vertices(repaired, options.free_copies);
   // Above it, edges are costed when they reach the top of the queue (SimplifierLimits).
   const uint64_t defer_line = defer_recosting_line(input_faces);
 

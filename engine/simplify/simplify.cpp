@@ -56,10 +56,10 @@ void check_simplify_options(const SimplifyOptions& options) {
   check_energy_tuning(options.energy);
 }
 
-std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired) {
+std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired, bool free_copies) {
   const Mesh& mesh = repaired.mesh;
   std::vector<uint8_t> locked(mesh.vertex_count(), 0);
-  if (repaired.input_vertex.empty()) return locked;
+  if (repaired.input_vertex.empty() || free_copies) return locked;
   std::vector<uint32_t> uses(mesh.vertex_count(), 0);
   for (VertexId in : repaired.input_vertex) {
     if (in >= uses.size()) uses.resize(size_t(in) + 1, 0);
@@ -104,7 +104,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
 
   // Vertices the repair step duplicated (non-manifold input) stay where they are, so that the
   // copies of one input vertex never drift apart and open a crack.
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const std::vector<uint8_t> locked = locked_vertices(repaired, options.free_copies);
   CollapseMesh working(mesh);
   std::unique_ptr<PriorityModule> priority = make_priority_module(options, mesh, locked);
   Simplifier simplifier(working, *priority, standard_constraints(locked));

@@ -46,6 +46,15 @@ struct SimplifyOptions {
   EnergyTuning energy;      // energy: the terms' weights, the noise creases
   uint64_t seed = 1;        // of the randomised steps (the energy's extra points)
   bool keep_order = false;  // store the input's vertex and face order in the PM
+  // The repair splits a non-manifold input vertex into copies, one per sheet meeting there.
+  // false: the copies never move (locked_vertices), so the sheets meet at every level; they and
+  // their edges are then what remains at coarse levels (the 203k dragon: 10.5k faces at least,
+  // 65% of its 10% level's vertices). true: they simplify like any vertex, and the sheets part
+  // at coarse levels (cracks), by far more than the level's distance error: at 10% of the
+  // faces, the dragon's copies are 0.17% of the diagonal apart on average (10x its RMS error),
+  // up to 3.2%; cad-cycloidal-43k's 1.6-1.9% on average, up to 6.8-7.4% (pm/copy_separation.h).
+  // Full resolution is exact either way.
+  bool free_copies = false;
   // Re-costing deferred above a tenth of the input's faces (SimplifierLimits::
   // defer_above_faces; the energy only). Off: every edge around a collapse is costed at once
   // (for measuring what deferral saves; the PM differs a little).
@@ -73,8 +82,9 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
 void check_simplify_options(const SimplifyOptions& options);
 void check_energy_tuning(const EnergyTuning& energy);
 // Per vertex of repaired.mesh: 1 when the repair step made copies of its input vertex (such
-// vertices never move, so that the copies of one input vertex never crack apart).
-std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired);
+// vertices never move, so that the copies of one input vertex never crack apart); all 0 with
+// `free_copies` (SimplifyOptions::free_copies).
+std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired, bool free_copies = false);
 class PriorityModule;
 // The priority module of options.metric for `mesh` (per vertex `locked`). reference_diagonal:
 // the scale energy costs are measured against; 0 means mesh's own bounding-box diagonal (a

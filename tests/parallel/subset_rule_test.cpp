@@ -153,8 +153,11 @@ TEST(SubsetRule, BorderFacesAreWhatNoJobCanRemove) {
     EXPECT_EQ(border + removable, whole.live_faces()) << "p = " << p;
     for (const SubsetJob& job : jobs) {
       const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
-      for (VertexId v = 0; v < job.mesh.vertex_count(); ++v)
-        if (job.owned[v]) EXPECT_EQ(bound[job.global_vertex[v]], !free[v]) << "p = " << p;
+      for (VertexId v = 0; v < job.mesh.vertex_count(); ++v) {
+        if (job.owned[v]) {
+          EXPECT_EQ(bound[job.global_vertex[v]], !free[v]) << "p = " << p;
+        }
+      }
     }
   }
 }

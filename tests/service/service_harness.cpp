@@ -219,6 +219,7 @@ std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
   if (e.min_crease_edges() > 0)
     args.insert(args.end(), {"--crease-min-edges", std::to_string(e.min_crease_edges())});
   if (o.keep_order()) args.push_back("--keep-order");
+  if (o.free_copies()) args.push_back("--free-copies");
   return args;
 }
 

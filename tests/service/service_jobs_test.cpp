@@ -118,6 +118,10 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   extra.set_extra_round_faces(200);
   extra.set_border_excess(0.02);
   build_and_compare("gmsh-aneurysm-20k.stl.gz", extra, names);
+  // The repair's copies freed (`--free-copies`): the CAD part's non-manifold vertices.
+  parapm::v1::JobOptions free_copies = options(2, parapm::v1::METRIC_QUADRIC, 0);
+  free_copies.set_free_copies(true);
+  build_and_compare("cad-cycloidal-43k.ply", free_copies, names);
   // At p = 12 the 20k-face vessel's rounds take at most one subset per 2000 faces (the
   // default, as `parapm simplify` builds it: 10 in round 0), or 12 in every round with
   // `--min-subset-faces 0` (negative in the message).
