@@ -14,6 +14,13 @@
 namespace parapm {
 
 std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord>> lists) {
+  std::vector<CollapseRecord> merged;
+  append_merged_by_cost(lists, merged);
+  return merged;
+}
+
+void append_merged_by_cost(std::vector<std::vector<CollapseRecord>>& lists,
+                           std::vector<CollapseRecord>& out) {
   struct Head {
     double cost;
     uint32_t list;
@@ -31,15 +38,14 @@ std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord
     if (!lists[i].empty()) heads.push({lists[i][0].cost, i});
   }
   std::vector<size_t> next(lists.size(), 0);
-  std::vector<CollapseRecord> merged;
-  merged.reserve(total);
+  out.reserve(out.size() + total);
   while (!heads.empty()) {
     const uint32_t i = heads.top().list;
     heads.pop();
-    merged.push_back(std::move(lists[i][next[i]]));
+    out.push_back(std::move(lists[i][next[i]]));
     if (++next[i] < lists[i].size()) heads.push({lists[i][next[i]].cost, i});
   }
-  return merged;
+  lists.clear();
 }
 
 namespace {

@@ -18,6 +18,9 @@ namespace parapm {
 // the subset rule needs for the sequence to replay (subset_rule.h); a list's costs need not
 // be sorted (a subset's cost sequence is only roughly increasing). O(n log k).
 std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord>> lists);
+// The same merge, appended to `out` (each record moved once; `lists` is left empty).
+void append_merged_by_cost(std::vector<std::vector<CollapseRecord>>& lists,
+                           std::vector<CollapseRecord>& out);
 
 struct ReplayReport {
   uint64_t collapses = 0;
