@@ -543,9 +543,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
       bookkeeping_seconds = seconds_since(tb);
     };
     if (parallel.replay_state) {
-      // Tests only: the merged sequence drives the master's module, one collapse at a time.
-      const std::vector<CollapseRecord> merged =
-          merge_by_cost(lists);  // the bookkeeping reads lists
+      // Tests only: the merged sequence drives the master's module, one collapse at a time
+      // (merged from a copy: the bookkeeping reads the lists).
+      const std::vector<CollapseRecord> merged = merge_by_cost(lists);
       replay = replay_collapses(whole, merged, master.get());
       bookkeeping();
       records.insert(records.end(), merged.begin(), merged.end());

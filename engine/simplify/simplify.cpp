@@ -103,7 +103,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   const Mesh& mesh = repaired.mesh;
 
   // Vertices the repair step duplicated (non-manifold input) stay where they are, so that the
-  // copies of one input vertex never drift apart and open a crack.
+  // copies of one input vertex never drift apart and open a crack (unless free_copies).
   const std::vector<uint8_t> locked = locked_vertices(repaired, options.free_copies);
   CollapseMesh working(mesh);
   std::unique_ptr<PriorityModule> priority = make_priority_module(options, mesh, locked);

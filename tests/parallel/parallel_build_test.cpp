@@ -438,8 +438,8 @@ TEST(ParallelBuild, RoundsBoundedByTheirBorderBand) {
 
 // A round cuts the mesh into at most (its faces / min_subset_faces) subsets: the 20k-face
 // vessel at p = 16 gets 10 subsets in its first round and fewer as it shrinks (never below 2),
-// and it takes fewer rounds (each of fixed work: partition,
-// extraction, merge) than with 16 subsets of 1.2k faces, a fifth of which are border band.
+// and it takes fewer rounds (each of fixed work: partition, extraction, merge) than with 16
+// subsets of 1.2k faces, a fifth of which are border band.
 TEST(ParallelBuild, SmallMeshesTakeFewerSubsets) {
   const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
   const SimplifyOptions options = metric_options("energy", 0.01);
@@ -460,8 +460,7 @@ TEST(ParallelBuild, SmallMeshesTakeFewerSubsets) {
 
   ParallelOptions uncapped = capped;
   uncapped.min_subset_faces = 0;
-  const ProgressiveMesh all =
-      build_progressive_mesh_parallel(repaired, options, uncapped, &uncapped_stats);
+  build_progressive_mesh_parallel(repaired, options, uncapped, &uncapped_stats);
   EXPECT_EQ(uncapped_stats.round_stats[0].subsets.size(), 16u);
   std::printf("gmsh-aneurysm-20k p=16: %zu rounds capped (first on %zu subsets), %zu with 16\n",
               stats.round_stats.size(), stats.round_stats[0].subsets.size(),
