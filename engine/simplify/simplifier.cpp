@@ -100,6 +100,8 @@ void Simplifier::compact_heap() {
       items.end());
   heap_.rebuild();
   stats_.stale += before - items.size();
+  compacted_size_ = items.size();
+  ++stats_.compactions;
 }
 
 // Each side lists a vetoed edge at most once, so the lists stay as short as the valence.
@@ -182,6 +184,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   // Every undirected edge once: from the face holding a->b with a < b, or from the only face
   // of a boundary edge. The heap's order does not depend on the order of insertion.
   heap_.clear();
+  compacted_size_ = 0;
   heap_.reserve(mesh_.face_capacity() * 3);
   for (FaceId f = 0; f < mesh_.face_capacity(); ++f) {
     if (!mesh_.face_alive(f)) continue;
@@ -213,8 +216,13 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     // Lazy deletion leaves stale entries behind (about seven per collapse). Once the queue
     // holds more than two entries per live face (live edges are ~1.5 per face) they are
     // dropped in one sequential pass, far cheaper than popping each through the
-    // cache-missing heap; amortised, each entry is compacted away at most once.
-    if (heap_.size() > 2 * mesh_.live_faces() + 1024) compact_heap();
+    // cache-missing heap; amortised, each entry is compacted away at most once. Not again
+    // before the heap has doubled since the last pass: a mesh of many tiny pieces holds more
+    // current entries than that (3 edges per face for loose triangles), and a pass per pop
+    // made it quadratic (the motorbike with --free-copies: 789 s, chair-dupfaces 0.95 s for
+    // no collapse at all).
+    if (heap_.size() > std::max<size_t>(2 * mesh_.live_faces() + 1024, 2 * compacted_size_))
+      compact_heap();
     const Entry entry = heap_.pop();
     if (is_stale(entry)) {
       ++stats_.stale;

@@ -74,8 +74,9 @@ struct SimplifierStats {
   // With a costly priority module: edges the topological rules vetoed before any costing
   // (retried after their star changed, or on top of the queue: those count as rejected too).
   uint64_t screened = 0;
-  uint64_t deferred = 0;    // edges queued below their last key instead of costed at once
-  std::string stop_reason;  // why the loop ended
+  uint64_t deferred = 0;     // edges queued below their last key instead of costed at once
+  uint64_t compactions = 0;  // passes dropping the queue's stale entries at once
+  std::string stop_reason;   // why the loop ended
 };
 
 class Simplifier {
@@ -135,6 +136,7 @@ class Simplifier {
   PriorityModule& priority_;
   std::vector<std::unique_ptr<ConstraintModule>> constraints_;
   QuadHeap<Entry, Before> heap_;
+  size_t compacted_size_ = 0;  // the heap's size after the last compact_heap()
   // priority_.costly(): retried and top edges meet the topological rules before any costing.
   bool screen_ = false;
   std::vector<uint32_t> version_;
