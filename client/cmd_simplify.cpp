@@ -63,6 +63,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"partition_seconds", r.partition_seconds},
                       {"partition_overlap_seconds", r.partition_overlap_seconds},
                       {"extract_seconds", r.extract_seconds},
+                      {"share_seconds", r.share_seconds},
                       {"slowest_extract_cpu_seconds", r.slowest_extract_cpu_seconds},
                       {"extract_critical_seconds", r.extract_critical_seconds},
                       {"subsets_seconds", r.subsets_seconds},

@@ -36,6 +36,7 @@
 #include <string>
 #include <tuple>
 
+#include "mesh/spatial_order.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -477,6 +478,9 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   const std::vector<uint32_t> twin =
       pair_edges(out.mesh.faces, out.mesh.vertex_count(), &out.report.nonmanifold_edges);
   split_fans(twin, &out);
+
+  // 5. Neighbours on the surface become neighbours in memory.
+  if (options.spatial_order) order_spatially(out);
   return out;
 }
 

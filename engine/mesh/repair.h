@@ -28,7 +28,11 @@
 //     face is added: the result is an oriented 2-manifold with boundary (a halfedge structure
 //     can be built on it), and merging each copy into the vertex of input_vertex gives back
 //     the kept faces exactly.
-// Deterministic (no hashing, no threads) and O(F log(max valence)) time.
+//  5. Unless spatial_order is off: vertices, faces and wedges renumbered for memory locality
+//     (spatial_order.h: vertices along a Morton curve, faces by their first vertex, wedges by
+//     their vertex). Nothing else changes; input_vertex, input_face and input_wedge follow.
+//     Rules 3 and 4's orders are those before this step.
+// Deterministic (no hashing, no threads) and O(F log(max valence) + V log V) time.
 #pragma once
 
 #include <cstdint>
@@ -41,6 +45,8 @@ namespace parapm {
 
 struct RepairOptions {
   bool keep_unreferenced = false;
+  // Rule 5. Off: the output keeps the input's order (rules 3 and 4).
+  bool spatial_order = true;
 };
 
 struct RepairReport {
@@ -63,7 +69,7 @@ struct RepairedMesh {
   // non-manifold vertex map to the same input vertex as the original.
   std::vector<VertexId> input_vertex;
   // For each face of `mesh`: its index among the input's faces (after fan triangulation);
-  // increasing, since faces keep their order.
+  // increasing without spatial_order (faces keep their order).
   std::vector<FaceId> input_face;
   // For each wedge of `mesh`: the wedge of the input it came from (copies made with a vertex
   // copy map to the wedge they copy). Empty when the mesh has no attributes.

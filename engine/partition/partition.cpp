@@ -231,9 +231,18 @@ Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& o
   }
   VertexGraph graph = build_vertex_graph(mesh);
   graph.weight.assign(n, options.balance == Balance::kVertices ? 1 : 0);
-  if (options.balance == Balance::kFaces)
+  if (options.balance == Balance::kFaces) {
     for (const Triangle& face : mesh.faces)
       for (VertexId v : face) ++graph.weight[v];
+    graph.face_count = uint32_t(mesh.face_count());
+    graph.face_offsets.assign(n + 1, 0);
+    for (VertexId v = 0; v < n; ++v)
+      graph.face_offsets[v + 1] = graph.face_offsets[v] + graph.weight[v];
+    graph.face_ids.resize(graph.face_offsets[n]);
+    std::vector<size_t> fill(graph.face_offsets.begin(), graph.face_offsets.end() - 1);
+    for (uint32_t f = 0; f < mesh.face_count(); ++f)
+      for (VertexId v : mesh.faces[f]) graph.face_ids[fill[v]++] = f;
+  }
   uint64_t total = 0;
   for (uint32_t w : graph.weight) total += w;
   const std::vector<uint64_t> targets = share_targets(total, p, options.weights);

@@ -21,10 +21,11 @@ namespace parapm {
 inline constexpr uint32_t kMaxPartitionSubsets = 256;
 
 // What the subsets' shares count. The workers' work grows with faces, and the balance
-// bound is on faces, so faces is the default: a vertex then weighs the number of faces around
-// it (each face counts once at each of its three corners). Vertex counts are the thesis'
-// original measure; they drift from face counts where vertices have few faces (meshes that
-// the repair step cut into many pieces).
+// bound is on faces, so faces is the default: the greedy algorithm counts the faces each
+// subset will own (greedy_partition.cpp), the BFS baseline a vertex's faces (each face once at
+// each of its three corners). Vertex counts are the thesis' original measure; they drift from
+// face counts where vertices have few faces (meshes that the repair step cut into many
+// pieces).
 enum class Balance { kFaces, kVertices };
 
 struct PartitionOptions {

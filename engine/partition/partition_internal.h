@@ -21,6 +21,12 @@ struct VertexGraph {
   // What a vertex counts for in its subset's share: 1 (Balance::kVertices) or its number of
   // faces (Balance::kFaces). Set by partition_mesh.
   std::vector<uint32_t> weight;
+  // Balance::kFaces only (else empty): the faces of v are face_ids[face_offsets[v] ..
+  // face_offsets[v + 1]), for the greedy algorithm to count the faces a subset will own (two
+  // corners or more in it) rather than their corners (faces_of).
+  std::vector<size_t> face_offsets;
+  std::vector<uint32_t> face_ids;
+  uint32_t face_count = 0;
 
   uint32_t vertex_count() const { return uint32_t(offsets.size() - 1); }
   uint32_t degree(uint32_t v) const { return uint32_t(offsets[v + 1] - offsets[v]); }
@@ -28,6 +34,10 @@ struct VertexGraph {
     return {neighbours.data() + offsets[v], neighbours.data() + offsets[v + 1]};
   }
   uint32_t max_degree() const;
+  bool has_faces() const { return !face_offsets.empty(); }
+  std::span<const uint32_t> faces_of(uint32_t v) const {
+    return {face_ids.data() + face_offsets[v], face_ids.data() + face_offsets[v + 1]};
+  }
 };
 
 // O(F + V). Error(kInvalidInput) when a face corner is out of range; repeated corners are

@@ -4,7 +4,9 @@
 // whole to the neighbour they touch most, both only while every subset stays within
 // [0.97, 1.03] x its target (inside the partitioner's 5% bound). Fewer cut edges mean less border
 // left for the later rounds of the parallel build; fewer components mean compact subsets. Each
-// sweep is O(|E|).
+// sweep is O(|E|). A vertex that moves can split its old subset, and a stray may find no room
+// to go: when the result has more cut edges or more components than the partition it started
+// from (seen on two meshes of ../shared/meshes, one component more), that partition is kept.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -134,11 +136,46 @@ class Refiner {
   std::vector<uint64_t> load_, upper_, lower_;
 };
 
+struct Shape {
+  uint64_t cut_edges = 0;
+  uint64_t components = 0;  // connected pieces of the subsets, summed
+};
+
+Shape shape_of(const VertexGraph& graph, const std::vector<uint32_t>& subset) {
+  Shape shape;
+  const uint32_t n = graph.vertex_count();
+  std::vector<uint8_t> seen(n, 0);
+  std::vector<uint32_t> stack;
+  for (uint32_t s = 0; s < n; ++s) {
+    for (uint32_t u : graph.neighbours_of(s))
+      if (u > s && subset[u] != subset[s]) ++shape.cut_edges;
+    if (seen[s]) continue;
+    ++shape.components;
+    seen[s] = 1;
+    stack.assign(1, s);
+    while (!stack.empty()) {
+      const uint32_t v = stack.back();
+      stack.pop_back();
+      for (uint32_t u : graph.neighbours_of(v)) {
+        if (seen[u] || subset[u] != subset[s]) continue;
+        seen[u] = 1;
+        stack.push_back(u);
+      }
+    }
+  }
+  return shape;
+}
+
 }  // namespace
 
 void refine_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
                       Partition& partition) {
+  const std::vector<uint32_t> before = partition.vertex_subset;
+  const Shape start = shape_of(graph, before);
   Refiner(graph, targets, partition).run();
+  const Shape end = shape_of(graph, partition.vertex_subset);
+  if (end.cut_edges > start.cut_edges || end.components > start.components)
+    partition.vertex_subset = before;
 }
 
 }  // namespace parapm::partition_detail

@@ -7,13 +7,19 @@
 
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "mesh/mesh_checks.h"
 #include "mesh/repair.h"
 
 namespace parapm::testing {
 
-inline void expect_faithful_repair(const Mesh& input, const RepairedMesh& repaired) {
+// How the output is numbered: as the input (rules 1-4; RepairOptions::spatial_order off), or
+// in any order (rule 5 on: the maps back to the input are checked, not the order).
+enum class RepairOrder { kInput, kAny };
+
+inline void expect_faithful_repair(const Mesh& input, const RepairedMesh& repaired,
+                                   RepairOrder order = RepairOrder::kInput) {
   const Mesh& mesh = repaired.mesh;
   const RepairReport& report = repaired.report;
   std::string why;
@@ -22,15 +28,19 @@ inline void expect_faithful_repair(const Mesh& input, const RepairedMesh& repair
   EXPECT_EQ(mesh.layout, input.layout);
   EXPECT_EQ(mesh.positions_are_float, input.positions_are_float);
 
-  // Faces: the input's, in order, minus the removed ones, up to merging copies.
+  // Faces: the input's, in order, minus the removed ones, up to merging copies; each input face
+  // at most once.
   ASSERT_EQ(repaired.input_face.size(), mesh.face_count());
   EXPECT_EQ(mesh.face_count() + report.degenerate_faces_removed + report.duplicate_faces_removed,
             input.face_count());
   ASSERT_EQ(repaired.input_vertex.size(), mesh.vertex_count());
+  std::vector<uint8_t> face_used(input.face_count(), 0);
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     const FaceId from = repaired.input_face[f];
     ASSERT_LT(from, input.face_count());
-    if (f) {
+    ASSERT_FALSE(face_used[from]) << "input face " << from << " twice";
+    face_used[from] = 1;
+    if (f && order == RepairOrder::kInput) {
       ASSERT_LT(repaired.input_face[f - 1], from) << "face " << f;
     }
     for (int i = 0; i < 3; ++i) {
@@ -39,17 +49,23 @@ inline void expect_faithful_repair(const Mesh& input, const RepairedMesh& repair
     }
   }
 
-  // Vertices: the originals keep their order and come first; copies follow.
+  // Vertices: each kept input vertex once, plus its copies; in input order, the originals keep
+  // their order and come first, copies follow.
   const size_t originals = mesh.vertex_count() - report.vertex_copies_added;
   EXPECT_EQ(originals + report.unreferenced_vertices_removed, input.vertex_count());
+  std::vector<uint8_t> vertex_used(input.vertex_count(), 0);
+  size_t distinct = 0;
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     const VertexId from = repaired.input_vertex[v];
     ASSERT_LT(from, input.vertex_count());
-    if (v && v < originals) {
+    if (!vertex_used[from]) ++distinct;
+    vertex_used[from] = 1;
+    if (v && v < originals && order == RepairOrder::kInput) {
       ASSERT_LT(repaired.input_vertex[v - 1], from);
     }
     ASSERT_EQ(mesh.positions[v], input.positions[from]) << "vertex " << v;
   }
+  EXPECT_EQ(distinct, originals);
 
   // Wedges: same values, of the same input vertex, used by the same corners.
   if (!input.layout.any()) {

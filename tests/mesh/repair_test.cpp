@@ -1,4 +1,6 @@
 // repair_mesh() on tiny meshes drawn in code: one case per rule of repair.h, with exact counts.
+// Rules 1-4 are checked in the input's order (rule 5 off: their exact outputs are readable);
+// rule 5 has its own tests (spatial_order_test.cpp).
 #include "mesh/repair.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +18,12 @@ namespace parapm {
 namespace {
 
 using testing::expect_faithful_repair;
+
+// repair_mesh() with rules 1-4 only: the output in the input's order.
+RepairedMesh repair_in_input_order(const Mesh& mesh, RepairOptions options = {}) {
+  options.spatial_order = false;
+  return repair_mesh(mesh, options);
+}
 
 Mesh make_mesh(std::vector<Vec3> positions, std::vector<Triangle> faces) {
   Mesh mesh;
@@ -38,7 +46,7 @@ void add_vertex_texcoords(Mesh* mesh) {
 // Runs repair_mesh and returns the message of the Error(kInvalidInput) it must throw.
 std::string repair_error(const Mesh& mesh) {
   try {
-    repair_mesh(mesh);
+    repair_in_input_order(mesh);
   } catch (const Error& error) {
     EXPECT_EQ(error.code(), ErrorCode::kInvalidInput) << error.what();
     return error.what();
@@ -149,7 +157,7 @@ TEST(RepairErrors, WedgeArraysOfTheWrongSize) {
 
 TEST(Repair, CleanMeshIsUnchanged) {
   const Mesh mesh = square();
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_FALSE(repaired.report.changed());
   EXPECT_EQ(repaired.mesh.faces, mesh.faces);
   EXPECT_EQ(repaired.mesh.positions, mesh.positions);
@@ -161,7 +169,7 @@ TEST(Repair, DegenerateFacesRemoved) {
   Mesh mesh = square();
   mesh.faces.insert(mesh.faces.begin() + 1, Triangle{0, 0, 1});
   mesh.faces.push_back({2, 3, 2});
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.degenerate_faces_removed, 2u);
   EXPECT_EQ(repaired.mesh.faces, square().faces);
   EXPECT_EQ(repaired.input_face, (std::vector<FaceId>{0, 2}));
@@ -174,7 +182,7 @@ TEST(Repair, DuplicateFacesRemovedInAnyRotationKeepingTheFirst) {
   mesh.faces.push_back({1, 2, 0});
   mesh.faces.push_back({0, 2, 3});
   mesh.faces.push_back({2, 0, 1});
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.duplicate_faces_removed, 3u);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 0u);
   EXPECT_EQ(repaired.mesh.faces, square().faces);
@@ -189,7 +197,7 @@ TEST(Repair, DuplicateWithOtherWedgesStillRemoved) {
   mesh.wedge_values.insert(mesh.wedge_values.end(), {0.5f, 0.5f});
   mesh.faces.push_back({0, 1, 2});
   mesh.face_wedges.push_back({0, 4, 2});
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.duplicate_faces_removed, 1u);
   EXPECT_EQ(repaired.mesh.face_wedges[0], (std::array<WedgeId, 3>{0, 1, 2}));
   EXPECT_EQ(repaired.mesh.wedge_count(), 5u);  // the unused wedge of a kept vertex stays
@@ -200,7 +208,7 @@ TEST(Repair, OppositeOrientationKept) {
   // (0, 1, 2) and (0, 2, 1): a two-face "pillow", each edge used once in each direction,
   // which is a (flat) closed manifold.
   const Mesh mesh = make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 2, 1}});
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_FALSE(repaired.report.changed());
   EXPECT_EQ(repaired.report.nonmanifold_edges, 0u);
   EXPECT_EQ(repaired.mesh.faces, mesh.faces);
@@ -220,7 +228,7 @@ TEST(Repair, UnreferencedVerticesRemovedAndRenumberedInOrder) {
   Mesh mesh =
       make_mesh({{9, 9, 9}, {0, 1, 0}, {1, 1, 0}, {5, 5, 5}, {0, 0, 0}}, {{1, 4, 2}, {3, 3, 1}});
   add_vertex_texcoords(&mesh);
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.unreferenced_vertices_removed, 2u);
   EXPECT_EQ(repaired.mesh.faces, (std::vector<Triangle>{{0, 2, 1}}));
   EXPECT_EQ(repaired.input_vertex, (std::vector<VertexId>{1, 2, 4}));
@@ -237,7 +245,7 @@ TEST(Repair, UnreferencedVerticesKeptWhenAsked) {
   add_vertex_texcoords(&mesh);
   RepairOptions options;
   options.keep_unreferenced = true;
-  const RepairedMesh repaired = repair_mesh(mesh, options);
+  const RepairedMesh repaired = repair_in_input_order(mesh, options);
   EXPECT_EQ(repaired.report.unreferenced_vertices_removed, 0u);
   EXPECT_EQ(repaired.mesh.positions, mesh.positions);
   EXPECT_EQ(repaired.mesh.faces, mesh.faces);
@@ -258,7 +266,7 @@ TEST(Repair, ZeroAreaFacesCountedAndKept) {
   mesh.positions.push_back({0.5, 0, 0});  // 5, between 0 and 1
   mesh.faces.push_back({0, 5, 1});
   mesh.faces.push_back({1, 4, 2});
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.zero_area_faces, 2u);
   EXPECT_EQ(repaired.mesh.face_count(), 4u);
   EXPECT_FALSE(repaired.report.changed());
@@ -270,7 +278,7 @@ TEST(Repair, ZeroAreaFacesCountedAndKept) {
 
 TEST(RepairManifold, BowtieVertexSplitIntoTwo) {
   const Mesh mesh = bowtie();
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 0u);
   EXPECT_EQ(repaired.report.nonmanifold_vertices, 1u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 1u);
@@ -291,7 +299,7 @@ TEST(RepairManifold, TwoClosedFansAtOneVertexSplit) {
   std::vector<Triangle> faces = tetrahedron(0, 1, 2, 3);
   for (const Triangle& t : tetrahedron(4, 5, 6, 3)) faces.push_back(t);
   const Mesh mesh = make_mesh(positions, faces);
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 0u);
   EXPECT_EQ(repaired.report.nonmanifold_vertices, 1u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 1u);
@@ -312,7 +320,7 @@ TEST(RepairManifold, BookOfThreePagesCutAlongItsSpine) {
   // own triangle: 0 and 1 get two copies each.
   const Mesh mesh = make_mesh({{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, 0, 1}, {0.5, -1, 0}},
                               {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 1u);
   EXPECT_EQ(repaired.report.nonmanifold_vertices, 2u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 4u);
@@ -329,7 +337,7 @@ TEST(RepairManifold, SameDirectionEdgeCut) {
   //     0-1     (3 drawn above for clarity; it is below the edge in the plane)
   const Mesh mesh =
       make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, -1, 0}}, {{0, 1, 2}, {0, 1, 3}});
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 1u);
   EXPECT_EQ(repaired.report.nonmanifold_vertices, 2u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 2u);
@@ -347,7 +355,7 @@ TEST(RepairManifold, WedgesCopiedWithTheSplitVertex) {
   mesh.wedge_vertex.push_back(0);  // wedge 6
   mesh.wedge_values.insert(mesh.wedge_values.end(), {0.5f, 0.5f});
   mesh.face_wedges[1] = {5, 4, 3};
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.vertex_copies_added, 1u);
   // The copy (vertex 5) takes a copy of wedge 5 (wedge 7); wedge 5 stays on vertex 2.
   ASSERT_EQ(repaired.mesh.wedge_count(), 8u);
@@ -366,7 +374,7 @@ TEST(RepairManifold, SharedWedgeCopiedOncePerFan) {
   Mesh mesh = make_mesh({{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, 0, 1}, {0.5, -1, 0}},
                         {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
   add_vertex_texcoords(&mesh);
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.mesh.wedge_count(), 5u + 4u);
   EXPECT_EQ(repaired.input_wedge, (std::vector<WedgeId>{0, 1, 2, 3, 4, 0, 0, 1, 1}));
   expect_faithful_repair(mesh, repaired);
@@ -385,7 +393,7 @@ TEST(RepairManifold, CutEdgeStaysAnEdgeWhenItsFacesShareFansAtBothEnds) {
   std::vector<Triangle> faces = tetrahedron(0, 1, 2, 3);
   faces.push_back({0, 1, 4});
   const Mesh mesh = make_mesh(positions, faces);
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 1u);
   EXPECT_EQ(repaired.report.nonmanifold_vertices, 2u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 2u);
@@ -419,7 +427,7 @@ TEST(RepairManifold, ThirdFaceOnASpokeOpensTheDisk) {
   for (VertexId k = 1; k <= 6; ++k) faces.push_back({0, k, k % 6 + 1});
   faces.push_back({0, 1, 7});
   const Mesh mesh = make_mesh(positions, faces);
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 1u);
   EXPECT_EQ(repaired.report.nonmanifold_vertices, 2u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 1u + 2u);
@@ -451,7 +459,7 @@ TEST(RepairManifold, MobiusStripBecomesAnOrientableStrip) {
   std::string why;
   EXPECT_FALSE(is_oriented_manifold(mesh, &why));
   EXPECT_EQ(why, "edge (0, 4) is used in the same direction by faces 0 and 7");
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 1u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 2u);
   const TopologyStats stats = topology_stats(repaired.mesh);
@@ -479,7 +487,7 @@ Mesh everything_wrong() {
 
 TEST(Repair, EveryRuleAtOnce) {
   const Mesh mesh = everything_wrong();
-  const RepairedMesh repaired = repair_mesh(mesh);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.degenerate_faces_removed, 1u);
   EXPECT_EQ(repaired.report.duplicate_faces_removed, 1u);
   EXPECT_EQ(repaired.report.unreferenced_vertices_removed, 1u);
@@ -491,8 +499,8 @@ TEST(Repair, EveryRuleAtOnce) {
 
 TEST(Repair, Deterministic) {
   const Mesh mesh = everything_wrong();
-  const RepairedMesh a = repair_mesh(mesh);
-  const RepairedMesh b = repair_mesh(mesh);
+  const RepairedMesh a = repair_in_input_order(mesh);
+  const RepairedMesh b = repair_in_input_order(mesh);
   EXPECT_EQ(a.mesh.positions, b.mesh.positions);
   EXPECT_EQ(a.mesh.faces, b.mesh.faces);
   EXPECT_EQ(a.mesh.wedge_vertex, b.mesh.wedge_vertex);
@@ -504,8 +512,8 @@ TEST(Repair, Deterministic) {
 }
 
 TEST(Repair, RepairIsIdempotent) {
-  const RepairedMesh once = repair_mesh(everything_wrong());
-  const RepairedMesh twice = repair_mesh(once.mesh);
+  const RepairedMesh once = repair_in_input_order(everything_wrong());
+  const RepairedMesh twice = repair_in_input_order(once.mesh);
   EXPECT_FALSE(twice.report.changed());
   EXPECT_EQ(twice.report.nonmanifold_edges, 0u);
   EXPECT_EQ(twice.mesh.faces, once.mesh.faces);
@@ -534,9 +542,9 @@ TEST(Repair, RandomSoupsBecomeManifolds) {
     }
     if (round % 2) add_vertex_texcoords(&mesh);
     SCOPED_TRACE("round " + std::to_string(round));
-    const RepairedMesh repaired = repair_mesh(mesh);
+    const RepairedMesh repaired = repair_in_input_order(mesh);
     expect_faithful_repair(mesh, repaired);
-    const RepairedMesh again = repair_mesh(repaired.mesh);
+    const RepairedMesh again = repair_in_input_order(repaired.mesh);
     EXPECT_FALSE(again.report.changed());
     EXPECT_EQ(again.report.nonmanifold_edges, 0u);
     // The report agrees with the independent statistics of the input.
@@ -550,7 +558,7 @@ TEST(Repair, RandomSoupsBecomeManifolds) {
 }
 
 TEST(Repair, EmptyMesh) {
-  const RepairedMesh repaired = repair_mesh(Mesh{});
+  const RepairedMesh repaired = repair_in_input_order(Mesh{});
   EXPECT_EQ(repaired.mesh.vertex_count(), 0u);
   EXPECT_FALSE(repaired.report.changed());
 }

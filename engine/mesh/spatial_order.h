@@ -1,0 +1,40 @@
+// Memory locality for the engine: vertices renumbered along a space-filling curve (Morton
+// order: the bits of the three quantised coordinates interleaved), faces by their first vertex
+// in that order, wedges by their vertex. The simplifier, the energy's points and the subset
+// jobs then touch neighbouring memory when they touch neighbouring surface.
+//
+// Why: a collapse reads its star (faces, corners, positions, point lists, queue entries), and
+// on a mesh of hundreds of thousands of faces most of those reads miss the caches unless
+// neighbours on the surface are neighbours in memory. Measured on the 871k dragon (its file is
+// in scan order, already fairly coherent): energy 20.4 -> 19.2 s, quadric 4.29 -> 3.92 s,
+// energy at p = 2 10.75 -> 10.0 s; the same mesh in shuffled order took 26.3, 4.92 and 15.0 s
+// (docs/BENCHMARKS.md, "Memory order"). The order is the repair's last step
+// (RepairOptions::spatial_order), so every path (CLI, service, tests through repair_mesh)
+// simplifies the same numbering, and the PM renumbers vertices in its own order anyway.
+//
+// Deterministic: ties (equal codes, faces with the same first vertex) keep their previous
+// order, so ordering an ordered mesh changes nothing.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "mesh/mesh.h"
+
+namespace parapm {
+
+struct RepairedMesh;
+
+// The 63-bit Morton code of p in `box` (21 bits per axis). An axis of zero extent, or a point
+// outside the box, clamps.
+uint64_t morton_code(const Vec3& p, const Box& box);
+
+// new_id[old] for every vertex of `mesh`: ranked by Morton code, ties by id.
+std::vector<VertexId> spatial_vertex_order(const Mesh& mesh);
+
+// Renumbers repaired.mesh's vertices, faces and wedges as above and composes the maps back to
+// the input (input_vertex, input_face, input_wedge), so that the repaired mesh means what it
+// meant. A mesh with one wedge per vertex (wedge i of vertex i) keeps that property.
+void order_spatially(RepairedMesh& repaired);
+
+}  // namespace parapm
