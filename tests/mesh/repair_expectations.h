@@ -90,4 +90,16 @@ inline void expect_faithful_repair(const Mesh& input, const RepairedMesh& repair
   }
 }
 
+// Two repairs gave the same mesh and the same maps back to the input.
+inline void expect_same_repair(const RepairedMesh& a, const RepairedMesh& b) {
+  EXPECT_EQ(a.mesh.positions, b.mesh.positions);
+  EXPECT_EQ(a.mesh.faces, b.mesh.faces);
+  EXPECT_EQ(a.mesh.wedge_vertex, b.mesh.wedge_vertex);
+  EXPECT_EQ(a.mesh.wedge_values, b.mesh.wedge_values);
+  EXPECT_EQ(a.mesh.face_wedges, b.mesh.face_wedges);
+  EXPECT_EQ(a.input_vertex, b.input_vertex);
+  EXPECT_EQ(a.input_face, b.input_face);
+  EXPECT_EQ(a.input_wedge, b.input_wedge);
+}
+
 }  // namespace parapm::testing

@@ -121,21 +121,12 @@ TEST(SpatialOrder, ShuffledRealMeshComesOutInOrderAndFaithful) {
 
   // The repair's last step is order_spatially on rules 1-4's output.
   order_spatially(unordered);
-  EXPECT_EQ(unordered.mesh.positions, ordered.mesh.positions);
-  EXPECT_EQ(unordered.mesh.faces, ordered.mesh.faces);
-  EXPECT_EQ(unordered.mesh.face_wedges, ordered.mesh.face_wedges);
-  EXPECT_EQ(unordered.mesh.wedge_values, ordered.mesh.wedge_values);
-  EXPECT_EQ(unordered.input_vertex, ordered.input_vertex);
-  EXPECT_EQ(unordered.input_face, ordered.input_face);
-  EXPECT_EQ(unordered.input_wedge, ordered.input_wedge);
+  testing::expect_same_repair(unordered, ordered);
 
   // Idempotent: an ordered mesh is its own order.
   RepairedMesh again = ordered;
   order_spatially(again);
-  EXPECT_EQ(again.mesh.positions, ordered.mesh.positions);
-  EXPECT_EQ(again.mesh.faces, ordered.mesh.faces);
-  EXPECT_EQ(again.mesh.face_wedges, ordered.mesh.face_wedges);
-  EXPECT_EQ(again.input_wedge, ordered.input_wedge);
+  testing::expect_same_repair(again, ordered);
 }
 
 // Per-vertex attributes (a PLY's colours: wedge i of vertex i) stay per vertex.
