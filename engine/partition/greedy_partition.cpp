@@ -173,9 +173,14 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
       }
       if (start == kNoId) start = continuation_seed();
     }
+    if (start == kNoId) break;  // every vertex is taken: the remaining subsets stay empty
     front.assign(1, start);
 
-    while (counted < cumulative_target) {
+    // At least one vertex, even when the subsets before passed this one's target too (by
+    // faces, one vertex can settle more faces than a small share: a grid cut in as many
+    // subsets as vertices).
+    auto wants_more = [&] { return counted < cumulative_target || members.empty(); };
+    while (wants_more()) {
       if (front.empty()) {
         // Locked in: no unmarked neighbour, still below target. Continue from a new seed
         // (the subset becomes multi-connected) rather than restart the whole partition.
@@ -209,7 +214,7 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
         // (updated as they are taken), which leaves the fewest unmarked vertices cut off.
         for (uint32_t v : front) partial_front.insert(v, updated_degree[v]);
         // (The front's gain exceeds what is missing, so it does not run out; checked anyway.)
-        while (counted < cumulative_target && !partial_front.empty()) {
+        while (wants_more() && !partial_front.empty()) {
           const uint32_t v = partial_front.pop_min();
           counted += mark(v, k);
           members.push_back(v);

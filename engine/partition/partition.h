@@ -25,7 +25,9 @@ inline constexpr uint32_t kMaxPartitionSubsets = 256;
 // subset will own (greedy_partition.cpp), the BFS baseline a vertex's faces (each face once at
 // each of its three corners). Vertex counts are the thesis' original measure; they drift from
 // face counts where vertices have few faces (meshes that the repair step cut into many
-// pieces).
+// pieces). By faces, shares of a face or two (p above about half the vertex count) can leave
+// the last greedy subsets without a vertex (the parallel build's default keeps 2000 faces per
+// subset: ParallelOptions::min_subset_faces).
 enum class Balance { kFaces, kVertices };
 
 struct PartitionOptions {

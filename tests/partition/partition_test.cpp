@@ -199,6 +199,36 @@ TEST(GreedyPartition, IsolatedVerticesOnlyStillGetAssigned) {
   }
 }
 
+// Balanced by faces, the greedy algorithm counts a face once its owner is settled (two corners
+// in one subset, or its third corner): the strip's halves own 4 faces each.
+TEST(GreedyPartition, ByFacesTheStripsHalvesOwnFourFacesEach) {
+  const Mesh mesh = strip();
+  PartitionOptions by_faces = options("greedy");
+  by_faces.balance = Balance::kFaces;
+  const Partition partition = partition_mesh(mesh, 2, by_faces);
+  expect_valid(mesh, partition, 2, {}, Balance::kFaces);
+  const PartitionMetrics metrics = partition_metrics(mesh, partition, by_faces);
+  EXPECT_EQ(metrics.subset_faces, (std::vector<uint64_t>{4, 4}));
+}
+
+// Shares of a few faces, less than one vertex can settle (a grid of 25 vertices and 32 faces
+// in 10 subsets by faces): every subset still gets a vertex; without that rule one of the 10
+// got none. (With about half as many vertices as subsets or fewer, the greedy subsets, which
+// take vertices until their faces are settled, can leave the last ones none: faces cannot be
+// spread that thin; 13 subsets of the 6 x 6 grid leave one empty.)
+TEST(GreedyPartition, ByFacesEverySubsetGetsAVertexWhenSharesAreTiny) {
+  const Mesh mesh = grid(5);
+  PartitionOptions by_faces = options("greedy");
+  by_faces.balance = Balance::kFaces;
+  for (uint32_t p : {8u, 10u}) {
+    const Partition partition = partition_mesh(mesh, p, by_faces);
+    expect_valid(mesh, partition, p, {}, Balance::kFaces);
+    std::vector<uint32_t> vertices(p, 0);
+    for (uint32_t s : partition.vertex_subset) ++vertices[s];
+    for (uint32_t k = 0; k < p; ++k) EXPECT_GE(vertices[k], 1u) << "p = " << p << ", subset " << k;
+  }
+}
+
 TEST(PartitionMesh, GridQuartersAreConnectedAndDeterministic) {
   const Mesh mesh = grid(8);  // 64 vertices, 98 faces
   for (const char* algorithm : {"greedy", "bfs"}) {
