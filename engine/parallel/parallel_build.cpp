@@ -571,11 +571,16 @@ ProgressiveMesh build_progressive_mesh_parallel(
     t = std::chrono::steady_clock::now();
     if (parallel.band_pass && round >= 1) {
       // The last round's bound vertices become the lagging ones: bound in this round too.
-      for (size_t v = 0; v < bound.size(); ++v) bound_before[v] &= bound[v];
+      std::vector<VertexId> lagging;
+      for (size_t v = 0; v < bound.size(); ++v) {
+        bound_before[v] &= bound[v];
+        if (bound_before[v]) lagging.push_back(VertexId(v));
+      }
       BandPriority band(keys, std::move(bound_before), ceiling);
       Simplifier pass(whole, band, standard_constraints(locked));
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
+      band_limits.first_queue_around = &lagging;  // the band refuses every other edge
       std::vector<CollapseRecord> band_records = pass.run(band_limits, {}, cancel);
       rs.band_pass_collapses = band_records.size();
       records.insert(records.end(), std::make_move_iterator(band_records.begin()),

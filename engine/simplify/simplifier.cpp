@@ -12,6 +12,30 @@ Simplifier::Simplifier(CollapseMesh& mesh, PriorityModule& priority,
                        std::vector<std::unique_ptr<ConstraintModule>> constraints)
     : mesh_(mesh), priority_(priority), constraints_(std::move(constraints)) {}
 
+void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
+                                    const CancelToken* cancel) {
+  std::vector<uint8_t> listed(mesh_.vertex_capacity(), 0);
+  for (VertexId v : vertices)
+    if (v < listed.size()) listed[v] = 1;
+  std::vector<VertexId> ring;
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const VertexId v = vertices[i];
+    if (v >= listed.size() || !mesh_.vertex_alive(v)) continue;
+    if (cancel && (i & 1023) == 0) cancel->check();
+    // v's neighbours, each once; an edge between two listed vertices from its smaller end.
+    ring.clear();
+    for (FaceId f : mesh_.faces_of(v))
+      for (VertexId u : mesh_.face(f))
+        if (u != v && !(listed[u] && u < v)) ring.push_back(u);
+    std::sort(ring.begin(), ring.end());
+    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    for (VertexId u : ring) {
+      Entry entry;
+      if (queue_entry(v, u, entry)) heap_.items().push_back(entry);
+    }
+  }
+}
+
 void Simplifier::push_edge(VertexId a, VertexId b) {
   Entry entry;
   if (queue_entry(a, b, entry)) heap_.push(entry);
@@ -185,8 +209,12 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   // of a boundary edge. The heap's order does not depend on the order of insertion.
   heap_.clear();
   compacted_size_ = 0;
-  heap_.reserve(mesh_.face_capacity() * 3);
-  for (FaceId f = 0; f < mesh_.face_capacity(); ++f) {
+  if (limits.first_queue_around) {
+    queue_edges_around(*limits.first_queue_around, cancel);
+  } else {
+    heap_.reserve(mesh_.face_capacity() * 3);
+  }
+  for (FaceId f = 0; f < mesh_.face_capacity() && !limits.first_queue_around; ++f) {
     if (!mesh_.face_alive(f)) continue;
     // The first costing of every edge takes a while with the energy: stay cancellable.
     if (cancel && (f & 1023) == 0) cancel->check();

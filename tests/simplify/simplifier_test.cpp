@@ -255,5 +255,63 @@ TEST(Simplifier, ACostlyModuleIsNotAskedToCostEdgesTheTopologicalRulesVeto) {
   }
 }
 
+// A module that costs only the edges with an end in a band (as the parallel build's band pass
+// does) gives the same run whether the first queue holds every edge of the mesh or only the
+// band's (SimplifierLimits::first_queue_around), and costs far fewer edges.
+TEST(Simplifier, AFirstQueueAroundTheBandGivesTheSameRun) {
+  class BandOnly : public PriorityWrapper {
+   public:
+    BandOnly(PriorityModule& inner, std::vector<uint8_t> band)
+        : PriorityWrapper(inner), band_(std::move(band)) {}
+    bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                  Costing costing) const override {
+      return (band_[a] || band_[b]) && inner_.evaluate(mesh, a, b, out, costing);
+    }
+    void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
+                   const EdgeFaces& edge) override {
+      band_[done.vs] = band_[done.vt] = 0;  // as the band pass: the band is done once collapsed
+      inner_.collapsed(mesh, done, edge);
+    }
+
+   private:
+    std::vector<uint8_t> band_;
+  };
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("stratocaster-9k.ply")));
+  // The band: a slab of the model, across its middle.
+  const Box box = bounding_box(repaired.mesh);
+  const double middle = 0.5 * (box.min[0] + box.max[0]), width = 0.06 * (box.max[0] - box.min[0]);
+  std::vector<uint8_t> band(repaired.mesh.vertex_count(), 0);
+  std::vector<VertexId> listed;
+  for (VertexId v = 0; v < repaired.mesh.vertex_count(); ++v)
+    if (std::abs(repaired.mesh.positions[v][0] - middle) < width) {
+      band[v] = 1;
+      listed.push_back(v);
+    }
+  ASSERT_GT(listed.size(), 20u);
+  auto run = [&](bool around) {
+    CollapseMesh cm(repaired.mesh);
+    QuadricPriority quadric(locked_vertices(repaired), QuadricOptions{});
+    BandOnly priority(quadric, band);
+    Simplifier simplifier(cm, priority, standard_constraints(locked_vertices(repaired)));
+    SimplifierLimits limits;
+    if (around) limits.first_queue_around = &listed;
+    std::vector<CollapseRecord> records = simplifier.run(limits, {}, nullptr);
+    return std::make_pair(std::move(records), simplifier.stats().evaluations);
+  };
+  const auto [all_records, all_evaluations] = run(false);
+  const auto [band_records, band_evaluations] = run(true);
+  EXPECT_GT(all_records.size(), 10u);
+  ASSERT_EQ(band_records.size(), all_records.size());
+  for (size_t i = 0; i < all_records.size(); ++i) {
+    const CollapseRecord &x = all_records[i], &y = band_records[i];
+    ASSERT_TRUE(x.vs == y.vs && x.vt == y.vt && x.position == y.position && x.cost == y.cost)
+        << "collapse " << i << " differs";
+  }
+  std::printf("band of %zu vertices: %llu costings from every edge, %llu from the band's\n",
+              listed.size(), (unsigned long long)all_evaluations,
+              (unsigned long long)band_evaluations);
+  EXPECT_LT(band_evaluations * 4, all_evaluations);
+}
+
 }  // namespace
 }  // namespace parapm
