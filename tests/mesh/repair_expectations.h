@@ -28,8 +28,8 @@ inline void expect_faithful_repair(const Mesh& input, const RepairedMesh& repair
   EXPECT_EQ(mesh.layout, input.layout);
   EXPECT_EQ(mesh.positions_are_float, input.positions_are_float);
 
-  // Faces: the input's, in order, minus the removed ones, up to merging copies; each input face
-  // at most once.
+  // Faces: the input's (in their order unless renumbered), minus the removed ones, up to
+  // merging copies; each input face at most once.
   ASSERT_EQ(repaired.input_face.size(), mesh.face_count());
   EXPECT_EQ(mesh.face_count() + report.degenerate_faces_removed + report.duplicate_faces_removed,
             input.face_count());
