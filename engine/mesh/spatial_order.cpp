@@ -20,11 +20,15 @@ uint64_t spread_bits(uint64_t x) {
   return x;
 }
 
+// x's place in [lo, hi] on 21 bits. Coordinates near the double range make x - lo or hi - lo
+// infinite and t NaN: those clamp too (the order is only a matter of speed).
 uint64_t quantise(double x, double lo, double hi) {
   constexpr double kMax = double((1u << 21) - 1);
-  if (!(hi > lo)) return 0;
+  if (!(hi > lo)) return 0;  // an axis of no extent
   const double t = (x - lo) / (hi - lo);
-  return uint64_t(std::clamp(t, 0.0, 1.0) * kMax);
+  if (!(t > 0)) return 0;  // also NaN
+  if (!(t < 1)) return uint64_t(kMax);
+  return uint64_t(t * kMax);
 }
 
 // Applies new_index[old] to a per-element array.

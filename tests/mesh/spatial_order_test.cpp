@@ -142,6 +142,18 @@ TEST(SpatialOrder, PerVertexWedgesStayPerVertex) {
     ASSERT_EQ(ordered.mesh.wedge_vertex[w], w);
 }
 
+// Coordinates at the ends of the double range: the codes' arithmetic overflows (infinite
+// extents, NaN ratios), which must only clamp.
+TEST(SpatialOrder, CoordinatesNearTheDoubleRangeClamp) {
+  Mesh mesh;
+  const double big = 1e308;
+  mesh.positions = {{-big, -big, 0}, {big, -big, 0}, {big, big, 1}, {-big, big, -1}, {0, 0, 0}};
+  mesh.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  const RepairedMesh ordered = repair_mesh(mesh);
+  expect_faithful_repair(mesh, ordered, RepairOrder::kAny);
+  expect_spatially_ordered(ordered.mesh);
+}
+
 TEST(SpatialOrder, EmptyAndSingleFaceMeshes) {
   EXPECT_EQ(repair_mesh(Mesh{}).mesh.vertex_count(), 0u);
   Mesh one;
