@@ -48,6 +48,23 @@ EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
   return result;
 }
 
+std::vector<FaceId> CollapseMesh::twin_faces() const {
+  std::vector<FaceId> twin(3 * faces_.size(), kNoId);
+  std::vector<std::pair<VertexId, FaceId>> fan;  // (the vertex before a, the face) around a
+  for (VertexId a = 0; a < vertex_capacity(); ++a) {
+    fan.clear();
+    for (FaceId f : faces_of_[a]) fan.emplace_back(faces_[f][(corner_of(faces_[f], a) + 2) % 3], f);
+    for (FaceId f : faces_of_[a]) {
+      const int i = corner_of(faces_[f], a);
+      const VertexId next = faces_[f][(i + 1) % 3];
+      // The face holding next -> a: next comes before a there (the last one, as edge_faces).
+      for (const auto& [before, g] : fan)
+        if (before == next) twin[3 * size_t(f) + size_t(i)] = g;
+    }
+  }
+  return twin;
+}
+
 uint32_t CollapseMesh::next_stamp() const {
   if (++stamp_ == 0) {  // wrapped: old marks could collide with new stamps
     std::fill(mark_.begin(), mark_.end(), 0);

@@ -45,6 +45,12 @@ class CollapseMesh {
   bool is_boundary(VertexId v) const { return boundary_[v]; }
 
   EdgeFaces edge_faces(VertexId a, VertexId b) const;
+  // For every corner slot 3 f + k of a live face f, the face across its edge t[k] -> t[k + 1]
+  // (the one holding t[k + 1] -> t[k]; kNoId on a boundary), dead faces' slots kNoId: what
+  // edge_faces(t[k + 1], t[k]).left gives for each, in one pass over the vertices' fans (each
+  // face read three times, not six times per edge: passes over every edge, such as a first
+  // queue or the sharp edges' search, used to spend most of their time in those lookups).
+  std::vector<FaceId> twin_faces() const;
   // The distinct vertices sharing a face with v, in no particular order.
   void neighbors(VertexId v, std::vector<VertexId>& out) const;
   // Calls visit(n) once for every vertex n adjacent to both a and b.

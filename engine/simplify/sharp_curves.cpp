@@ -58,12 +58,13 @@ std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& 
                                                             const SharpEdgeOptions& options) {
   std::vector<std::pair<VertexId, VertexId>> edges, creases;
   const double crease_cos = std::cos(options.crease_angle_degrees * M_PI / 180.0);
+  const std::vector<FaceId> twin = mesh.twin_faces();
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     if (!mesh.face_alive(f)) continue;
     const Triangle& t = mesh.face(f);
     for (int k = 0; k < 3; ++k) {
       const VertexId a = t[k], b = t[(k + 1) % 3];
-      const FaceId g = mesh.edge_faces(b, a).left;
+      const FaceId g = twin[3 * size_t(f) + size_t(k)];
       if (g == kNoId) {
         if (options.boundaries) edges.emplace_back(std::min(a, b), std::max(a, b));
         continue;

@@ -255,6 +255,38 @@ TEST(Simplifier, ACostlyModuleIsNotAskedToCostEdgesTheTopologicalRulesVeto) {
   }
 }
 
+// twin_faces() is edge_faces() of every live corner's edge, in one pass: on a real mesh with
+// boundaries and seams, before and after collapses (dead faces and emptied fans).
+TEST(Simplifier, TwinFacesAreTheEdgesFacesOfEveryCorner) {
+  const RepairedMesh repaired =
+      repair_mesh(read_mesh(testing::test_data("pymeshlab-bunny-textured-10k.obj")));
+  CollapseMesh cm(repaired.mesh);
+  auto expect_twins = [&](const char* when) {
+    const std::vector<FaceId> twin = cm.twin_faces();
+    ASSERT_EQ(twin.size(), 3 * cm.face_capacity());
+    size_t boundary = 0;
+    for (FaceId f = 0; f < cm.face_capacity(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const FaceId got = twin[3 * size_t(f) + size_t(k)];
+        if (!cm.face_alive(f)) {
+          ASSERT_EQ(got, kNoId) << when << ": dead face " << f;
+          continue;
+        }
+        const Triangle& t = cm.face(f);
+        ASSERT_EQ(got, cm.edge_faces(t[(k + 1) % 3], t[k]).left) << when << ": face " << f;
+        boundary += got == kNoId;
+      }
+    EXPECT_GT(boundary, 0u) << when << ": no boundary edge, a weak test";
+  };
+  expect_twins("input");
+  QuadricPriority priority(locked_vertices(repaired), QuadricOptions{});
+  Simplifier simplifier(cm, priority, standard_constraints(locked_vertices(repaired)));
+  SimplifierLimits limits;
+  limits.target_faces = cm.live_faces() / 3;
+  ASSERT_FALSE(simplifier.run(limits, {}, nullptr).empty());
+  expect_twins("after collapses");
+}
+
 // A module that costs only the edges with an end in a band (as the parallel build's band pass
 // does) gives the same run whether the first queue holds every edge of the mesh or only the
 // band's (SimplifierLimits::first_queue_around), and costs far fewer edges.
