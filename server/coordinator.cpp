@@ -48,6 +48,12 @@ std::string repairs_text(const RepairReport& r) {
   return text.str();
 }
 
+// The event as stored: its job and the time it happened.
+void stamp(parapm::v1::JobEvent& event, const std::string& job_id) {
+  event.set_job_id(job_id);
+  event.set_unix_ms(unix_ms_now());
+}
+
 }  // namespace
 
 Upload::Upload(std::string file_name, uint64_t max_bytes)
@@ -230,15 +236,13 @@ parapm::v1::Job Coordinator::cancel(const std::string& job_id) {
 }
 
 void Coordinator::emit(const std::string& job_id, parapm::v1::JobEvent event) {
-  event.set_job_id(job_id);
-  event.set_unix_ms(unix_ms_now());
+  stamp(event, job_id);
   store_.append_event(job_id, event.unix_ms(), event.SerializeAsString());
   events_changed_.notify_all();
 }
 
 void Coordinator::end_job(const JobRecord& record, parapm::v1::JobEvent terminal) {
-  terminal.set_job_id(record.job_id);
-  terminal.set_unix_ms(unix_ms_now());
+  stamp(terminal, record.job_id);
   store_.end_job(record, terminal.unix_ms(), terminal.SerializeAsString());
   events_changed_.notify_all();
 }

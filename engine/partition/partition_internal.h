@@ -45,6 +45,14 @@ struct VertexGraph {
 // ignored (no self loops).
 VertexGraph build_vertex_graph(const Mesh& mesh);
 
+// The edges between subsets, and per subset its connected pieces (partition_metrics.cpp).
+struct CutShape {
+  uint64_t cut_edges = 0;
+  std::vector<uint32_t> components;  // per subset
+};
+CutShape cut_shape(const VertexGraph& graph, const std::vector<uint32_t>& vertex_subset,
+                   uint32_t p);
+
 // Items 0..n-1 with integer keys 0..max_key, each in at most once. Insert, remove and changing
 // a key are O(1); pop_min scans up from the lowest key that may be occupied. Equal keys pop in
 // insertion order (a key change counts as a new insertion), so the order is deterministic.

@@ -9,6 +9,38 @@
 #include "util/error.h"
 
 namespace parapm {
+namespace partition_detail {
+
+CutShape cut_shape(const VertexGraph& graph, const std::vector<uint32_t>& vertex_subset,
+                   uint32_t p) {
+  // Cut edges and components together: union-find over the edges inside a subset.
+  const uint32_t n = graph.vertex_count();
+  std::vector<uint32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];  // path halving
+    return v;
+  };
+  CutShape shape;
+  for (uint32_t v = 0; v < n; ++v) {
+    for (uint32_t u : graph.neighbours_of(v)) {
+      if (u < v) continue;  // each edge once
+      if (vertex_subset[u] != vertex_subset[v]) {
+        ++shape.cut_edges;
+      } else {
+        const uint32_t a = find(u), b = find(v);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+  }
+  shape.components.assign(p, 0);
+  for (uint32_t v = 0; v < n; ++v) {
+    if (find(v) == v) ++shape.components[vertex_subset[v]];
+  }
+  return shape;
+}
+
+}  // namespace partition_detail
 
 PartitionMetrics partition_metrics(const Mesh& mesh, const Partition& partition,
                                    const PartitionOptions& options, double seconds) {
@@ -54,30 +86,10 @@ PartitionMetrics partition_metrics(const Mesh& mesh, const Partition& partition,
     if (vs[face[0]] != vs[face[1]] || vs[face[0]] != vs[face[2]]) ++metrics.cut_faces;
   }
 
-  // Cut edges and components together: union-find over the edges inside a subset.
-  const partition_detail::VertexGraph graph = partition_detail::build_vertex_graph(mesh);
-  const uint32_t n = graph.vertex_count();
-  std::vector<uint32_t> parent(n);
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];  // path halving
-    return v;
-  };
-  for (uint32_t v = 0; v < n; ++v) {
-    for (uint32_t u : graph.neighbours_of(v)) {
-      if (u < v) continue;  // each edge once
-      if (vs[u] != vs[v]) {
-        ++metrics.cut_edges;
-      } else {
-        const uint32_t a = find(u), b = find(v);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-      }
-    }
-  }
-  metrics.components.assign(p, 0);
-  for (uint32_t v = 0; v < n; ++v) {
-    if (find(v) == v) ++metrics.components[vs[v]];
-  }
+  const partition_detail::CutShape shape = partition_detail::cut_shape(
+      partition_detail::build_vertex_graph(mesh), partition.vertex_subset, p);
+  metrics.cut_edges = shape.cut_edges;
+  metrics.components = shape.components;
   return metrics;
 }
 

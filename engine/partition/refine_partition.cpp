@@ -9,6 +9,7 @@
 // from (seen on two meshes of ../shared/meshes, one component more), that partition is kept.
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <vector>
 
 #include "partition/partition_internal.h"
@@ -136,45 +137,18 @@ class Refiner {
   std::vector<uint64_t> load_, upper_, lower_;
 };
 
-struct Shape {
-  uint64_t cut_edges = 0;
-  uint64_t components = 0;  // connected pieces of the subsets, summed
-};
-
-Shape shape_of(const VertexGraph& graph, const std::vector<uint32_t>& subset) {
-  Shape shape;
-  const uint32_t n = graph.vertex_count();
-  std::vector<uint8_t> seen(n, 0);
-  std::vector<uint32_t> stack;
-  for (uint32_t s = 0; s < n; ++s) {
-    for (uint32_t u : graph.neighbours_of(s))
-      if (u > s && subset[u] != subset[s]) ++shape.cut_edges;
-    if (seen[s]) continue;
-    ++shape.components;
-    seen[s] = 1;
-    stack.assign(1, s);
-    while (!stack.empty()) {
-      const uint32_t v = stack.back();
-      stack.pop_back();
-      for (uint32_t u : graph.neighbours_of(v)) {
-        if (seen[u] || subset[u] != subset[s]) continue;
-        seen[u] = 1;
-        stack.push_back(u);
-      }
-    }
-  }
-  return shape;
-}
-
 }  // namespace
 
 void refine_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
                       Partition& partition) {
   const std::vector<uint32_t> before = partition.vertex_subset;
-  const Shape start = shape_of(graph, before);
+  auto pieces = [](const CutShape& shape) {
+    return std::accumulate(shape.components.begin(), shape.components.end(), uint64_t(0));
+  };
+  const CutShape start = cut_shape(graph, before, partition.subsets);
   Refiner(graph, targets, partition).run();
-  const Shape end = shape_of(graph, partition.vertex_subset);
-  if (end.cut_edges > start.cut_edges || end.components > start.components)
+  const CutShape end = cut_shape(graph, partition.vertex_subset, partition.subsets);
+  if (end.cut_edges > start.cut_edges || pieces(end) > pieces(start))
     partition.vertex_subset = before;
 }
 

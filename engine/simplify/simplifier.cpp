@@ -22,14 +22,10 @@ void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
     const VertexId v = vertices[i];
     if (v >= listed.size() || !mesh_.vertex_alive(v)) continue;
     if (cancel && (i & 1023) == 0) cancel->check();
-    // v's neighbours, each once; an edge between two listed vertices from its smaller end.
-    ring.clear();
-    for (FaceId f : mesh_.faces_of(v))
-      for (VertexId u : mesh_.face(f))
-        if (u != v && !(listed[u] && u < v)) ring.push_back(u);
-    std::sort(ring.begin(), ring.end());
-    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    mesh_.neighbors(v, ring);
     for (VertexId u : ring) {
+      if (listed[u] && u < v)
+        continue;  // an edge between two listed vertices: from its smaller end
       Entry entry;
       if (queue_entry(v, u, entry)) heap_.items().push_back(entry);
     }
