@@ -61,6 +61,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"asked_faces", r.asked_faces},
                       {"faces_after", r.faces_after},
                       {"partition_seconds", r.partition_seconds},
+                      {"append_seconds", r.append_seconds},
                       {"partition_overlap_seconds", r.partition_overlap_seconds},
                       {"extract_seconds", r.extract_seconds},
                       {"share_seconds", r.share_seconds},
@@ -84,6 +85,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
           {"setup_seconds", stats.setup_seconds},
           {"final_pass_collapses", stats.final_pass_collapses},
           {"final_pass_seconds", stats.final_pass_seconds},
+          {"final_append_seconds", stats.final_append_seconds},
           {"pm_build_seconds", stats.pm_build_seconds},
           {"cpu_seconds", stats.cpu_seconds},
           {"critical_path_seconds", stats.critical_path_seconds}};

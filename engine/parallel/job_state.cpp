@@ -46,13 +46,19 @@ void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const Su
 }
 
 MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
-                                const SubsetJob& job) {
+                                const SubsetJob& job, const std::vector<CollapseRecord>& records) {
+  std::vector<uint8_t> changed(mesh.vertex_capacity(), 0);
+  for (const CollapseRecord& r : records) {
+    if (r.vs >= changed.size() || r.vt >= changed.size() || !job.owned[r.vs] || !job.owned[r.vt])
+      throw_internal("export_result_state: a collapse of vertices the job does not own");
+    changed[r.vs] = changed[r.vt] = 1;
+  }
   MetricState state;
   state.metric = module.name();
   if (const auto* q = dynamic_cast<const QuadricPriority*>(&module)) {
-    state.quadric = q->export_global(maps_of(job), job.owned);
+    state.quadric = q->export_global(maps_of(job), changed);
   } else if (const auto* e = dynamic_cast<const EnergyPriority*>(&module)) {
-    state.energy = e->export_global(mesh, maps_of(job), job.owned);
+    state.energy = e->export_global(mesh, maps_of(job), changed);
   } else {
     throw_internal("export_result_state: no state export for metric " + module.name());
   }

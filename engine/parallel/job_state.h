@@ -10,6 +10,7 @@
 #include "parallel/subset_job.h"
 #include "simplify/module_state.h"
 #include "simplify/modules.h"
+#include "simplify/simplifier.h"
 
 namespace parapm {
 
@@ -22,10 +23,11 @@ MetricState export_job_state(const PriorityModule& master, const SubsetJob& job)
 // Error(kInvalidInput) when the state does not fit the module or the job's mesh.
 void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job);
 
-// The job's module state at its end, of the faces with three owned corners, the owned
-// vertices and their wedges, in global ids.
+// The job's module state at its end, in global ids: what its collapses `records` (in local
+// ids) changed, the rest being as the master has it (the quadrics of their vertices; the
+// energy's faces around them, their corners and wedges).
 MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
-                                const SubsetJob& job);
+                                const SubsetJob& job, const std::vector<CollapseRecord>& records);
 
 // The master takes a job's returned state. The jobs of a round own disjoint faces, vertices
 // and wedges, and mixed faces never change (subset_rule.h), so the order of imports is free.

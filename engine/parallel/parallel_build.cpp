@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 
 #include <spdlog/spdlog.h>
@@ -11,6 +12,7 @@
 #include "parallel/edge_keys.h"
 #include "parallel/job_pool.h"
 #include "parallel/job_state.h"
+#include "parallel/round_shares.h"
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
 #include "parallel/subset_rule.h"
@@ -50,6 +52,40 @@ std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
   return vertex_subset;
 }
 
+// Runs `work` on this thread and `side` beside it, on a thread of its own when the build may
+// use two (one after the other otherwise). `side` must not touch what `work` does.
+struct Beside {
+  double work_seconds = 0, side_seconds = 0;
+  double side_cpu_elsewhere = 0;  // the side's CPU when it ran on another thread
+};
+template <class Work, class Side>
+Beside run_beside(unsigned threads, Work&& work, Side&& side) {
+  Beside out;
+  auto timed_side = [&] {
+    const auto ts = std::chrono::steady_clock::now();
+    const double cpu = thread_cpu_seconds();
+    side();
+    out.side_seconds = seconds_since(ts);
+    return thread_cpu_seconds() - cpu;
+  };
+  std::future<double> beside;
+  if (pool_threads(threads, 2) >= 2) beside = std::async(std::launch::async, timed_side);
+  const auto tw = std::chrono::steady_clock::now();
+  try {
+    work();
+  } catch (...) {
+    if (beside.valid()) beside.wait();
+    throw;
+  }
+  out.work_seconds = seconds_since(tw);
+  if (beside.valid()) {
+    out.side_cpu_elsewhere = beside.get();
+  } else {
+    timed_side();
+  }
+  return out;
+}
+
 // The subsets of a round starting at `faces` (ParallelOptions::min_subset_faces); below 2 (with
 // p >= 2), no round.
 uint32_t round_subsets(const ParallelOptions& parallel, uint64_t faces) {
@@ -83,121 +119,6 @@ uint64_t round_seed(uint64_t seed, uint32_t round) {
   if (round == 0) return seed;
   SplitMix64 mix(seed + round);
   return mix.next() >> 1;
-}
-
-// What a sample of a round's edges says about its costs: the live inner edges (both ends in
-// one subset; every `stride`-th, about 1024 per subset), costed by the master's module.
-struct RoundCosts {
-  // The jobs' cost ceiling: `factor` times the water level, the cost below which the sampled
-  // edges, scaled to all edges, would give the round's collapses. A sequential run, cheapest
-  // first, would not go far above it in this round (the costs of the edges it creates grow,
-  // hence the factor); a subset whose region holds few cheap collapses would, if it had to
-  // remove its share of the faces whatever they cost. Infinite if `factor` is 0.
-  double ceiling = std::numeric_limits<double>::infinity();
-  // Per subset, the fraction of its sampled edges that are cheap: among the cheapest
-  // kCheapEdgesPerCollapse edges per collapse of the round, all subsets' edges ranked
-  // together (set_targets).
-  std::vector<double> cheap_fraction;
-};
-
-// Cheap edges counted per collapse of the round: a sequential run's costs grow as a region
-// coarsens, so the collapses it makes in a region follow the edges there below a cost a
-// few times the round's first quantile. Measured on the energy (docs/BENCHMARKS.md, "Shares
-// by cheap edges"): 1 and 1.5 left the 50% level of fandisk at p = 8 10% / 4% worse than
-// 2.5, 4 made it 15% worse; the 203k dragon's levels moved by less than 2%.
-constexpr double kCheapEdgesPerCollapse = 2.5;
-
-// Deterministic: the sample depends on the mesh only.
-RoundCosts sample_round_costs(const CollapseMesh& mesh, const PriorityModule& master,
-                              const std::vector<uint32_t>& vertex_subset, uint32_t p,
-                              uint64_t remove, double factor) {
-  RoundCosts out;
-  uint64_t total_edges = 0;
-  auto inner = [&](VertexId a, VertexId b) {
-    return a < b && vertex_subset[a] == vertex_subset[b];
-  };
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-    if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    for (int k = 0; k < 3; ++k) total_edges += inner(t[k], t[(k + 1) % 3]) ? 1 : 0;
-  }
-  const uint64_t stride = std::max<uint64_t>(1, total_edges / (1024 * uint64_t(p)));
-  std::vector<double> costs;
-  std::vector<std::vector<double>> subset_costs(p);
-  uint64_t index = 0;
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-    if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    for (int k = 0; k < 3; ++k) {
-      const VertexId a = t[k], b = t[(k + 1) % 3];
-      if (!inner(a, b) || index++ % stride != 0) continue;
-      CollapseCandidate c;
-      costs.push_back(master.evaluate(mesh, a, b, c, Costing::kQueue)
-                          ? c.cost
-                          : std::numeric_limits<double>::infinity());
-      subset_costs[vertex_subset[a]].push_back(costs.back());
-    }
-  }
-  if (costs.empty()) return out;
-  // A collapse removes two faces and about three edges.
-  const double fraction = std::min(1.0, double(remove) / 2 / double(total_edges));
-  auto quantile = [&](double q) {
-    const auto k = std::min(costs.size() - 1, size_t(q * double(costs.size())));
-    std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
-    return costs[k];
-  };
-  // At least the cost below which twice the round's collapses lie: where most sampled edges
-  // cost nothing (coplanar quadrics), factor x 0 would stop every job at once.
-  if (factor > 0)
-    out.ceiling = std::max(factor * quantile(fraction), quantile(std::min(1.0, 2 * fraction)));
-  const double cheap = quantile(std::min(1.0, kCheapEdgesPerCollapse * fraction));
-  out.cheap_fraction.assign(p, 0.0);
-  for (uint32_t s = 0; s < p; ++s) {
-    const std::vector<double>& own = subset_costs[s];
-    const auto below = std::count_if(own.begin(), own.end(), [&](double c) { return c <= cheap; });
-    out.cheap_fraction[s] = own.empty() ? fraction : double(below) / double(own.size());
-  }
-  return out;
-}
-
-// Each subset removes a share of the faces it can remove, so that its inside leaves the round
-// as coarse as the whole mesh should. Its border stays finer, for the next round's new
-// partition or the final pass to take, cheapest first, as a sequential run would have. (A
-// share of all its faces made a job coarsen its inside further to make up for its border: the
-// level a round left was uneven, up to 11% worse in RMS than the sequential one on a small
-// mesh cut in 8; docs/BENCHMARKS.md, "Shares of the removable faces".)
-// Without `cheap_fraction`, every share is the round's fraction (faces_before - goal) /
-// faces_before of the subset's removable faces. With it, the same total is divided in
-// proportion to the subset's removable faces times its fraction of cheap edges (at most 95%
-// of its removable faces): a sequential run takes more from a flat region than from a curved
-// one, and equal shares left the 50% level of the energy's PM up to 6% (the 203k dragon at
-// p = 8, 16) and 29% (fandisk at p = 8) worse than the sequential one (docs/BENCHMARKS.md,
-// "Shares by cheap edges"). Returns the faces asked of all jobs.
-uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& removable,
-                     uint64_t faces_before, uint64_t goal,
-                     const std::vector<double>& cheap_fraction) {
-  const double fraction =
-      faces_before > goal ? double(faces_before - goal) / double(faces_before) : 0.0;
-  std::vector<double> fractions(jobs.size(), fraction);
-  if (cheap_fraction.size() == jobs.size()) {
-    double total = 0, weighted = 0;
-    for (size_t s = 0; s < jobs.size(); ++s) {
-      total += fraction * double(removable[s]);
-      weighted += cheap_fraction[s] * double(removable[s]);
-    }
-    if (weighted > 0)
-      for (size_t s = 0; s < jobs.size(); ++s)
-        fractions[s] = std::min(0.95, total * cheap_fraction[s] / weighted);
-  }
-  uint64_t asked = 0;
-  for (size_t s = 0; s < jobs.size(); ++s) {
-    const auto share = uint64_t(std::llround(fractions[s] * double(removable[s])));
-    const uint64_t faces = jobs[s].mesh.face_count();
-    // 0 would mean "as far as legal": a job with nothing to remove keeps one face.
-    jobs[s].options.target_faces = std::max<uint64_t>(1, faces > share ? faces - share : 0);
-    asked += faces - jobs[s].options.target_faces;
-  }
-  return asked;
 }
 
 // The band pass's priority: the master's metric, restricted to edges with a lagging end (bound
@@ -359,6 +280,18 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // At most one collapse per vertex: no round's records move the earlier ones (growing by
   // doubling moved the 871k dragon's first 190k records at round 1's merge, 0.2 s).
   records.reserve(whole.live_vertices());
+  // A round's records wait for the next step of the master to go into `records`: the subsets'
+  // lists k-way merged by cost, then the band pass's. Nothing reads `records` before the PM is
+  // assembled, so the merge by cost (0.07 s for the 871k dragon's first round at p = 16) runs
+  // beside the next round's partition, or the final pass.
+  std::vector<std::vector<CollapseRecord>> pending_lists;
+  std::vector<CollapseRecord> pending_band;
+  auto append_pending = [&] {
+    append_merged_by_cost(pending_lists, records);
+    records.insert(records.end(), std::make_move_iterator(pending_band.begin()),
+                   std::make_move_iterator(pending_band.end()));
+    pending_band.clear();
+  };
   std::vector<uint8_t> bound_before;  // the previous round's bound vertices (subset_rule.h)
   double subsets_cpu = 0;
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
@@ -422,8 +355,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
     } else {
       PartitionOptions partition_options;
       partition_options.seed = round_seed(options.seed, round);
-      vertex_subset = partition_live(whole, subsets, partition_options);
-      rs.partition_seconds = seconds_since(t);
+      const Beside timed = run_beside(
+          parallel.threads,
+          [&] { vertex_subset = partition_live(whole, subsets, partition_options); },
+          append_pending);
+      rs.partition_seconds = timed.work_seconds;
+      rs.append_seconds = timed.side_seconds;
+      rs.partition_overlap_seconds = std::min(timed.work_seconds, timed.side_seconds);
+      subsets_cpu += timed.side_cpu_elsewhere;
     }
     if (events.partitioned) events.partitioned(round, subsets, rs.faces_before);
     // The partition's border (sequential, O(faces), counted with the partition).
@@ -447,20 +386,11 @@ ProgressiveMesh build_progressive_mesh_parallel(
     t = std::chrono::steady_clock::now();
     const std::vector<std::vector<VertexId>> owned = owned_vertices(whole, vertex_subset, subsets);
     double sequential_extract = seconds_since(t);
-    RoundCosts round_costs;
-    if (parallel.water_level_factor > 0 || parallel.cost_shares) {
-      const auto ts = std::chrono::steady_clock::now();
-      round_costs =
-          sample_round_costs(whole, keys, vertex_subset, subsets, rs.faces_before - rs.goal_faces,
-                             parallel.water_level_factor);
-      if (!parallel.cost_shares) round_costs.cheap_fraction.clear();
-      if (parallel.water_level_factor > 0) rs.water_level = round_costs.ceiling;
-      rs.share_seconds = seconds_since(ts);
-      sequential_extract += rs.share_seconds;
-    }
+    const bool sample = parallel.water_level_factor > 0 || parallel.cost_shares;
     std::vector<SubsetJob> jobs(subsets);
     std::vector<uint64_t> removable(subsets, 0);
-    std::vector<double> job_cpu(jobs.size(), 0);
+    std::vector<SubsetSample> samples(sample ? subsets : 0);
+    std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
     run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
       const double cpu = thread_cpu_seconds();
       // The jobs' meshes carry the input's wedge values; the metric's current ones
@@ -471,8 +401,24 @@ ProgressiveMesh build_progressive_mesh_parallel(
       const std::vector<uint8_t> free = free_vertices(jobs[i].mesh, jobs[i].owned);
       removable[i] = removable_faces(jobs[i].mesh, free);
       if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i], free);
+      if (sample) {
+        const double sample_start = thread_cpu_seconds();
+        samples[i] = sample_subset(jobs[i], free, carry_keys, jobs[i].keys);
+        sample_cpu[i] = thread_cpu_seconds() - sample_start;
+      }
       job_cpu[i] = thread_cpu_seconds() - cpu;
     });
+    // The water level and the shares (sequential: a sort of the samples).
+    RoundCosts round_costs;
+    if (sample) {
+      const auto ts = std::chrono::steady_clock::now();
+      round_costs =
+          round_costs_of(samples, rs.faces_before - rs.goal_faces, parallel.water_level_factor);
+      if (!parallel.cost_shares) round_costs.cheap_fraction.clear();
+      if (parallel.water_level_factor > 0) rs.water_level = round_costs.ceiling;
+      sequential_extract += seconds_since(ts);
+      for (double c : sample_cpu) rs.share_seconds += c;
+    }
     rs.asked_faces =
         set_targets(jobs, removable, rs.faces_before, rs.goal_faces, round_costs.cheap_fraction);
     // Deferred re-costing as the sequential build has it at these face counts: in every round
@@ -556,9 +502,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
       // the bookkeeping, whichever is longer.
       rs.merge_overlap_seconds =
           std::max(0.0, seconds_since(tr) - std::max(replay.slowest_seconds, bookkeeping_seconds));
-      // Straight into the PM's records: each record moved once (a merged list moved again
-      // took as long as the merge itself, 0.08 s in the 871k dragon's first round at p = 16).
-      append_merged_by_cost(lists, records);
+      // Into the PM's records at the next step (append_pending): each record moved once (a
+      // merged list moved again took as long as the merge itself).
+      pending_lists = std::move(lists);
     }
     rs.merge_seconds = seconds_since(t);
 
@@ -581,17 +527,16 @@ ProgressiveMesh build_progressive_mesh_parallel(
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
       band_limits.first_queue_around = &lagging;  // the band refuses every other edge
-      std::vector<CollapseRecord> band_records = pass.run(band_limits, {}, cancel);
-      rs.band_pass_collapses = band_records.size();
-      records.insert(records.end(), std::make_move_iterator(band_records.begin()),
-                     std::make_move_iterator(band_records.end()));
+      pending_band = pass.run(band_limits, {}, cancel);
+      rs.band_pass_collapses = pending_band.size();
     }
     rs.band_pass_seconds = seconds_since(t);
     bound_before = std::move(bound);
     rs.faces_after = whole.live_faces();
-    st.critical_path_seconds += rs.partition_seconds - rs.partition_overlap_seconds +
-                                rs.extract_critical_seconds + rs.slowest_subset_cpu_seconds +
-                                rs.merge_seconds - rs.merge_overlap_seconds + rs.band_pass_seconds;
+    st.critical_path_seconds += rs.partition_seconds + rs.append_seconds -
+                                rs.partition_overlap_seconds + rs.extract_critical_seconds +
+                                rs.slowest_subset_cpu_seconds + rs.merge_seconds -
+                                rs.merge_overlap_seconds + rs.band_pass_seconds;
     spdlog::debug(
         "parallel round {}: {} subsets {}->{} faces (goal {}{}; {} border faces), partition "
         "{:.3f} s, extract {:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} "
@@ -623,14 +568,24 @@ ProgressiveMesh build_progressive_mesh_parallel(
   limits.target_faces = target;
   if (options.defer_recosting) limits.defer_above_faces = defer_line;
   const uint64_t done_before = input_faces - whole.live_faces();
-  std::vector<CollapseRecord> final_records = final_pass.run(
-      limits,
-      [&](uint64_t done, uint64_t) {
-        if (progress) progress(done_before + done, input_faces - target);
+  const double final_setup_seconds = seconds_since(t);
+  std::vector<CollapseRecord> final_records;
+  // The last round's records go into `records` beside it (append_pending).
+  const Beside timed = run_beside(
+      parallel.threads,
+      [&] {
+        final_records = final_pass.run(
+            limits,
+            [&](uint64_t done, uint64_t) {
+              if (progress) progress(done_before + done, input_faces - target);
+            },
+            cancel);
       },
-      cancel);
+      append_pending);
   st.final_pass_collapses = final_records.size();
-  st.final_pass_seconds = seconds_since(t);
+  st.final_pass_seconds = final_setup_seconds + timed.work_seconds;
+  st.final_append_seconds = timed.side_seconds;
+  subsets_cpu += timed.side_cpu_elsewhere;
   st.stop_reason = final_pass.stats().stop_reason;
   {
     const SimplifierStats& fs = final_pass.stats();
@@ -652,7 +607,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
   pm.info.metric = master->name();
   st.pm_build_seconds = seconds_since(t);
   st.collapses = records.size();
-  st.critical_path_seconds += st.final_pass_seconds + st.pm_build_seconds;
+  st.critical_path_seconds += st.final_pass_seconds +
+                              std::max(0.0, st.final_append_seconds - timed.work_seconds) +
+                              st.pm_build_seconds;
   st.seconds = seconds_since(start);
   st.cpu_seconds = subsets_cpu + (thread_cpu_seconds() - master_cpu_start);
   pm.info.seconds = st.seconds;

@@ -104,11 +104,15 @@ struct RoundStats {
   uint64_t asked_faces = 0;
   uint64_t faces_after = 0;
   double partition_seconds = 0;  // with finding its border (bound_vertices, border_faces)
-  // Round 0's partition is drawn beside the master's initialisation: the shorter of the two,
-  // which the critical path leaves out.
+  // The previous round's records (its subsets' lists merged by cost, then its band pass's) go
+  // into the PM's list beside this round's partition.
+  double append_seconds = 0;
+  // Round 0's partition is drawn beside the master's initialisation, a later round's beside
+  // the append: the shorter of the two, which the critical path leaves out.
   double partition_overlap_seconds = 0;
   double extract_seconds = 0;  // jobs and their state, shares included (wall)
-  double share_seconds = 0;    // of which costing the edge sample (water level, shares)
+  // The edge sample (water level, shares), costed in the extraction's tasks: their CPU summed.
+  double share_seconds = 0;
   // Each job's mesh and state are built on the pool: the slowest one's CPU, and the
   // extraction's share of the critical path (its sequential steps plus the slowest job).
   double slowest_extract_cpu_seconds = 0;
@@ -119,7 +123,7 @@ struct RoundStats {
   uint64_t border_faces = 0;
   bool border_limited = false;
   double subsets_seconds = 0;  // wall time of the round's jobs
-  double merge_seconds = 0;    // replay on the whole mesh, state import, keys, k-way merge
+  double merge_seconds = 0;    // replay on the whole mesh, state import, keys
   // The subsets' replays run side by side, and beside the rest (state import, water level,
   // keys), on the pool's threads: what of it would overlap with a core per task (the critical
   // path leaves it out).
@@ -142,15 +146,17 @@ struct ParallelStats {
   double setup_seconds = 0;  // the master's metric, initialised once on the whole mesh
   uint64_t final_pass_collapses = 0;
   double final_pass_seconds = 0;
+  double final_append_seconds = 0;  // the last round's records appended, beside the final pass
   double pm_build_seconds = 0;
   uint64_t collapses = 0;
   std::string stop_reason;  // of the final pass
   double seconds = 0;       // the whole construction, wall
   double cpu_seconds = 0;   // the subsets' CPU plus the master's (partition, merge, final pass)
   // What the build would take with one processor per subset: setup, then per round the
-  // partition, extraction (its sequential steps and the slowest job's), the slowest subset's
-  // CPU, the merge and the band pass, then the final pass and the PM assembly (CPU of the
-  // jobs, not wall: on a loaded machine wall time is not the job's).
+  // partition (or the previous round's append, if longer), extraction (its sequential steps
+  // and the slowest job's), the slowest subset's CPU, the merge and the band pass, then the
+  // final pass (or the last append) and the PM assembly (CPU of the jobs, not wall: on a
+  // loaded machine wall time is not the job's).
   double critical_path_seconds = 0;
 };
 

@@ -44,6 +44,25 @@ std::vector<EdgeKey> current_keys_in_global_ids(const KeyMemo& memo, const Colla
 
 }  // namespace
 
+SimplifyOptions simplify_options_of(const SubsetOptions& subset) {
+  SimplifyOptions options;
+  options.metric = subset.metric;
+  options.samples_per_face = subset.samples_per_face;
+  options.crease_angle_degrees = subset.crease_angle_degrees;
+  options.attribute_weight = subset.attribute_weight;
+  options.energy = subset.energy;
+  options.seed = subset.seed;
+  check_simplify_options(options);
+  return options;
+}
+
+std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseMesh& working) {
+  std::unique_ptr<PriorityModule> module = make_priority_module(
+      simplify_options_of(job.options), job.mesh, job.locked, job.options.reference_diagonal);
+  if (!job.state.empty()) import_job_state(*module, working, job);
+  return module;
+}
+
 double thread_cpu_seconds() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -55,14 +74,7 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
   validate_subset_job(job);
-  SimplifyOptions options;
-  options.metric = job.options.metric;
-  options.samples_per_face = job.options.samples_per_face;
-  options.crease_angle_degrees = job.options.crease_angle_degrees;
-  options.attribute_weight = job.options.attribute_weight;
-  options.energy = job.options.energy;
-  options.seed = job.options.seed;
-  check_simplify_options(options);
+  const SimplifyOptions options = simplify_options_of(job.options);
 
   SubsetResult result;
   result.round = job.round;
@@ -73,14 +85,10 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   for (uint8_t f : free_vertex) result.free_vertices += f;
 
   CollapseMesh working(job.mesh);
-  std::unique_ptr<PriorityModule> metric =
-      make_priority_module(options, job.mesh, job.locked, job.options.reference_diagonal);
+  std::unique_ptr<PriorityModule> metric = job_module(job, working);
   // With a state, the metric is the master's over the job: imported, not initialised.
   std::unique_ptr<PriorityModule> imported;
-  if (!job.state.empty()) {
-    import_job_state(*metric, working, job);
-    imported = without_initialize(*metric);
-  }
+  if (!job.state.empty()) imported = without_initialize(*metric);
   PriorityModule& module = imported ? *imported : *metric;
   std::optional<KeyMemo> memo;  // only for a metric whose keys are worth carrying (costly())
   if (metric->costly()) {
@@ -97,8 +105,8 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   limits.target_faces = job.options.target_faces;
   if (job.options.defer_recosting) limits.defer_above_faces = 0;
   result.records = simplifier.run(limits, progress, cancel);
+  if (!job.state.empty()) result.state = export_result_state(*metric, working, job, result.records);
   for (CollapseRecord& r : result.records) globalise(r, job);
-  if (!job.state.empty()) result.state = export_result_state(*metric, working, job);
   // Keys mean something to the master only when the job's state is the master's.
   if (memo && !job.state.empty()) result.keys = current_keys_in_global_ids(*memo, working, job);
   result.keys_reused = memo ? memo->reused() : 0;

@@ -4,11 +4,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "parallel/subset_job.h"
+#include "simplify/modules.h"
 #include "simplify/simplifier.h"
+#include "simplify/simplify.h"
 #include "util/progress.h"
 
 namespace parapm {
@@ -19,8 +22,8 @@ struct SubsetResult {
   // In the order performed, in global ids (vs, vt, vl, vr, fl, fr, corner and changed
   // wedges), with their costs: ready to be merged (collapse_merge.h) or streamed.
   std::vector<CollapseRecord> records;
-  // With a job state: the metric's state at the end, of the faces with three owned corners,
-  // the owned vertices and their wedges, in global ids (job_state.h). Empty otherwise.
+  // With a job state: the metric's state at the end, of what the job changed, in global ids
+  // (job_state.h, export_result_state). Empty otherwise.
   MetricState state;
   // The queue keys still current at the end (edge_keys.h), in global ids, sorted by (a, b);
   // the next round's jobs take those of their free edges instead of costing them again.
@@ -38,6 +41,13 @@ struct SubsetResult {
 // kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing.
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr);
+
+// The options a job's metric is made with (Error(kInvalidInput) for invalid ones).
+SimplifyOptions simplify_options_of(const SubsetOptions& subset);
+
+// The job's metric module over `working` (a CollapseMesh of job.mesh), as simplify_subset
+// makes it: with a job state, the master's state imported (not yet initialised otherwise).
+std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseMesh& working);
 
 // CPU seconds used by the calling thread so far.
 double thread_cpu_seconds();

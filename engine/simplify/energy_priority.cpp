@@ -132,21 +132,25 @@ EnergyState EnergyPriority::export_local(const IdMaps& maps) const {
 }
 
 EnergyState EnergyPriority::export_global(const CollapseMesh& mesh, const IdMaps& maps,
-                                          const std::vector<uint8_t>& owned) const {
-  std::vector<VertexId> vertices;
-  for (VertexId v = 0; v < owned.size(); ++v)
-    if (owned[v]) vertices.push_back(v);
-  // The faces with three owned corners, alive or not (a collapse renames an owned corner to
-  // an owned vertex, so the set is that of the job's start); mixed faces never change.
+                                          const std::vector<uint8_t>& changed) const {
+  // The faces around a changed vertex, alive or not: a collapse changes the points, corners and
+  // drift of the faces around vs (its star, which stay around vs or the vertex vs later
+  // collapses into) and removes two faces around vt. Their corners: a collapse renames vt in
+  // its neighbours' sharp lists, and those neighbours stay neighbours of vs.
+  std::vector<uint8_t> vertex_mark(changed.size(), 0);
   std::vector<FaceId> faces;
   std::vector<WedgeId> wedges;
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     const Triangle& t = mesh.face(f);
-    if (owned[t[0]] && owned[t[1]] && owned[t[2]]) faces.push_back(f);
+    if (!changed[t[0]] && !changed[t[1]] && !changed[t[2]]) continue;
+    faces.push_back(f);
+    for (int k = 0; k < 3; ++k) vertex_mark[t[k]] = 1;
     if (scalar_.enabled() && mesh.has_wedges())
-      for (int k = 0; k < 3; ++k)
-        if (owned[t[k]]) wedges.push_back(mesh.corner_wedges(f)[k]);
+      for (int k = 0; k < 3; ++k) wedges.push_back(mesh.corner_wedges(f)[k]);
   }
+  std::vector<VertexId> vertices;
+  for (VertexId v = 0; v < changed.size(); ++v)
+    if (changed[v] || vertex_mark[v]) vertices.push_back(v);
   std::sort(wedges.begin(), wedges.end());
   wedges.erase(std::unique(wedges.begin(), wedges.end()), wedges.end());
   EnergyState state;
@@ -290,6 +294,13 @@ std::vector<EnergyPriority::PointState> EnergyPriority::point_states() const {
   for (VertexId v = 0; v < parked_point_.size(); ++v)
     if (parked_point_[v] != kNoPoint) states[parked_point_[v]].parked = v;
   return states;
+}
+
+size_t EnergyPriority::held_point_count() const {
+  size_t held = 0;
+  for (const auto& list : face_points_) held += list.size();
+  for (uint32_t id : parked_point_) held += id != kNoPoint ? 1 : 0;
+  return held;
 }
 
 void EnergyPriority::gather_face(FaceId f, int home) const {

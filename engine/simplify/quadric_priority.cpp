@@ -112,10 +112,10 @@ void QuadricPriority::import_local(const CollapseMesh& mesh, const QuadricState&
 }
 
 QuadricState QuadricPriority::export_global(const IdMaps& maps,
-                                            const std::vector<uint8_t>& owned) const {
+                                            const std::vector<uint8_t>& changed) const {
   QuadricState state;
-  for (VertexId v = 0; v < owned.size(); ++v)
-    if (owned[v]) {
+  for (VertexId v = 0; v < changed.size(); ++v)
+    if (changed[v]) {
       state.vertices.push_back((*maps.vertex)[v]);
       state.quadrics.push_back(quadrics_[v]);
     }

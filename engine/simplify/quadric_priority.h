@@ -32,11 +32,12 @@ class QuadricPriority : public PriorityModule {
   // State export/import for the parallel construction (module_state.h). export_local: the
   // quadrics of a job's vertices (maps: its local -> global ids), in its local ids.
   // import_local: a job's module from that state, instead of initialize(). export_global: the
-  // quadrics of the job's owned vertices (owned: per local vertex), in global ids.
+  // quadrics of the vertices marked in `changed` (per local vertex: those the job's collapses
+  // moved or removed; the others' quadrics are the master's), in global ids.
   // import_global: the master overwrites those vertices' quadrics.
   QuadricState export_local(const IdMaps& maps) const;
   void import_local(const CollapseMesh& mesh, const QuadricState& state);
-  QuadricState export_global(const IdMaps& maps, const std::vector<uint8_t>& owned) const;
+  QuadricState export_global(const IdMaps& maps, const std::vector<uint8_t>& changed) const;
   void import_global(const QuadricState& state);
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 

@@ -196,6 +196,10 @@ TEST(JobState, ImportedStateEqualsTheReplayedState) {
         const auto* e = dynamic_cast<EnergyPriority*>(master.get());
         const auto* r = dynamic_cast<EnergyPriority*>(replayed.get());
         ASSERT_EQ(e->point_count(), r->point_count());
+        // Each point held once: a face a job changed but did not return would keep points
+        // that moved on (held twice) or lose the ones that came (held nowhere).
+        ASSERT_EQ(e->held_point_count(), r->held_point_count()) << what;
+        ASSERT_LE(e->held_point_count(), e->point_count()) << what;
         size_t parked = 0, other_face = 0;
         double sum_master = 0, sum_replayed = 0;
         const auto es = e->point_states(), rs = r->point_states();

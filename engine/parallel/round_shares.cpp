@@ -1,0 +1,122 @@
+#include "parallel/round_shares.h"
+
+#include <algorithm>
+#include <memory>
+#include <optional>
+#include <utility>
+
+#include "parallel/simplify_subset.h"
+#include "simplify/collapse_mesh.h"
+#include "util/error.h"
+
+namespace parapm {
+
+SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
+                           std::vector<EdgeKey>& keys) {
+  if (job.state.empty()) throw_internal("sample_subset: a job without the master's state");
+  SubsetSample out;
+  const Mesh& mesh = job.mesh;
+  auto inner = [&](VertexId a, VertexId b) { return a < b && job.owned[a] && job.owned[b]; };
+  for (const Triangle& t : mesh.faces)
+    for (int k = 0; k < 3; ++k) out.inner_edges += inner(t[k], t[(k + 1) % 3]) ? 1 : 0;
+  if (out.inner_edges == 0) return out;
+  const uint64_t stride = std::max<uint64_t>(1, out.inner_edges / kSampledEdgesPerSubset);
+  CollapseMesh local(mesh);
+  std::unique_ptr<PriorityModule> module = job_module(job, local);
+  std::optional<KeyMemo> memo;
+  if (carry_keys) {
+    memo.emplace(*module, local.vertex_capacity());
+    memo->reset(keys);
+  }
+  const PriorityModule& costing = memo ? static_cast<const PriorityModule&>(*memo) : *module;
+  uint64_t index = 0;
+  const size_t carried = keys.size();
+  for (const Triangle& t : mesh.faces)
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3];
+      if (!inner(a, b) || index++ % stride != 0) continue;
+      CollapseCandidate c;
+      const bool placed = costing.evaluate(local, a, b, c, Costing::kQueue);
+      out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
+      if (carry_keys && free[a] && free[b])
+        keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
+    }
+  if (keys.size() > carried) {
+    // Carried keys answered the edges they cover: those came back the same. Keep one of each.
+    sort_keys(keys);
+    keys.erase(
+        std::unique(keys.begin(), keys.end(),
+                    [](const EdgeKey& x, const EdgeKey& y) { return x.a == y.a && x.b == y.b; }),
+        keys.end());
+  }
+  return out;
+}
+
+RoundCosts round_costs_of(const std::vector<SubsetSample>& samples, uint64_t remove,
+                          double factor) {
+  RoundCosts out;
+  uint64_t total_edges = 0;
+  std::vector<std::pair<double, double>> weighted;  // (cost, edges it stands for)
+  for (const SubsetSample& s : samples) {
+    total_edges += s.inner_edges;
+    for (double c : s.costs)
+      weighted.push_back({c, double(s.inner_edges) / double(s.costs.size())});
+  }
+  if (weighted.empty()) return out;
+  std::sort(weighted.begin(), weighted.end());
+  double total_weight = 0;
+  for (const auto& w : weighted) total_weight += w.second;
+  // The cost below which a fraction q of the edges lies: the first sampled cost whose
+  // cumulative weight passes q (with equal weights, the floor(q n)-th smallest).
+  auto quantile = [&](double q) {
+    double sum = 0;
+    for (const auto& [cost, weight] : weighted) {
+      sum += weight;
+      if (sum > q * total_weight) return cost;
+    }
+    return weighted.back().first;
+  };
+  // A collapse removes two faces and about three edges.
+  const double fraction = std::min(1.0, double(remove) / 2 / double(total_edges));
+  // At least the cost below which twice the round's collapses lie: where most sampled edges
+  // cost nothing (coplanar quadrics), factor x 0 would stop every job at once.
+  if (factor > 0)
+    out.ceiling = std::max(factor * quantile(fraction), quantile(std::min(1.0, 2 * fraction)));
+  const double cheap = quantile(std::min(1.0, kCheapEdgesPerCollapse * fraction));
+  out.cheap_fraction.assign(samples.size(), 0.0);
+  for (size_t s = 0; s < samples.size(); ++s) {
+    const std::vector<double>& own = samples[s].costs;
+    const auto below = std::count_if(own.begin(), own.end(), [&](double c) { return c <= cheap; });
+    out.cheap_fraction[s] = own.empty() ? fraction : double(below) / double(own.size());
+  }
+  return out;
+}
+
+uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& removable,
+                     uint64_t faces_before, uint64_t goal,
+                     const std::vector<double>& cheap_fraction) {
+  const double fraction =
+      faces_before > goal ? double(faces_before - goal) / double(faces_before) : 0.0;
+  std::vector<double> fractions(jobs.size(), fraction);
+  if (cheap_fraction.size() == jobs.size()) {
+    double total = 0, weighted = 0;
+    for (size_t s = 0; s < jobs.size(); ++s) {
+      total += fraction * double(removable[s]);
+      weighted += cheap_fraction[s] * double(removable[s]);
+    }
+    if (weighted > 0)
+      for (size_t s = 0; s < jobs.size(); ++s)
+        fractions[s] = std::min(0.95, total * cheap_fraction[s] / weighted);
+  }
+  uint64_t asked = 0;
+  for (size_t s = 0; s < jobs.size(); ++s) {
+    const auto share = uint64_t(std::llround(fractions[s] * double(removable[s])));
+    const uint64_t faces = jobs[s].mesh.face_count();
+    // 0 would mean "as far as legal": a job with nothing to remove keeps one face.
+    jobs[s].options.target_faces = std::max<uint64_t>(1, faces > share ? faces - share : 0);
+    asked += faces - jobs[s].options.target_faces;
+  }
+  return asked;
+}
+
+}  // namespace parapm

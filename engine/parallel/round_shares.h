@@ -1,0 +1,79 @@
+// What a round of the parallel construction asks of its jobs (parallel_build.cpp): a sample of
+// its edges' costs, taken by the jobs' own modules side by side, sets the jobs' cost ceiling
+// (the water level) and their shares of the round's faces (by their cheap edges).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "parallel/edge_keys.h"
+#include "parallel/subset_job.h"
+
+namespace parapm {
+
+// What a sample of a round's edges says about its costs: the live inner edges (both ends in
+// one subset; every stride-th of them, about kSampledEdgesPerSubset per subset).
+struct RoundCosts {
+  // The jobs' cost ceiling: `factor` times the water level, the cost below which the sampled
+  // edges, scaled to all edges, would give the round's collapses. A sequential run, cheapest
+  // first, would not go far above it in this round (the costs of the edges it creates grow,
+  // hence the factor); a subset whose region holds few cheap collapses would, if it had to
+  // remove its share of the faces whatever they cost. Infinite if `factor` is 0.
+  double ceiling = std::numeric_limits<double>::infinity();
+  // Per subset, the fraction of its sampled edges that are cheap: among the cheapest
+  // kCheapEdgesPerCollapse edges per collapse of the round, all subsets' edges ranked
+  // together (set_targets).
+  std::vector<double> cheap_fraction;
+};
+
+// Cheap edges counted per collapse of the round: a sequential run's costs grow as a region
+// coarsens, so the collapses it makes in a region follow the edges there below a cost a
+// few times the round's first quantile. Measured on the energy (docs/BENCHMARKS.md, "Shares
+// by cheap edges"): 1 and 1.5 left the 50% level of fandisk at p = 8 10% / 4% worse than
+// 2.5, 4 made it 15% worse; the 203k dragon's levels moved by less than 2%.
+constexpr double kCheapEdgesPerCollapse = 2.5;
+// Fewer made fandisk's shares at p = 8 worse (docs/BENCHMARKS.md, "The edge sample, fewer
+// edges").
+constexpr uint64_t kSampledEdgesPerSubset = 1024;
+
+// One subset's part of the sample: its inner edges, and the costs of every stride-th one.
+struct SubsetSample {
+  uint64_t inner_edges = 0;
+  std::vector<double> costs;  // infinite: the module could not place the edge
+};
+
+// The sample of a job's subset (a job with the master's state: Error(kInternal) otherwise),
+// costed by the job's own module, imported from the job's state as simplify_subset imports
+// it, so that the subsets' samples are costed side by side (in the extraction's tasks).
+// Costed on the master, one after the other, the sample was the largest sequential step of a
+// round: 0.04-0.09 s per round on the 871k dragon at p = 16.
+// `free`: free_vertices of the job. `keys` (with carry_keys): the job's carried keys (local
+// ids, sorted), which answer the edges they cover; the sampled edges with two free ends join
+// them, so that the job does not cost them again (its module costs them alike: same state).
+SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
+                           std::vector<EdgeKey>& keys);
+
+// The round's costs from its subsets' samples (one per job, in order), each sampled edge
+// standing for its subset's inner edges over its sampled ones; `remove`: the faces the round
+// removes, `factor`: the water level's factor (0: no ceiling). Deterministic.
+RoundCosts round_costs_of(const std::vector<SubsetSample>& samples, uint64_t remove, double factor);
+
+// Each subset removes a share of the faces it can remove, so that its inside leaves the round
+// as coarse as the whole mesh should. Its border stays finer, for the next round's new
+// partition or the final pass to take, cheapest first, as a sequential run would have. (A
+// share of all its faces made a job coarsen its inside further to make up for its border: the
+// level a round left was uneven, up to 11% worse in RMS than the sequential one on a small
+// mesh cut in 8; docs/BENCHMARKS.md, "Shares of the removable faces".)
+// Without `cheap_fraction`, every share is the round's fraction (faces_before - goal) /
+// faces_before of the subset's removable faces. With it, the same total is divided in
+// proportion to the subset's removable faces times its fraction of cheap edges (at most 95%
+// of its removable faces): a sequential run takes more from a flat region than from a curved
+// one, and equal shares left the 50% level of the energy's PM up to 6% (the 203k dragon at
+// p = 8, 16) and 29% (fandisk at p = 8) worse than the sequential one (docs/BENCHMARKS.md,
+// "Shares by cheap edges"). Returns the faces asked of all jobs.
+uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& removable,
+                     uint64_t faces_before, uint64_t goal,
+                     const std::vector<double>& cheap_fraction);
+
+}  // namespace parapm

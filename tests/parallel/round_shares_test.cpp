@@ -1,0 +1,118 @@
+// What a round asks of its jobs (engine/parallel/round_shares.h): the edge sample, taken by each
+// job's own module in the extraction's tasks, and the water level and cheap-edge fractions
+// drawn from it, each sampled edge weighted by the edges it stands for.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "parallel/round_shares.h"
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_rule.h"
+#include "parallel_test_support.h"
+
+namespace parapm {
+namespace {
+
+void expect_same_records(const std::vector<CollapseRecord>& a, const std::vector<CollapseRecord>& b,
+                         const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].vs, b[i].vs) << what << " record " << i;
+    ASSERT_EQ(a[i].vt, b[i].vt) << what << " record " << i;
+    ASSERT_EQ(std::memcmp(&a[i].cost, &b[i].cost, sizeof(double)), 0) << what << " record " << i;
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(a[i].position[k], b[i].position[k]) << what;
+  }
+}
+
+// The sampled edges with two free ends join the job's keys. They are the job's own costs (its
+// module is imported from the same state), so the job given them makes the run it makes without
+// them, answering those costings from the keys. Half the fresh keys are carried in, so that the
+// sample answers some edges from them too.
+TEST(RoundShares, SampledKeysGiveTheJobsOwnRun) {
+  for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
+    SimplifyOptions options;
+    options.metric = "energy";
+    testing::RoundZero round(name, options, 3);
+    for (SubsetJob& job : round.jobs) {
+      const std::string what = std::string(name) + " subset " + std::to_string(job.subset);
+      job.options.target_faces = job.mesh.face_count() * 2 / 5;
+      const std::vector<EdgeKey> fresh = testing::fresh_keys(*round.master, round.whole, job);
+      std::vector<EdgeKey> half;
+      for (size_t i = 0; i < fresh.size(); i += 2) half.push_back(fresh[i]);
+      job.keys = half;
+      SubsetJob sampled = job;
+      const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+      const SubsetSample sample = sample_subset(sampled, free, true, sampled.keys);
+      EXPECT_GT(sample.inner_edges, sample.costs.size()) << what;
+      EXPECT_GE(sample.costs.size(), std::min<uint64_t>(sample.inner_edges, 1000)) << what;
+      ASSERT_GT(sampled.keys.size(), half.size()) << what;
+      // Every key once, sorted, each an edge with two free ends costed as the master costs it.
+      for (size_t i = 0; i < sampled.keys.size(); ++i) {
+        const EdgeKey& k = sampled.keys[i];
+        ASSERT_TRUE(free[k.a] && free[k.b]) << what;
+        if (i > 0) {
+          const EdgeKey& before = sampled.keys[i - 1];
+          ASSERT_TRUE(before.a < k.a || (before.a == k.a && before.b < k.b)) << what;
+        }
+        const auto it = std::lower_bound(
+            fresh.begin(), fresh.end(), k,
+            [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+        ASSERT_TRUE(it != fresh.end() && it->a == k.a && it->b == k.b) << what;
+        ASSERT_TRUE(it->cost == k.cost || (std::isnan(it->cost) && std::isnan(k.cost))) << what;
+      }
+      const SubsetResult with_sample = simplify_subset(sampled);
+      const SubsetResult without = simplify_subset(job);
+      expect_same_records(with_sample.records, without.records, what);
+      EXPECT_GT(with_sample.keys_reused, without.keys_reused) << what;
+    }
+  }
+}
+
+// Without carried keys (a metric cheaper to cost than to remember: the quadric), the sample
+// leaves the keys alone.
+TEST(RoundShares, WithoutCarriedKeysTheKeysStayEmpty) {
+  testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
+  for (SubsetJob& job : round.jobs) {
+    const SubsetSample sample =
+        sample_subset(job, free_vertices(job.mesh, job.owned), false, job.keys);
+    EXPECT_FALSE(sample.costs.empty());
+    EXPECT_TRUE(job.keys.empty());
+  }
+}
+
+// Two subsets: 900 inner edges sampled by 9 costs (1 ... 9, each standing for 100 edges) and
+// 100 edges by 10 costs (10 ... 19, each for 10). A round removing 400 faces takes about 200
+// collapses of 1000 edges: the water level is at the 20% quantile of the edges, 3 (counting
+// samples alike, it would be the 4th of 19 costs, 4), and the ceiling is the larger of twice
+// that and the 40% quantile, 5: 6. The cheap edges, the 50% quantile and below (6), are 6 of
+// the first subset's 9 and none of the second's.
+TEST(RoundShares, EachSampledEdgeStandsForItsSubsetsEdges) {
+  std::vector<SubsetSample> samples(2);
+  samples[0].inner_edges = 900;
+  for (int c = 1; c <= 9; ++c) samples[0].costs.push_back(c);
+  samples[1].inner_edges = 100;
+  for (int c = 10; c <= 19; ++c) samples[1].costs.push_back(c);
+  const RoundCosts costs = round_costs_of(samples, 400, 2.0);
+  EXPECT_EQ(costs.ceiling, 6.0);
+  ASSERT_EQ(costs.cheap_fraction.size(), 2u);
+  EXPECT_DOUBLE_EQ(costs.cheap_fraction[0], 6.0 / 9.0);
+  EXPECT_EQ(costs.cheap_fraction[1], 0.0);
+  // Without a factor, no ceiling; the shares are the same.
+  const RoundCosts no_ceiling = round_costs_of(samples, 400, 0.0);
+  EXPECT_EQ(no_ceiling.ceiling, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(no_ceiling.cheap_fraction, costs.cheap_fraction);
+  // Edges the module cannot place (infinite) rank last: in place of the dearest three, they
+  // change nothing below them.
+  for (int k = 6; k < 9; ++k) samples[0].costs[k] = std::numeric_limits<double>::infinity();
+  const RoundCosts unplaced = round_costs_of(samples, 400, 2.0);
+  EXPECT_EQ(unplaced.ceiling, 6.0);
+  EXPECT_EQ(unplaced.cheap_fraction, costs.cheap_fraction);
+  // No sample at all: no ceiling, no shares.
+  EXPECT_TRUE(round_costs_of({SubsetSample{}, SubsetSample{}}, 400, 2.0).cheap_fraction.empty());
+}
+
+}  // namespace
+}  // namespace parapm
