@@ -14,6 +14,14 @@ void sort_keys(std::vector<EdgeKey>& keys) {
             [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
 }
 
+void sort_unique_keys(std::vector<EdgeKey>& keys) {
+  sort_keys(keys);
+  keys.erase(
+      std::unique(keys.begin(), keys.end(),
+                  [](const EdgeKey& x, const EdgeKey& y) { return x.a == y.a && x.b == y.b; }),
+      keys.end());
+}
+
 KeyMemo::KeyMemo(PriorityModule& inner, size_t vertex_capacity)
     : PriorityWrapper(inner), head_(vertex_capacity, kEnd), changed_at_(vertex_capacity, 0) {}
 

@@ -32,6 +32,9 @@ struct EdgeKey {
 
 // By (a, b).
 void sort_keys(std::vector<EdgeKey>& keys);
+// By (a, b), one key per edge (the first of equal ones: std::sort is not stable, so only for
+// keys whose duplicates are equal).
+void sort_unique_keys(std::vector<EdgeKey>& keys);
 
 // A priority module that remembers the inner module's queue keys, and answers the first queue
 // costing of an edge whose key was carried in (reset()) and whose ends no collapse has changed

@@ -41,14 +41,8 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
       if (carry_keys && free[a] && free[b])
         keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
     }
-  if (keys.size() > carried) {
-    // Carried keys answered the edges they cover: those came back the same. Keep one of each.
-    sort_keys(keys);
-    keys.erase(
-        std::unique(keys.begin(), keys.end(),
-                    [](const EdgeKey& x, const EdgeKey& y) { return x.a == y.a && x.b == y.b; }),
-        keys.end());
-  }
+  // Carried keys answered the edges they cover: those came back the same.
+  if (keys.size() > carried) sort_unique_keys(keys);
   return out;
 }
 

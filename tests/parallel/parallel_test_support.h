@@ -70,12 +70,7 @@ inline std::vector<EdgeKey> fresh_keys(const PriorityModule& master, const Colla
           master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], c, Costing::kQueue);
       keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
     }
-  sort_keys(keys);
-  // An inner edge is listed by both its faces.
-  keys.erase(
-      std::unique(keys.begin(), keys.end(),
-                  [](const EdgeKey& x, const EdgeKey& y) { return x.a == y.a && x.b == y.b; }),
-      keys.end());
+  sort_unique_keys(keys);  // an inner edge is listed by both its faces
   return keys;
 }
 
