@@ -62,6 +62,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"faces_after", r.faces_after},
                       {"partition_seconds", r.partition_seconds},
                       {"append_seconds", r.append_seconds},
+                      {"partition_foreseen", r.partition_foreseen},
                       {"partition_overlap_seconds", r.partition_overlap_seconds},
                       {"extract_seconds", r.extract_seconds},
                       {"share_seconds", r.share_seconds},

@@ -1,5 +1,13 @@
 #include "parallel/job_state.h"
 
+#include <algorithm>
+#include <chrono>
+#include <functional>
+
+#include "parallel/job_pool.h"
+#include "parallel/simplify_subset.h"
+#include "util/clock.h"
+
 #include "simplify/energy_priority.h"
 #include "simplify/quadric_priority.h"
 #include "util/error.h"
@@ -76,6 +84,56 @@ void import_result_state(PriorityModule& master, const MetricState& state) {
   } else {
     throw_internal("import_result_state: no state import for metric " + master.name());
   }
+}
+
+ImportTimes import_result_states(PriorityModule& master,
+                                 const std::vector<const MetricState*>& states,
+                                 const std::vector<uint32_t>& vertex_subset,
+                                 const std::vector<uint32_t>& face_subset, unsigned threads) {
+  const auto start = std::chrono::steady_clock::now();
+  ImportTimes times;
+  for (const MetricState* state : states)
+    if (state->metric != master.name())
+      throw_internal("import_result_states: a state of metric '" + state->metric + "' for " +
+                     master.name());
+  std::vector<double> check_cpu(states.size(), 0), apply_cpu(states.size(), 0);
+  // Each step on the pool, each state's CPU timed.
+  auto side_by_side = [&](std::vector<double>& cpu, const std::function<void(size_t)>& step) {
+    run_jobs(states.size(), threads, [&](size_t k) {
+      const double t = thread_cpu_seconds();
+      step(k);
+      cpu[k] = thread_cpu_seconds() - t;
+    });
+  };
+  double sequential = 0;
+  if (auto* q = dynamic_cast<QuadricPriority*>(&master)) {
+    side_by_side(check_cpu, [&](size_t k) {
+      q->check_global(states[k]->quadric, uint32_t(k), &vertex_subset);
+    });
+    side_by_side(apply_cpu, [&](size_t k) { q->import_global(states[k]->quadric); });
+  } else if (auto* e = dynamic_cast<EnergyPriority*>(&master)) {
+    const auto begin = std::chrono::steady_clock::now();
+    e->begin_global_imports();
+    sequential += seconds_since(begin);
+    const EnergyPriority::GlobalOwners owners{&vertex_subset, &face_subset};
+    std::vector<EnergyPriority::GlobalImport> imports(states.size());
+    side_by_side(check_cpu, [&](size_t k) {
+      imports[k] = e->check_global(states[k]->energy, uint32_t(k), owners);
+    });
+    side_by_side(apply_cpu, [&](size_t k) { e->apply_global(states[k]->energy, imports[k]); });
+    const auto wedges = std::chrono::steady_clock::now();
+    for (const MetricState* state : states) e->apply_global_wedges(state->energy);
+    sequential += seconds_since(wedges);
+  } else {
+    throw_internal("import_result_states: no state import for metric " + master.name());
+  }
+  times.seconds = seconds_since(start);
+  for (size_t k = 0; k < states.size(); ++k) {
+    times.slowest_check_seconds = std::max(times.slowest_check_seconds, check_cpu[k]);
+    times.slowest_apply_seconds = std::max(times.slowest_apply_seconds, apply_cpu[k]);
+  }
+  times.critical_seconds = sequential + times.slowest_check_seconds + times.slowest_apply_seconds;
+  return times;
 }
 
 std::unique_ptr<PriorityModule> without_initialize(PriorityModule& inner) {

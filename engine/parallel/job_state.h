@@ -33,6 +33,26 @@ MetricState export_result_state(const PriorityModule& module, const CollapseMesh
 // and wedges, and mixed faces never change (subset_rule.h), so the order of imports is free.
 void import_result_state(PriorityModule& master, const MetricState& state);
 
+// The states of a round's jobs (states[k]: subset k's job's, metric `master`'s) into the
+// master, side by side on `threads` threads (0: the hardware's): every state is checked first,
+// each only against its own subset (`vertex_subset`: per vertex its subset; `face_subset`: per
+// face the subset owning its three corners, kNoId for none), and refused with
+// Error(kInvalidInput) before the master changes (a worker's reply is untrusted: a state
+// naming another subset's face would have two threads write it); then all are taken, side by
+// side (their faces, vertices and points are disjoint; a curve sample on an edge between two
+// subsets is written by the subset of its first end), then the wedges, one state after the
+// other. The master's result is import_result_state's of each, in any order.
+struct ImportTimes {
+  double seconds = 0;                // wall
+  double critical_seconds = 0;       // with a core per state: the steps' slowest ones, in turn
+  double slowest_check_seconds = 0;  // CPU
+  double slowest_apply_seconds = 0;  // CPU
+};
+ImportTimes import_result_states(PriorityModule& master,
+                                 const std::vector<const MetricState*>& states,
+                                 const std::vector<uint32_t>& vertex_subset,
+                                 const std::vector<uint32_t>& face_subset, unsigned threads);
+
 // Forwards to `inner` except initialize(), which does nothing: for a module whose state was
 // imported or carried over (the master's, continued by the final pass).
 std::unique_ptr<PriorityModule> without_initialize(PriorityModule& inner);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <functional>
 #include <future>
 #include <limits>
 
@@ -28,60 +30,86 @@
 namespace parapm {
 namespace {
 
-// Partitions the live part of `mesh` (a compact copy: the partitioner wants a plain mesh) into
-// p subsets; returns, per vertex of `mesh`, its subset (0 for dead vertices).
-std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
-                                     const PartitionOptions& options) {
-  std::vector<VertexId> compact(mesh.vertex_capacity(), kNoId);
-  Mesh live;
+// The live part of a mesh as a plain mesh (what the partitioner takes), and per vertex of the
+// mesh its id there (kNoId for dead vertices).
+struct LiveCopy {
+  Mesh mesh;
+  std::vector<VertexId> compact;
+};
+LiveCopy live_copy(const CollapseMesh& mesh) {
+  LiveCopy out;
+  out.compact.assign(mesh.vertex_capacity(), kNoId);
   for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
     if (mesh.vertex_alive(v)) {
-      compact[v] = VertexId(live.positions.size());
-      live.positions.push_back(mesh.position(v));
+      out.compact[v] = VertexId(out.mesh.positions.size());
+      out.mesh.positions.push_back(mesh.position(v));
     }
-  live.faces.reserve(mesh.live_faces());
+  out.mesh.faces.reserve(mesh.live_faces());
   for (FaceId f = 0; f < mesh.face_capacity(); ++f)
     if (mesh.face_alive(f)) {
       const Triangle& t = mesh.face(f);
-      live.faces.push_back({compact[t[0]], compact[t[1]], compact[t[2]]});
+      out.mesh.faces.push_back({out.compact[t[0]], out.compact[t[1]], out.compact[t[2]]});
     }
-  const Partition partition = partition_mesh(live, p, options);
-  std::vector<uint32_t> vertex_subset(mesh.vertex_capacity(), 0);
-  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
-    if (compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[compact[v]];
+  return out;
+}
+
+// Partitions a live copy into p subsets; returns, per vertex of the mesh it was copied from,
+// its subset (0 for vertices dead at the copy).
+std::vector<uint32_t> partition_copy(const LiveCopy& live, uint32_t p,
+                                     const PartitionOptions& options) {
+  const Partition partition = partition_mesh(live.mesh, p, options);
+  std::vector<uint32_t> vertex_subset(live.compact.size(), 0);
+  for (VertexId v = 0; v < live.compact.size(); ++v)
+    if (live.compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[live.compact[v]];
   return vertex_subset;
 }
 
-// Runs `work` on this thread and `side` beside it, on a thread of its own when the build may
-// use two (one after the other otherwise). `side` must not touch what `work` does.
+std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
+                                     const PartitionOptions& options) {
+  return partition_copy(live_copy(mesh), p, options);
+}
+
+// Runs `work` on this thread and each of `sides` beside it, each on a thread of its own when
+// the build may use more than one (one after the other otherwise). No side may touch what
+// `work` or another side does.
 struct Beside {
-  double work_seconds = 0, side_seconds = 0;
-  double side_cpu_elsewhere = 0;  // the side's CPU when it ran on another thread
+  double work_seconds = 0;
+  std::vector<double> side_seconds;
+  double side_cpu_elsewhere = 0;  // the sides' CPU when they ran on other threads
 };
-template <class Work, class Side>
-Beside run_beside(unsigned threads, Work&& work, Side&& side) {
+Beside run_beside(unsigned threads, const std::function<void()>& work,
+                  const std::vector<std::function<void()>>& sides) {
   Beside out;
-  auto timed_side = [&] {
+  out.side_seconds.assign(sides.size(), 0);
+  auto timed_side = [&](size_t i) {
     const auto ts = std::chrono::steady_clock::now();
     const double cpu = thread_cpu_seconds();
-    side();
-    out.side_seconds = seconds_since(ts);
+    sides[i]();
+    out.side_seconds[i] = seconds_since(ts);
     return thread_cpu_seconds() - cpu;
   };
-  std::future<double> beside;
-  if (pool_threads(threads, 2) >= 2) beside = std::async(std::launch::async, timed_side);
+  std::vector<std::future<double>> beside;
+  if (pool_threads(threads, 2) >= 2)
+    for (size_t i = 0; i < sides.size(); ++i)
+      beside.push_back(std::async(std::launch::async, timed_side, i));
   const auto tw = std::chrono::steady_clock::now();
   try {
     work();
   } catch (...) {
-    if (beside.valid()) beside.wait();
+    for (std::future<double>& f : beside) f.wait();
     throw;
   }
   out.work_seconds = seconds_since(tw);
-  if (beside.valid()) {
-    out.side_cpu_elsewhere = beside.get();
+  if (beside.empty()) {
+    for (size_t i = 0; i < sides.size(); ++i) timed_side(i);
   } else {
-    timed_side();
+    std::exception_ptr error;
+    for (std::future<double>& f : beside) try {
+        out.side_cpu_elsewhere += f.get();
+      } catch (...) {
+        if (!error) error = std::current_exception();
+      }
+    if (error) std::rethrow_exception(error);
   }
   return out;
 }
@@ -280,19 +308,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // At most one collapse per vertex: no round's records move the earlier ones (growing by
   // doubling moved the 871k dragon's first 190k records at round 1's merge, 0.2 s).
   records.reserve(whole.live_vertices());
-  // A round's records wait for the next step of the master to go into `records`: the subsets'
-  // lists k-way merged by cost, then the band pass's. Nothing reads `records` before the PM is
-  // assembled, so the merge by cost (0.07 s for the 871k dragon's first round at p = 16) runs
-  // beside the next round's partition, or the final pass.
+  // A round's subsets' lists wait for the next step of the master to go into `records`, k-way
+  // merged by cost (the band pass's records follow them). Nothing reads `records` before the PM
+  // is assembled, so the merge by cost (0.07 s for the 871k dragon's first round at p = 16) runs
+  // beside the band pass, the next round's partition, or the final pass.
   std::vector<std::vector<CollapseRecord>> pending_lists;
-  std::vector<CollapseRecord> pending_band;
-  auto append_pending = [&] {
-    append_merged_by_cost(pending_lists, records);
-    records.insert(records.end(), std::make_move_iterator(pending_band.begin()),
-                   std::make_move_iterator(pending_band.end()));
-    pending_band.clear();
-  };
+  auto append_pending = [&] { append_merged_by_cost(pending_lists, records); };
   std::vector<uint8_t> bound_before;  // the previous round's bound vertices (subset_rule.h)
+  std::vector<uint32_t> face_subset;  // the round's: per face, the job owning its corners
   double subsets_cpu = 0;
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
   // if that is gentler: after two scheduled rounds (a ratio of 0.32 at the default handover),
@@ -305,20 +328,28 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // border band does not count, unless its jobs did not do half of it (locked parts: more
   // rounds would not get further).
   uint32_t scheduled_left = rounds;
-  for (uint32_t round = 0; round < 64; ++round) {
-    RoundStats rs;
-    rs.round = round;
-    rs.faces_before = whole.live_faces();
-    uint32_t subsets = round_subsets(parallel, rs.faces_before);  // of this round
-    if (subsets < std::min(2u, parallel.subsets)) break;
-    if (whole.live_vertices() < 4 * size_t(subsets)) break;
-    const bool scheduled = scheduled_left > 0;
-    if (scheduled) {
-      if (rs.faces_before <= handover) break;
+  // What the next round does, from the mesh's live faces and vertices, the scheduled rounds
+  // left and the last round's figures: whether there is one, with how many subsets, whether it
+  // is scheduled, its goal.
+  struct RoundPlan {
+    bool go = false;
+    uint32_t subsets = 0;
+    bool scheduled = false;
+    uint64_t goal = 0;
+  };
+  auto plan_round = [&](uint64_t faces, size_t vertices, uint32_t scheduled_rounds_left,
+                        const RoundStats* last) {
+    RoundPlan plan;
+    plan.subsets = round_subsets(parallel, faces);
+    if (plan.subsets < std::min(2u, parallel.subsets)) return plan;
+    if (vertices < 4 * size_t(plan.subsets)) return plan;
+    plan.scheduled = scheduled_rounds_left > 0;
+    if (plan.scheduled) {
+      if (faces <= handover) return plan;
       // Geometric steps from the present face count to the handover.
-      rs.goal_faces = uint64_t(std::llround(
-          double(rs.faces_before) *
-          std::pow(double(handover) / double(rs.faces_before), 1.0 / double(scheduled_left))));
+      plan.goal =
+          uint64_t(std::llround(double(faces) * std::pow(double(handover) / double(faces),
+                                                         1.0 / double(scheduled_rounds_left))));
     } else {
       // An extra round, if the last one's jobs did what they were asked (a mesh whose locked
       // parts stop it short gains nothing from more) and the subsets stay large enough that
@@ -327,21 +358,56 @@ ProgressiveMesh build_progressive_mesh_parallel(
       // must be larger (2.5 x the floor; with the floor itself, such rounds made the 203k
       // dragon's 10% level 7% worse at p = 4 and 8: docs/BENCHMARKS.md, "Extra rounds after a
       // short round").
-      if (parallel.extra_round_subset_faces == 0 || st.round_stats.empty()) break;
-      const RoundStats& last = st.round_stats.back();
-      const double done = double(last.faces_before) - double(last.faces_after);
-      const double asked = double(last.asked_faces);
-      if (!(done >= 0.5 * asked)) break;
+      if (parallel.extra_round_subset_faces == 0 || !last) return plan;
+      const double done = double(last->faces_before) - double(last->faces_after);
+      const double asked = double(last->asked_faces);
+      if (!(done >= 0.5 * asked)) return plan;
       const uint64_t floor = done >= 0.9 * asked ? parallel.extra_round_subset_faces
                                                  : parallel.extra_round_subset_faces * 5 / 2;
-      rs.goal_faces =
-          std::max<uint64_t>(target, uint64_t(std::llround(double(rs.faces_before) * step)));
-      if (rs.goal_faces >= rs.faces_before) break;
+      plan.goal = std::max<uint64_t>(target, uint64_t(std::llround(double(faces) * step)));
+      if (plan.goal >= faces) return plan;
       // Narrower rounds once p subsets would leave fewer faces each than the floor: the mesh
       // keeps shrinking in parallel, and the sequential final pass stays short at any p.
-      subsets = uint32_t(std::min<uint64_t>(subsets, rs.goal_faces / floor));
-      if (subsets < 2) break;
+      plan.subsets = uint32_t(std::min<uint64_t>(plan.subsets, plan.goal / floor));
+      if (plan.subsets < 2) return plan;
     }
+    plan.go = true;
+    return plan;
+  };
+  // A scheduled round counts unless it was shortened by its border band and did half of it.
+  auto counts = [](const RoundStats& r) {
+    return !r.border_limited || 2 * (r.faces_before - r.faces_after) < r.asked_faces;
+  };
+  // The next round's partition, drawn beside the band pass on a copy of the mesh before it
+  // (the band pass moves a few hundred vertices along old borders): used if the round after
+  // the band pass has as many subsets as foreseen.
+  struct Foreseen {
+    bool beside_band = false;  // the last round's lists were appended beside its band pass
+    bool drawn = false;        // and the next round's partition drawn
+    uint32_t subsets = 0;
+    std::vector<uint32_t> vertex_subset;
+    double copy_seconds = 0, partition_seconds = 0, append_seconds = 0, band_seconds = 0;
+  } foreseen;
+  // A foreseen partition not taken: the critical path still counts what of the append beside
+  // the band pass outlasted it.
+  auto forgo_foreseen = [&] {
+    if (foreseen.beside_band)
+      st.critical_path_seconds += std::max(0.0, foreseen.append_seconds - foreseen.band_seconds);
+    foreseen = Foreseen{};
+  };
+  for (uint32_t round = 0; round < 64; ++round) {
+    RoundStats rs;
+    rs.round = round;
+    rs.faces_before = whole.live_faces();
+    const RoundPlan plan = plan_round(rs.faces_before, whole.live_vertices(), scheduled_left,
+                                      st.round_stats.empty() ? nullptr : &st.round_stats.back());
+    if (!plan.go) {
+      forgo_foreseen();
+      break;
+    }
+    const uint32_t subsets = plan.subsets;
+    const bool scheduled = plan.scheduled;
+    rs.goal_faces = plan.goal;
 
     // A new partition of the current mesh: the previous round's borders, whose vertices could
     // not move, are inside subsets now.
@@ -352,18 +418,31 @@ ProgressiveMesh build_progressive_mesh_parallel(
       vertex_subset = std::move(first_partition);
       rs.partition_seconds = first_partition_seconds;
       rs.partition_overlap_seconds = std::min(first_partition_seconds, initialize_seconds);
+    } else if (foreseen.drawn && foreseen.subsets == subsets) {
+      // Drawn beside the last band pass, the previous round's records appended beside it too:
+      // the critical path counts what of them outlasted the band pass.
+      vertex_subset = std::move(foreseen.vertex_subset);
+      rs.partition_foreseen = true;
+      rs.partition_seconds = foreseen.copy_seconds + foreseen.partition_seconds;
+      rs.append_seconds = foreseen.append_seconds;
+      const double longest =
+          std::max({foreseen.partition_seconds, foreseen.append_seconds, foreseen.band_seconds});
+      rs.partition_overlap_seconds =
+          foreseen.partition_seconds + foreseen.append_seconds - (longest - foreseen.band_seconds);
     } else {
+      forgo_foreseen();
       PartitionOptions partition_options;
       partition_options.seed = round_seed(options.seed, round);
-      const Beside timed = run_beside(
-          parallel.threads,
-          [&] { vertex_subset = partition_live(whole, subsets, partition_options); },
-          append_pending);
+      const Beside timed =
+          run_beside(parallel.threads,
+                     [&] { vertex_subset = partition_live(whole, subsets, partition_options); },
+                     {append_pending});
       rs.partition_seconds = timed.work_seconds;
-      rs.append_seconds = timed.side_seconds;
-      rs.partition_overlap_seconds = std::min(timed.work_seconds, timed.side_seconds);
+      rs.append_seconds = timed.side_seconds[0];
+      rs.partition_overlap_seconds = std::min(timed.work_seconds, timed.side_seconds[0]);
       subsets_cpu += timed.side_cpu_elsewhere;
     }
+    foreseen = Foreseen{};
     if (events.partitioned) events.partitioned(round, subsets, rs.faces_before);
     // The partition's border (sequential, O(faces), counted with the partition).
     t = std::chrono::steady_clock::now();
@@ -390,6 +469,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
     std::vector<SubsetJob> jobs(subsets);
     std::vector<uint64_t> removable(subsets, 0);
     std::vector<SubsetSample> samples(sample ? subsets : 0);
+    // Per face, the subset whose job owns its three corners: the only state that may list it.
+    face_subset.assign(whole.face_capacity(), kNoId);
     std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
     run_jobs(jobs.size(), parallel.threads, [&](size_t i) {
       const double cpu = thread_cpu_seconds();
@@ -398,6 +479,11 @@ ProgressiveMesh build_progressive_mesh_parallel(
       jobs[i] = extract_subset(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
                                locked, vertex_subset, owned[i], uint32_t(i), round, subset_options);
       jobs[i].state = export_job_state(*master, jobs[i]);
+      for (FaceId f = 0; f < jobs[i].mesh.face_count(); ++f) {
+        const Triangle& c = jobs[i].mesh.faces[f];
+        if (jobs[i].owned[c[0]] && jobs[i].owned[c[1]] && jobs[i].owned[c[2]])
+          face_subset[jobs[i].global_face[f]] = uint32_t(i);
+      }
       const std::vector<uint8_t> free = free_vertices(jobs[i].mesh, jobs[i].owned);
       removable[i] = removable_faces(jobs[i].mesh, free);
       if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i], free);
@@ -469,8 +555,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
     double bookkeeping_seconds = 0;
     auto bookkeeping = [&] {
       const auto tb = std::chrono::steady_clock::now();
-      if (!parallel.replay_state)
-        for (const SubsetResult& r : results) import_result_state(*master, r.state);
+      double import_saved = 0;  // what the imports side by side save with a core per state
+      if (!parallel.replay_state) {
+        std::vector<const MetricState*> states;
+        for (const SubsetResult& r : results) states.push_back(&r.state);
+        const ImportTimes import =
+            import_result_states(*master, states, vertex_subset, face_subset, parallel.threads);
+        import_saved = std::max(0.0, import.seconds - import.critical_seconds);
+      }
       std::vector<double> costs;
       for (const std::vector<CollapseRecord>& list : lists)
         for (const CollapseRecord& r : list) costs.push_back(r.cost);
@@ -486,7 +578,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
         for (SubsetResult& r : results)
           returned.insert(returned.end(), r.keys.begin(), r.keys.end());
       keys.reset(returned);
-      bookkeeping_seconds = seconds_since(tb);
+      bookkeeping_seconds = seconds_since(tb) - import_saved;
     };
     if (parallel.replay_state) {
       // Tests only: the merged sequence drives the master's module, one collapse at a time
@@ -527,10 +619,45 @@ ProgressiveMesh build_progressive_mesh_parallel(
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
       band_limits.first_queue_around = &lagging;  // the band refuses every other edge
-      pending_band = pass.run(band_limits, {}, cancel);
-      rs.band_pass_collapses = pending_band.size();
+      // The next round as it would be without the band pass's collapses (it removes a few
+      // hundred faces of a round's tens of thousands): its partition is drawn beside it.
+      RoundStats before_band = rs;
+      before_band.faces_after = whole.live_faces();
+      const RoundPlan next =
+          plan_round(before_band.faces_after, whole.live_vertices(),
+                     scheduled_left - (scheduled && counts(before_band) ? 1 : 0), &before_band);
+      LiveCopy copy;
+      if (next.go) {
+        const auto tc = std::chrono::steady_clock::now();
+        copy = live_copy(whole);
+        foreseen.copy_seconds = seconds_since(tc);
+        foreseen.subsets = next.subsets;
+      }
+      std::vector<CollapseRecord> band_records;
+      PartitionOptions next_options;
+      next_options.seed = round_seed(options.seed, round + 1);
+      const double prepared = seconds_since(t);
+      const Beside timed =
+          run_beside(parallel.threads, [&] { band_records = pass.run(band_limits, {}, cancel); },
+                     {append_pending, [&] {
+                        if (next.go)
+                          foreseen.vertex_subset = partition_copy(copy, next.subsets, next_options);
+                      }});
+      foreseen.beside_band = true;
+      foreseen.drawn = next.go;
+      foreseen.band_seconds = prepared + timed.work_seconds - foreseen.copy_seconds;
+      foreseen.append_seconds = timed.side_seconds[0];
+      foreseen.partition_seconds = timed.side_seconds[1];
+      subsets_cpu += timed.side_cpu_elsewhere;
+      rs.band_pass_collapses = band_records.size();
+      records.insert(records.end(), std::make_move_iterator(band_records.begin()),
+                     std::make_move_iterator(band_records.end()));
     }
     rs.band_pass_seconds = seconds_since(t);
+    // With one thread, the band pass's time holds the append's and the partition's, which the
+    // critical path counts, beyond the band pass, in the next round (or forgo_foreseen), and
+    // the copy, counted with the partition.
+    if (foreseen.beside_band) rs.band_pass_seconds = foreseen.band_seconds;
     bound_before = std::move(bound);
     rs.faces_after = whole.live_faces();
     st.critical_path_seconds += rs.partition_seconds + rs.append_seconds -
@@ -546,13 +673,12 @@ ProgressiveMesh build_progressive_mesh_parallel(
         rs.partition_seconds, rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds,
         rs.merge_seconds, replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
     if (events.merged) events.merged(rs);
-    if (scheduled &&
-        (!rs.border_limited || 2 * (rs.faces_before - rs.faces_after) < rs.asked_faces))
-      --scheduled_left;
+    if (scheduled && counts(rs)) --scheduled_left;
     st.round_stats.push_back(std::move(rs));
     if (progress) progress(input_faces - whole.live_faces(), input_faces - target);
   }
 
+  forgo_foreseen();  // (the rounds' limit)
   st.rounds = uint32_t(st.round_stats.size());
 
   // The final pass: the borders and whatever remains down to the target, sequentially.
@@ -571,20 +697,20 @@ ProgressiveMesh build_progressive_mesh_parallel(
   const double final_setup_seconds = seconds_since(t);
   std::vector<CollapseRecord> final_records;
   // The last round's records go into `records` beside it (append_pending).
-  const Beside timed = run_beside(
-      parallel.threads,
-      [&] {
-        final_records = final_pass.run(
-            limits,
-            [&](uint64_t done, uint64_t) {
-              if (progress) progress(done_before + done, input_faces - target);
-            },
-            cancel);
-      },
-      append_pending);
+  const Beside timed = run_beside(parallel.threads,
+                                  [&] {
+                                    final_records = final_pass.run(
+                                        limits,
+                                        [&](uint64_t done, uint64_t) {
+                                          if (progress)
+                                            progress(done_before + done, input_faces - target);
+                                        },
+                                        cancel);
+                                  },
+                                  {append_pending});
   st.final_pass_collapses = final_records.size();
   st.final_pass_seconds = final_setup_seconds + timed.work_seconds;
-  st.final_append_seconds = timed.side_seconds;
+  st.final_append_seconds = timed.side_seconds[0];
   subsets_cpu += timed.side_cpu_elsewhere;
   st.stop_reason = final_pass.stats().stop_reason;
   {

@@ -104,11 +104,14 @@ struct RoundStats {
   uint64_t asked_faces = 0;
   uint64_t faces_after = 0;
   double partition_seconds = 0;  // with finding its border (bound_vertices, border_faces)
-  // The previous round's records (its subsets' lists merged by cost, then its band pass's) go
-  // into the PM's list beside this round's partition.
+  // The previous round's subsets' lists, merged by cost, go into the PM's list beside its band
+  // pass, or beside this round's partition.
   double append_seconds = 0;
+  // Drawn beside the previous round's band pass, on a copy of the mesh before it (when the
+  // round after it has as many subsets as foreseen); partition_seconds then counts the copy.
+  bool partition_foreseen = false;
   // Round 0's partition is drawn beside the master's initialisation, a later round's beside
-  // the append: the shorter of the two, which the critical path leaves out.
+  // the append, or beside the last band pass: what of it the critical path leaves out.
   double partition_overlap_seconds = 0;
   double extract_seconds = 0;  // jobs and their state, shares included (wall)
   // The edge sample (water level, shares), costed in the extraction's tasks: their CPU summed.
@@ -132,6 +135,8 @@ struct RoundStats {
   uint64_t keys_carried = 0;         // queue keys given to the jobs (edge_keys.h)
   uint64_t keys_reused = 0;          // the jobs' queue costings answered by them
   uint64_t band_pass_collapses = 0;  // sequential, after the merge (ParallelOptions::band_pass)
+  // The band pass alone (the append and the next partition beside it are the next round's
+  // append_seconds and partition_seconds, the mesh's copy for that partition too).
   double band_pass_seconds = 0;
   std::vector<SubsetTiming> subsets;
 };

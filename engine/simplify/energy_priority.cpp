@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -197,7 +198,91 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
 }
 
 void EnergyPriority::import_global(const EnergyState& state) {
-  check_global_state(state);
+  begin_global_imports();
+  const GlobalImport import = check_global(state, 0, GlobalOwners{});
+  apply_global(state, import);
+  apply_global_wedges(state);
+}
+
+void EnergyPriority::begin_global_imports() {
+  face_tag_.resize(face_points_.size(), 0);
+  vertex_tag_.resize(parked_point_.size(), 0);
+  point_tag_.resize(positions_.size(), 0);
+  // A tag is (generation, subset, given): no mark is ever cleared.
+  if (++import_generation_ >= (1u << 22)) {
+    std::fill(face_tag_.begin(), face_tag_.end(), 0);
+    std::fill(vertex_tag_.begin(), vertex_tag_.end(), 0);
+    std::fill(point_tag_.begin(), point_tag_.end(), 0);
+    import_generation_ = 1;
+  }
+}
+
+// What a job gives back (possibly from a worker over the network) may only rearrange the
+// points it was given: every point once, one that was on the state's faces or parked at its
+// vertices, at the position it was sampled at (points never move), on one of those faces or
+// parked at one of those vertices; and with owners, only faces and vertices of its subset.
+// Checked before the master changes anything. (A point may be missing: a collapse that leaves
+// its vertex without faces drops its star's points, as the sequential build does.)
+// Side by side for different subsets: a state's faces and vertices are checked to be its
+// subset's before anything is marked, so each check marks only its own faces, vertices and
+// the points on them; a point of another subset's (named by a dishonest state) is read while
+// its check may be marking it, hence the relaxed atomics: the tag read is never this state's.
+EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& state, uint32_t subset,
+                                                          const GlobalOwners& owners) const {
+  if (subset >= 512) throw_internal("energy state import: subset " + std::to_string(subset));
+  const uint32_t tag = (import_generation_ << 10) | (subset << 1), given = tag | 1;
+  auto point_tag = [&](uint32_t id) { return std::atomic_ref<uint32_t>(point_tag_[id]); };
+  auto fail = [](const std::string& problem) { throw_invalid("energy state: " + problem); };
+  auto face_ours = [&](FaceId f) {
+    return f < face_points_.size() && (!owners.face_subset || (*owners.face_subset)[f] == subset);
+  };
+  auto vertex_ours = [&](VertexId v) {
+    return v < parked_point_.size() &&
+           (!owners.vertex_subset || (*owners.vertex_subset)[v] == subset);
+  };
+  for (FaceId f : state.faces) {
+    if (f >= face_points_.size()) fail("face " + std::to_string(f) + " out of range");
+    if (!face_ours(f)) fail("face " + std::to_string(f) + " is another subset's");
+    face_tag_[f] = tag;
+    for (const FacePoint& p : face_points_[f])
+      point_tag(p.id).store(tag, std::memory_order_relaxed);
+  }
+  for (VertexId v : state.vertices) {
+    if (v >= parked_point_.size()) fail("vertex " + std::to_string(v) + " out of range");
+    if (!vertex_ours(v)) fail("vertex " + std::to_string(v) + " is another subset's");
+    vertex_tag_[v] = tag;
+    if (parked_point_[v] != kNoPoint)
+      point_tag(parked_point_[v]).store(tag, std::memory_order_relaxed);
+  }
+  for (const EnergyState::Point& p : state.points) {
+    const char* why = nullptr;
+    if (p.id >= positions_.size()) {
+      why = " out of range";
+    } else if (const uint32_t t = point_tag(p.id).load(std::memory_order_relaxed); t != tag) {
+      why = t == given ? " given twice" : " is not the job's";
+    } else if (p.position != positions_[p.id]) {
+      why = " moved from where it was sampled";
+    } else if (p.face != kNoId ? !face_ours(p.face) || face_tag_[p.face] != tag
+                               : !vertex_ours(p.vertex) || vertex_tag_[p.vertex] != tag) {
+      why = " is on a face or vertex the state does not list";
+    }
+    if (why) fail("point " + std::to_string(p.id) + why);
+    point_tag(p.id).store(given, std::memory_order_relaxed);
+  }
+  if (options_.discontinuities) curves_.check_global(state);
+  scalar_.check_global(state);
+  // The curve samples it writes: those on an edge whose first end is the subset's now. A
+  // sample on an edge between two subsets is listed by both (unchanged: no job moves a bound
+  // vertex's samples), and written once.
+  GlobalImport import;
+  for (uint32_t i = 0; i < state.samples.size(); ++i)
+    if (!owners.vertex_subset ||
+        (*owners.vertex_subset)[curves_.sample_edge(state.samples[i].id).first] == subset)
+      import.samples.push_back(i);
+  return import;
+}
+
+void EnergyPriority::apply_global(const EnergyState& state, const GlobalImport& import) {
   for (FaceId f : state.faces) {
     face_points_[f].clear();
     moments_ready_[f] = 0;
@@ -213,75 +298,10 @@ void EnergyPriority::import_global(const EnergyState& state) {
     }
     if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
   }
-  if (options_.discontinuities) curves_.import_global(state);
-  scalar_.import_global(state);
+  if (options_.discontinuities) curves_.import_global(state, &import.samples);
 }
 
-// What a job gives back (possibly from a worker over the network) may only rearrange the
-// points it was given: every point once, one that was on the state's faces or parked at its
-// vertices, at the position it was sampled at (points never move), on one of those faces or
-// parked at one of those vertices. Checked before the master changes anything. (A point may be
-// missing: a collapse that leaves its vertex without faces drops its star's points, as the
-// sequential build does.)
-void EnergyPriority::check_global_state(const EnergyState& state) const {
-  std::vector<uint8_t>& face_mark = import_face_mark_;
-  std::vector<uint8_t>& vertex_mark = import_vertex_mark_;
-  std::vector<uint8_t>& point_mark = import_point_mark_;
-  face_mark.resize(face_points_.size(), 0);
-  vertex_mark.resize(parked_point_.size(), 0);
-  point_mark.resize(positions_.size(), 0);
-  std::string problem;
-  for (FaceId f : state.faces) {
-    if (f >= face_points_.size()) {
-      problem = "face " + std::to_string(f) + " out of range";
-      break;
-    }
-    face_mark[f] = 1;
-    for (const FacePoint& p : face_points_[f]) point_mark[p.id] = 1;
-  }
-  if (problem.empty())
-    for (VertexId v : state.vertices) {
-      if (v >= parked_point_.size()) {
-        problem = "vertex " + std::to_string(v) + " out of range";
-        break;
-      }
-      vertex_mark[v] = 1;
-      if (parked_point_[v] != kNoPoint) point_mark[parked_point_[v]] = 1;
-    }
-  if (problem.empty())
-    for (const EnergyState::Point& p : state.points) {
-      const char* why = nullptr;
-      if (p.id >= positions_.size()) {
-        why = " out of range";
-      } else if (point_mark[p.id] != 1) {
-        why = point_mark[p.id] == 2 ? " given twice" : " is not the job's";
-      } else if (p.position != positions_[p.id]) {
-        why = " moved from where it was sampled";
-      } else if (p.face != kNoId ? p.face >= face_mark.size() || !face_mark[p.face]
-                                 : p.vertex >= vertex_mark.size() || !vertex_mark[p.vertex]) {
-        why = " is on a face or vertex the state does not list";
-      }
-      if (why) {
-        problem = "point " + std::to_string(p.id) + why;
-        break;
-      }
-      point_mark[p.id] = 2;
-    }
-  // Clear the marks (only what was set), whatever the outcome.
-  for (FaceId f : state.faces) {
-    if (f >= face_points_.size()) break;
-    face_mark[f] = 0;
-    for (const FacePoint& p : face_points_[f]) point_mark[p.id] = 0;
-  }
-  for (VertexId v : state.vertices) {
-    if (v >= parked_point_.size()) break;
-    vertex_mark[v] = 0;
-    if (parked_point_[v] != kNoPoint) point_mark[parked_point_[v]] = 0;
-  }
-  for (const EnergyState::Point& p : state.points)
-    if (p.id < point_mark.size()) point_mark[p.id] = 0;
-  if (!problem.empty()) throw_invalid("energy state: " + problem);
-}
+void EnergyPriority::apply_global_wedges(const EnergyState& state) { scalar_.import_global(state); }
 
 std::vector<EnergyPriority::PointState> EnergyPriority::point_states() const {
   std::vector<PointState> states(positions_.size());

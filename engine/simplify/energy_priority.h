@@ -159,6 +159,26 @@ class EnergyPriority : public PriorityModule {
                             const std::vector<uint8_t>& changed) const;
   void import_global(const EnergyState& state);  // checks the state first (kInvalidInput)
 
+  // Several jobs' states at once (job_state.h, import_result_states), side by side:
+  // begin_global_imports() once; check_global() of every state, each on its own thread if
+  // wished (each state k of a different subset); then, if none threw, apply_global() of every
+  // state, side by side too; then apply_global_wedges() of each, one after the other.
+  // `owners`: per vertex the subset owning it, per face the subset owning its three corners
+  // (kNoId: none); a state may list only its own subset's (null: not checked, one state
+  // alone). check_global throws Error(kInvalidInput) and changes no state (only its marks).
+  struct GlobalOwners {
+    const std::vector<uint32_t>* vertex_subset = nullptr;
+    const std::vector<uint32_t>* face_subset = nullptr;
+  };
+  struct GlobalImport {
+    std::vector<uint32_t> samples;  // indices into state.samples that this state writes
+  };
+  void begin_global_imports();
+  GlobalImport check_global(const EnergyState& state, uint32_t subset,
+                            const GlobalOwners& owners) const;
+  void apply_global(const EnergyState& state, const GlobalImport& import);
+  void apply_global_wedges(const EnergyState& state);
+
   // Observers, for tests and reports.
   size_t point_count() const { return positions_.size(); }
   struct PointState {
@@ -248,7 +268,6 @@ class EnergyPriority : public PriorityModule {
   Vec3 moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b,
                     PlaneModel* model = nullptr) const;
   Vec3 projection_solve(const Fit& fit, double iso_a, const Vec3& iso_b, const Vec3& from) const;
-  void check_global_state(const EnergyState& state) const;
   void prepare_fan(const CollapseMesh& mesh, VertexId vs);
   std::pair<int, Projection> closest_fan_face(const CollapseMesh& mesh,
                                               const std::vector<FaceId>& faces,
@@ -326,8 +345,10 @@ class EnergyPriority : public PriorityModule {
     Vec3 normal{};
   };
   std::vector<FanFace> fan_;
-  // check_global_state's marks, all 0 between calls.
-  mutable std::vector<uint8_t> import_face_mark_, import_vertex_mark_, import_point_mark_;
+  // check_global's marks: (generation << 10) | (subset << 1) | given. Each check writes its own
+  // subset's faces, vertices and the points on them; the points' marks through atomic_ref.
+  mutable std::vector<uint32_t> face_tag_, vertex_tag_, point_tag_;
+  uint32_t import_generation_ = 0;
   std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
   std::vector<std::array<double, 3>> moved_bary_;
   mutable std::vector<PreparedTriangle> prepared_;  // star_ with v at the projected position

@@ -122,6 +122,17 @@ QuadricState QuadricPriority::export_global(const IdMaps& maps,
   return state;
 }
 
+void QuadricPriority::check_global(const QuadricState& state, uint32_t subset,
+                                   const std::vector<uint32_t>* vertex_subset) const {
+  if (state.vertices.size() != state.quadrics.size())
+    throw_invalid("quadric state: vertices and quadrics disagree");
+  for (VertexId v : state.vertices) {
+    if (v >= quadrics_.size()) throw_invalid("quadric state: vertex out of range");
+    if (vertex_subset && (*vertex_subset)[v] != subset)
+      throw_invalid("quadric state: vertex " + std::to_string(v) + " is another subset's");
+  }
+}
+
 void QuadricPriority::import_global(const QuadricState& state) {
   if (state.vertices.size() != state.quadrics.size())
     throw_invalid("quadric state: vertices and quadrics disagree");

@@ -39,6 +39,11 @@ class QuadricPriority : public PriorityModule {
   void import_local(const CollapseMesh& mesh, const QuadricState& state);
   QuadricState export_global(const IdMaps& maps, const std::vector<uint8_t>& changed) const;
   void import_global(const QuadricState& state);
+  // Before import_global of several jobs' states side by side (job_state.h): throws
+  // Error(kInvalidInput) unless every vertex of `state` is in range and, with vertex_subset,
+  // the subset's.
+  void check_global(const QuadricState& state, uint32_t subset,
+                    const std::vector<uint32_t>* vertex_subset) const;
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 
  private:

@@ -211,15 +211,21 @@ void ScalarAttributes::import_local(const AttributeLayout& layout, double weight
   for (const EnergyState::Point& p : state.points) residual_.push_back(p.residual);
 }
 
-void ScalarAttributes::import_global(const EnergyState& state) {
+void ScalarAttributes::check_global(const EnergyState& state) const {
   if (floats_ == 0) return;
   if (state.wedge_values.size() != state.wedges.size() * size_t(floats_) ||
       state.wedge_class.size() != state.wedges.size())
     throw_invalid("energy state: wedge values or classes disagree with the wedges");
+  for (size_t i = 0; i < state.wedges.size(); ++i)
+    if (state.wedges[i] >= parent_.size() || state.wedge_class[i] >= parent_.size())
+      throw_invalid("energy state: wedge out of range");
+}
+
+void ScalarAttributes::import_global(const EnergyState& state) {
+  if (floats_ == 0) return;
+  check_global(state);
   for (size_t i = 0; i < state.wedges.size(); ++i) {
     const WedgeId w = state.wedges[i];
-    if (w >= parent_.size() || state.wedge_class[i] >= parent_.size())
-      throw_invalid("energy state: wedge out of range");
     std::copy_n(state.wedge_values.begin() + ptrdiff_t(i * size_t(floats_)), floats_,
                 values_.begin() + ptrdiff_t(size_t(w) * size_t(floats_)));
     join(w, state.wedge_class[i]);

@@ -61,7 +61,8 @@ class ScalarAttributes {
   void export_wedges(const std::vector<WedgeId>& wedges, const IdTranslation& to,
                      EnergyState& out) const;
   void import_local(const AttributeLayout& layout, double weight, const EnergyState& state);
-  void import_global(const EnergyState& state);
+  void import_global(const EnergyState& state);  // after check_global (kInvalidInput)
+  void check_global(const EnergyState& state) const;
 
   // The next point's attributes: those of the mesh where `position` projects on face f.
   void add_point(const CollapseMesh& mesh, FaceId f, const Vec3& position);

@@ -327,7 +327,7 @@ void SharpCurves::import_local(const CollapseMesh& mesh, const EnergyState& stat
   total_samples_ = state.curve_samples_total;
 }
 
-void SharpCurves::import_global(const EnergyState& state) {
+void SharpCurves::check_global(const EnergyState& state) const {
   const size_t n = state.vertices.size();
   if (state.sharp_begin.size() != n + 1 || state.listed_begin.size() != n + 1)
     throw_invalid("energy state: curve lists disagree with the vertices");
@@ -335,19 +335,40 @@ void SharpCurves::import_global(const EnergyState& state) {
     if (s.id >= samples_.size()) throw_invalid("energy state: curve sample id out of range");
     if (s.u >= neighbors_.size() || (s.w != kNoId && s.w >= neighbors_.size()))
       throw_invalid("energy state: curve sample on a vertex out of range");
-    samples_[s.id] = {s.position, s.distance_sq, s.u, s.w};
   }
   for (size_t i = 0; i < n; ++i) {
-    const VertexId v = state.vertices[i];
-    if (v >= neighbors_.size()) throw_invalid("energy state: vertex out of range");
+    if (state.vertices[i] >= neighbors_.size()) throw_invalid("energy state: vertex out of range");
+    if (state.sharp_begin[i] > state.sharp_begin[i + 1] ||
+        state.sharp_begin[i + 1] > state.sharp_neighbors.size() ||
+        state.listed_begin[i] > state.listed_begin[i + 1] ||
+        state.listed_begin[i + 1] > state.listed.size())
+      throw_invalid("energy state: curve lists out of range");
     for (uint32_t k = state.sharp_begin[i]; k < state.sharp_begin[i + 1]; ++k)
-      if (state.sharp_neighbors.at(k) >= neighbors_.size())
+      if (state.sharp_neighbors[k] >= neighbors_.size())
         throw_invalid("energy state: sharp neighbour out of range");
+    for (uint32_t k = state.listed_begin[i]; k < state.listed_begin[i + 1]; ++k)
+      if (state.listed[k] >= state.samples.size())
+        throw_invalid("energy state: listed curve sample out of range");
+  }
+}
+
+void SharpCurves::import_global(const EnergyState& state, const std::vector<uint32_t>* written) {
+  check_global(state);
+  auto write = [&](const EnergyState::CurveSample& s) {
+    samples_[s.id] = {s.position, s.distance_sq, s.u, s.w};
+  };
+  if (written) {
+    for (uint32_t i : *written) write(state.samples.at(i));
+  } else {
+    for (const EnergyState::CurveSample& s : state.samples) write(s);
+  }
+  for (size_t i = 0; i < state.vertices.size(); ++i) {
+    const VertexId v = state.vertices[i];
     neighbors_[v].assign(state.sharp_neighbors.begin() + state.sharp_begin[i],
                          state.sharp_neighbors.begin() + state.sharp_begin[i + 1]);
     listed_at_[v].clear();
     for (uint32_t k = state.listed_begin[i]; k < state.listed_begin[i + 1]; ++k)
-      listed_at_[v].push_back(state.samples.at(state.listed[k]).id);
+      listed_at_[v].push_back(state.samples[state.listed[k]].id);
   }
 }
 

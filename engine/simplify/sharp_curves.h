@@ -81,11 +81,14 @@ class SharpCurves {
   // `vertices` (the module's ids; out.vertices lists them written through `to`) go to out's
   // sharp and listed lists, the samples listed there (with their every end translating) to
   // out.samples. import_local builds the curves of a job's mesh from such a state (local ids)
-  // instead of initialize(); import_global overwrites the state's vertices and samples.
+  // instead of initialize(); import_global overwrites the state's vertices and its samples (or
+  // only those of `written`: indices into state.samples), after check_global, which throws
+  // Error(kInvalidInput) for a state whose lists or ids do not fit (it changes nothing).
   void export_state(const std::vector<VertexId>& vertices, const IdTranslation& to,
                     EnergyState& out) const;
   void import_local(const CollapseMesh& mesh, const EnergyState& state);
-  void import_global(const EnergyState& state);
+  void check_global(const EnergyState& state) const;
+  void import_global(const EnergyState& state, const std::vector<uint32_t>* written = nullptr);
 
   // Observers for tests: a sample's position, distance squared and the edge it is on.
   const Vec3& sample_position(size_t i) const { return samples_[i].position; }

@@ -111,6 +111,19 @@ TEST(JobState, ExportThenImportCostsEveryEdgeAlike) {
     }
 }
 
+// Per face of `mesh`, the subset of its three corners when they agree, kNoId otherwise.
+std::vector<uint32_t> face_subsets(const CollapseMesh& mesh,
+                                   const std::vector<uint32_t>& vertex_subset) {
+  std::vector<uint32_t> out(mesh.face_capacity(), kNoId);
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+    if (!mesh.face_alive(f)) continue;
+    const Triangle& t = mesh.face(f);
+    if (vertex_subset[t[0]] == vertex_subset[t[1]] && vertex_subset[t[1]] == vertex_subset[t[2]])
+      out[f] = vertex_subset[t[0]];
+  }
+  return out;
+}
+
 // A round of p subsets on `whole` (the master's module `master` initialised on it), as the
 // parallel build does it: new partition of the live mesh, jobs with state, merge by cost. The
 // records replay on `whole` and on `twin` (the same mesh); `master` follows by importing the
@@ -151,8 +164,12 @@ void round_both_ways(const RepairedMesh& repaired, const SimplifyOptions& option
   }
   const std::vector<CollapseRecord> merged = merge_by_cost(std::move(lists));
   ASSERT_GT(merged.size(), whole.live_faces() / 8);
+  // Side by side, as the build takes them (before the replay: the faces' owners are those of
+  // the jobs' start).
+  std::vector<const MetricState*> states;
+  for (const SubsetResult& r : results) states.push_back(&r.state);
+  import_result_states(master, states, vertex_subset, face_subsets(whole, vertex_subset), 2);
   replay_collapses(whole, merged, nullptr);
-  for (const SubsetResult& r : results) import_result_state(master, r.state);
   report = replay_collapses(twin, merged, &replayed);
 }
 
@@ -333,6 +350,134 @@ TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
     }
   }
   EXPECT_NO_THROW(import_result_state(*master, result.state));
+}
+
+// The states of a round go into the master side by side (import_result_states), so each may
+// name only its own subset's faces, vertices and points: a state naming another subset's (a
+// worker's reply is untrusted; taken side by side, two threads would write the same face) is
+// refused before the master changes, and the honest states give the master what taking them
+// one after the other gives.
+TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const SimplifyOptions options = options_of("energy");
+  const Mesh& mesh = repaired.mesh;
+  CollapseMesh whole(mesh);
+  auto master = make_priority_module(options, mesh, locked);
+  auto one_by_one = make_priority_module(options, mesh, locked);
+  master->initialize(whole);
+  one_by_one->initialize(whole);
+  std::vector<uint32_t> vertex_subset(whole.vertex_capacity(), 0);
+  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+    vertex_subset[v] = whole.position(v)[0] < 0 ? 0 : 1;  // two halves
+  const std::vector<uint32_t> face_subset = face_subsets(whole, vertex_subset);
+  std::vector<SubsetJob> jobs =
+      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                      vertex_subset, 2, 0, subset_options_of(options, mesh));
+  std::vector<MetricState> honest;
+  for (SubsetJob& job : jobs) {
+    job.options.target_faces = job.mesh.face_count() / 2;
+    job.state = export_job_state(*master, job);
+    honest.push_back(simplify_subset(job).state);
+    ASSERT_GT(honest.back().energy.faces.size(), 10u);
+  }
+  const auto* energy = dynamic_cast<EnergyPriority*>(master.get());
+  ASSERT_NE(energy, nullptr);
+  const auto before = energy->point_states();
+  const FaceId foreign_face = honest[1].energy.faces.front();
+  const VertexId foreign_vertex = honest[1].energy.vertices.front();
+  const uint32_t foreign_point = honest[1].energy.points.front().id;
+
+  struct Tamper {
+    const char* what;
+    std::function<void(std::vector<MetricState>&)> change;
+  };
+  const std::vector<Tamper> tampers = {
+      {"is another subset's",
+       [&](std::vector<MetricState>& s) { s[0].energy.faces.push_back(foreign_face); }},
+      {"is another subset's",
+       [&](std::vector<MetricState>& s) {
+         EnergyState& e = s[0].energy;
+         e.vertices.push_back(foreign_vertex);
+         e.sharp_begin.push_back(e.sharp_begin.back());
+         e.listed_begin.push_back(e.listed_begin.back());
+       }},
+      {"is another subset's", [&](std::vector<MetricState>& s) { s[1] = s[0]; }},
+      {"is not the job's",
+       [&](std::vector<MetricState>& s) { s[0].energy.points.front().id = foreign_point; }},
+  };
+  for (const Tamper& tamper : tampers) {
+    std::vector<MetricState> states = honest;
+    tamper.change(states);
+    try {
+      import_result_states(*master, {&states[0], &states[1]}, vertex_subset, face_subset, 2);
+      ADD_FAILURE() << tamper.what << ": accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << tamper.what;
+      EXPECT_NE(std::string(e.what()).find(tamper.what), std::string::npos) << e.what();
+    }
+    const auto after = energy->point_states();
+    ASSERT_EQ(after.size(), before.size());
+    for (size_t i = 0; i < after.size(); ++i) {
+      ASSERT_EQ(after[i].face, before[i].face) << tamper.what << " point " << i;
+      ASSERT_EQ(after[i].parked, before[i].parked) << tamper.what << " point " << i;
+      ASSERT_EQ(after[i].distance_sq, before[i].distance_sq) << tamper.what << " point " << i;
+    }
+  }
+
+  import_result_states(*master, {&honest[0], &honest[1]}, vertex_subset, face_subset, 2);
+  for (const MetricState& state : honest) import_result_state(*one_by_one, state);
+  const auto* other = dynamic_cast<EnergyPriority*>(one_by_one.get());
+  const auto a = energy->point_states(), b = other->point_states();
+  size_t moved = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].face, b[i].face) << "point " << i;
+    ASSERT_EQ(a[i].parked, b[i].parked) << "point " << i;
+    ASSERT_EQ(a[i].distance_sq, b[i].distance_sq) << "point " << i;
+    moved += a[i].face != before[i].face || a[i].parked != before[i].parked;
+  }
+  EXPECT_GT(moved, 100u);
+  EXPECT_EQ(energy->held_point_count(), other->held_point_count());
+  const SharpCurves &ca = energy->curves(), &cb = other->curves();
+  ASSERT_GT(ca.sample_count(), 0u);
+  for (size_t i = 0; i < ca.sample_count(); ++i) {
+    ASSERT_EQ(ca.sample_edge(i), cb.sample_edge(i)) << "curve sample " << i;
+    ASSERT_EQ(ca.sample_distance_sq(i), cb.sample_distance_sq(i)) << "curve sample " << i;
+  }
+  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+    ASSERT_EQ(ca.sharp_neighbors(v), cb.sharp_neighbors(v)) << "vertex " << v;
+}
+
+// The quadric's states too: a vertex of another subset's is refused, the master unchanged.
+TEST(JobState, QuadricStatesSideBySideTakeOnlyTheirOwnSubsets) {
+  testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
+  std::vector<uint32_t> vertex_subset(round.whole.vertex_capacity(), kNoId);
+  std::vector<MetricState> states;
+  for (SubsetJob& job : round.jobs) {
+    for (VertexId v = 0; v < job.mesh.vertex_count(); ++v)
+      if (job.owned[v]) vertex_subset[job.global_vertex[v]] = job.subset;
+    job.options.target_faces = job.mesh.face_count() / 2;
+    states.push_back(simplify_subset(job).state);
+  }
+  const auto* q = dynamic_cast<QuadricPriority*>(round.master.get());
+  ASSERT_NE(q, nullptr);
+  const VertexId foreign = states[1].quadric.vertices.front();
+  const Quadric kept = q->quadric(foreign);
+  std::vector<MetricState> tampered = states;
+  tampered[0].quadric.vertices.push_back(foreign);
+  tampered[0].quadric.quadrics.push_back(Quadric{});
+  const std::vector<uint32_t> faces = face_subsets(round.whole, vertex_subset);
+  try {
+    import_result_states(*round.master, {&tampered[0], &tampered[1]}, vertex_subset, faces, 2);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
+    EXPECT_NE(std::string(e.what()).find("is another subset's"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(q->quadric(foreign).c, kept.c);
+  EXPECT_EQ(q->quadric(foreign).weight, kept.weight);
+  import_result_states(*round.master, {&states[0], &states[1]}, vertex_subset, faces, 2);
+  EXPECT_EQ(q->quadric(foreign).c, states[1].quadric.quadrics.front().c);
 }
 
 }  // namespace

@@ -268,6 +268,33 @@ TEST(ParallelBuild, SameBytesWhateverTheThreadCount) {
   }
 }
 
+// After a band pass, the next round's partition is drawn beside it, on a copy of the mesh as
+// it was before the band pass; the round after it takes it when it has as many subsets as
+// foreseen. On two threads (the band pass and the partition really side by side) the PM is
+// the one-thread PM (SameBytesWhateverTheThreadCount) and lossless.
+TEST(ParallelBuild, TheNextPartitionIsDrawnBesideTheBandPass) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
+  const SimplifyOptions options = metric_options("energy", 0.01);
+  for (unsigned threads : {1u, 2u}) {
+    ParallelStats stats;
+    const ProgressiveMesh pm = build_progressive_mesh_parallel(
+        repaired, options, with_p(4, threads, /*rounds=*/0), &stats);
+    size_t foreseen = 0, band_passes = 0;
+    for (const RoundStats& r : stats.round_stats) {
+      foreseen += r.partition_foreseen ? 1 : 0;
+      EXPECT_FALSE(r.partition_foreseen && r.round < 2) << "round " << r.round;
+      EXPECT_GE(r.partition_overlap_seconds, 0) << "round " << r.round;
+      band_passes += r.round >= 1 ? 1 : 0;
+    }
+    ASSERT_GE(band_passes, 2u) << "threads " << threads;
+    EXPECT_GE(foreseen, band_passes - 1) << "threads " << threads;
+    std::istringstream in(testing::pm_bytes(pm));
+    const MeshDifference diff = compare_meshes_exact(restore_input(read_pm(in, "foreseen")),
+                                                     repaired_input(repaired), false);
+    EXPECT_TRUE(diff.equal) << diff.first_difference;
+  }
+}
+
 // With one subset nothing is a border: the job is the whole mesh and runs the sequential
 // queue to the handover; the final pass then continues from the same metric state with a
 // fresh queue. A quadric cost depends only on the edge's two ends, whose stamps the queue
