@@ -269,6 +269,26 @@ TEST(JobState, ImportedStateEqualsTheReplayedState) {
   }
 }
 
+// `import` throws Error(kInvalidInput) naming `what`, and the master's points are as `before`.
+void expect_refused_and_unchanged(const std::function<void()>& import, const std::string& what,
+                                  const EnergyPriority& energy,
+                                  const std::vector<EnergyPriority::PointState>& before) {
+  try {
+    import();
+    ADD_FAILURE() << what << ": accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << what;
+    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+  }
+  const auto after = energy.point_states();
+  ASSERT_EQ(after.size(), before.size());
+  for (size_t i = 0; i < after.size(); ++i) {
+    ASSERT_EQ(after[i].face, before[i].face) << what << " point " << i;
+    ASSERT_EQ(after[i].parked, before[i].parked) << what << " point " << i;
+    ASSERT_EQ(after[i].distance_sq, before[i].distance_sq) << what << " point " << i;
+  }
+}
+
 // What a job gives back may come from a worker over the network: an energy state that loses
 // track of its points (one given twice, one that is another job's, one moved from where it
 // was sampled, one put on a face the state does not list) is refused before the master
@@ -334,20 +354,8 @@ TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
   for (const Tamper& tamper : tampers) {
     MetricState state = result.state;
     tamper.change(state.energy);
-    try {
-      import_result_state(*master, state);
-      ADD_FAILURE() << tamper.what << ": accepted";
-    } catch (const Error& e) {
-      EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << tamper.what;
-      EXPECT_NE(std::string(e.what()).find(tamper.what), std::string::npos) << e.what();
-    }
-    const auto after = energy->point_states();
-    ASSERT_EQ(after.size(), before.size());
-    for (size_t i = 0; i < after.size(); ++i) {
-      ASSERT_EQ(after[i].face, before[i].face) << tamper.what << " point " << i;
-      ASSERT_EQ(after[i].parked, before[i].parked) << tamper.what << " point " << i;
-      ASSERT_EQ(after[i].distance_sq, before[i].distance_sq) << tamper.what << " point " << i;
-    }
+    expect_refused_and_unchanged([&] { import_result_state(*master, state); }, tamper.what, *energy,
+                                 before);
   }
   EXPECT_NO_THROW(import_result_state(*master, result.state));
 }
@@ -409,20 +417,11 @@ TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
   for (const Tamper& tamper : tampers) {
     std::vector<MetricState> states = honest;
     tamper.change(states);
-    try {
-      import_result_states(*master, {&states[0], &states[1]}, vertex_subset, face_subset, 2);
-      ADD_FAILURE() << tamper.what << ": accepted";
-    } catch (const Error& e) {
-      EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << tamper.what;
-      EXPECT_NE(std::string(e.what()).find(tamper.what), std::string::npos) << e.what();
-    }
-    const auto after = energy->point_states();
-    ASSERT_EQ(after.size(), before.size());
-    for (size_t i = 0; i < after.size(); ++i) {
-      ASSERT_EQ(after[i].face, before[i].face) << tamper.what << " point " << i;
-      ASSERT_EQ(after[i].parked, before[i].parked) << tamper.what << " point " << i;
-      ASSERT_EQ(after[i].distance_sq, before[i].distance_sq) << tamper.what << " point " << i;
-    }
+    expect_refused_and_unchanged(
+        [&] {
+          import_result_states(*master, {&states[0], &states[1]}, vertex_subset, face_subset, 2);
+        },
+        tamper.what, *energy, before);
   }
 
   import_result_states(*master, {&honest[0], &honest[1]}, vertex_subset, face_subset, 2);
