@@ -275,10 +275,11 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
   // sample on an edge between two subsets is listed by both (unchanged: no job moves a bound
   // vertex's samples), and written once.
   GlobalImport import;
-  for (uint32_t i = 0; i < state.samples.size(); ++i)
-    if (!owners.vertex_subset ||
-        (*owners.vertex_subset)[curves_.sample_edge(state.samples[i].id).first] == subset)
-      import.samples.push_back(i);
+  if (options_.discontinuities)  // (without, the curves are empty and take nothing)
+    for (uint32_t i = 0; i < state.samples.size(); ++i)
+      if (!owners.vertex_subset ||
+          (*owners.vertex_subset)[curves_.sample_edge(state.samples[i].id).first] == subset)
+        import.samples.push_back(i);
   return import;
 }
 
