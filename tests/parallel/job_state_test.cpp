@@ -269,6 +269,36 @@ TEST(JobState, ImportedStateEqualsTheReplayedState) {
   }
 }
 
+// The energy's master on stratocaster-9k and the jobs of its two halves (by the sign of x),
+// each with the master's state and a target of half its faces.
+struct TwoHalves {
+  TwoHalves()
+      : repaired(testing::repaired_test_mesh("stratocaster-9k.ply")),
+        locked(locked_vertices(repaired)),
+        options(options_of("energy")),
+        whole(repaired.mesh),
+        master(make_priority_module(options, repaired.mesh, locked)),
+        vertex_subset(whole.vertex_capacity(), 0) {
+    const Mesh& mesh = repaired.mesh;
+    master->initialize(whole);
+    for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+      vertex_subset[v] = whole.position(v)[0] < 0 ? 0 : 1;
+    jobs = extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                           vertex_subset, 2, 0, subset_options_of(options, mesh));
+    for (SubsetJob& job : jobs) {
+      job.options.target_faces = job.mesh.face_count() / 2;
+      job.state = export_job_state(*master, job);
+    }
+  }
+  RepairedMesh repaired;
+  std::vector<uint8_t> locked;
+  SimplifyOptions options;
+  CollapseMesh whole;
+  std::unique_ptr<PriorityModule> master;
+  std::vector<uint32_t> vertex_subset;
+  std::vector<SubsetJob> jobs;
+};
+
 // `import` throws Error(kInvalidInput) naming `what`, and the master's points are as `before`.
 void expect_refused_and_unchanged(const std::function<void()>& import, const std::string& what,
                                   const EnergyPriority& energy,
@@ -294,23 +324,11 @@ void expect_refused_and_unchanged(const std::function<void()>& import, const std
 // was sampled, one put on a face the state does not list) is refused before the master
 // changes, and the honest state is then taken as usual.
 TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
-  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  const SimplifyOptions options = options_of("energy");
-  const Mesh& mesh = repaired.mesh;
-  CollapseMesh whole(mesh);
-  auto master = make_priority_module(options, mesh, locked);
-  master->initialize(whole);
-  std::vector<uint32_t> vertex_subset(whole.vertex_capacity(), 0);
-  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
-    vertex_subset[v] = whole.position(v)[0] < 0 ? 0 : 1;  // two halves
-  std::vector<SubsetJob> jobs =
-      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                      vertex_subset, 2, 0, subset_options_of(options, mesh));
-  SubsetJob& job = jobs.at(0);
-  job.options.target_faces = job.mesh.face_count() / 2;
-  job.state = export_job_state(*master, job);
-  const SubsetResult result = simplify_subset(job);
+  TwoHalves halves;
+  const std::unique_ptr<PriorityModule>& master = halves.master;
+  const CollapseMesh& whole = halves.whole;
+  const std::vector<SubsetJob>& jobs = halves.jobs;
+  const SubsetResult result = simplify_subset(jobs.at(0));
   const EnergyState& honest = result.state.energy;
   ASSERT_GT(honest.points.size(), 10u);
   const auto* energy = dynamic_cast<EnergyPriority*>(master.get());
@@ -366,26 +384,15 @@ TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
 // refused before the master changes, and the honest states give the master what taking them
 // one after the other gives.
 TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
-  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  const SimplifyOptions options = options_of("energy");
-  const Mesh& mesh = repaired.mesh;
-  CollapseMesh whole(mesh);
-  auto master = make_priority_module(options, mesh, locked);
-  auto one_by_one = make_priority_module(options, mesh, locked);
-  master->initialize(whole);
+  TwoHalves halves;
+  const std::unique_ptr<PriorityModule>& master = halves.master;
+  const CollapseMesh& whole = halves.whole;
+  const std::vector<uint32_t>& vertex_subset = halves.vertex_subset;
+  auto one_by_one = make_priority_module(halves.options, halves.repaired.mesh, halves.locked);
   one_by_one->initialize(whole);
-  std::vector<uint32_t> vertex_subset(whole.vertex_capacity(), 0);
-  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
-    vertex_subset[v] = whole.position(v)[0] < 0 ? 0 : 1;  // two halves
   const std::vector<uint32_t> face_subset = face_subsets(whole, vertex_subset);
-  std::vector<SubsetJob> jobs =
-      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                      vertex_subset, 2, 0, subset_options_of(options, mesh));
   std::vector<MetricState> honest;
-  for (SubsetJob& job : jobs) {
-    job.options.target_faces = job.mesh.face_count() / 2;
-    job.state = export_job_state(*master, job);
+  for (const SubsetJob& job : halves.jobs) {
     honest.push_back(simplify_subset(job).state);
     ASSERT_GT(honest.back().energy.faces.size(), 10u);
   }
