@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <string>
 
 #include "parallel/job_pool.h"
 #include "parallel/simplify_subset.h"
@@ -86,18 +87,47 @@ void import_result_state(PriorityModule& master, const MetricState& state) {
   }
 }
 
+void check_state_covers(const MetricState& state, const std::vector<CollapseRecord>& records) {
+  const bool energy = state.metric == "energy";
+  if (!energy && state.metric != "quadric")
+    throw_internal("check_state_covers: no state of metric '" + state.metric + "'");
+  const std::vector<VertexId>& vertices = energy ? state.energy.vertices : state.quadric.vertices;
+  const std::vector<FaceId>& faces = state.energy.faces;
+  auto increasing = [](const std::vector<uint32_t>& ids) {
+    return std::adjacent_find(ids.begin(), ids.end(), std::greater_equal<>()) == ids.end();
+  };
+  if (!increasing(vertices) || !increasing(faces))
+    throw_invalid(state.metric + " state: its vertex or face list is not in increasing order");
+  for (size_t i = 0; i < records.size(); ++i) {
+    const CollapseRecord& r = records[i];
+    for (VertexId v : {r.vs, r.vt})
+      if (!std::binary_search(vertices.begin(), vertices.end(), v))
+        throw_invalid(state.metric + " state: does not cover vertex " + std::to_string(v) +
+                      ", an end of its job's collapse " + std::to_string(i));
+    if (energy)
+      for (FaceId f : {r.fl, r.fr})
+        if (f != kNoId && !std::binary_search(faces.begin(), faces.end(), f))
+          throw_invalid("energy state: does not cover face " + std::to_string(f) +
+                        ", removed by its job's collapse " + std::to_string(i));
+  }
+}
+
 ImportTimes import_result_states(PriorityModule& master,
                                  const std::vector<const MetricState*>& states,
                                  const std::vector<uint32_t>& vertex_subset,
-                                 const std::vector<uint32_t>& face_subset, unsigned threads) {
+                                 const std::vector<uint32_t>& face_subset, unsigned threads,
+                                 const std::vector<const std::vector<CollapseRecord>*>& records) {
   const auto start = std::chrono::steady_clock::now();
   ImportTimes times;
   for (const MetricState* state : states)
     if (state->metric != master.name())
       throw_internal("import_result_states: a state of metric '" + state->metric + "' for " +
                      master.name());
+  if (!records.empty() && records.size() != states.size())
+    throw_internal("import_result_states: " + std::to_string(records.size()) +
+                   " record lists for " + std::to_string(states.size()) + " states");
   std::vector<double> check_cpu(states.size(), 0), apply_cpu(states.size(), 0);
-  // Each step on the pool, each state's CPU timed.
+  // Each step on the pool, each state's CPU timed; a state's check ends with its coverage.
   auto side_by_side = [&](std::vector<double>& cpu, const std::function<void(size_t)>& step) {
     run_jobs(states.size(), threads, [&](size_t k) {
       const double t = thread_cpu_seconds();
@@ -105,10 +135,14 @@ ImportTimes import_result_states(PriorityModule& master,
       cpu[k] = thread_cpu_seconds() - t;
     });
   };
+  auto covers = [&](size_t k) {
+    if (!records.empty()) check_state_covers(*states[k], *records[k]);
+  };
   double sequential = 0;
   if (auto* q = dynamic_cast<QuadricPriority*>(&master)) {
     side_by_side(check_cpu, [&](size_t k) {
       q->check_global(states[k]->quadric, uint32_t(k), &vertex_subset);
+      covers(k);
     });
     side_by_side(apply_cpu, [&](size_t k) { q->import_global(states[k]->quadric); });
   } else if (auto* e = dynamic_cast<EnergyPriority*>(&master)) {
@@ -119,6 +153,7 @@ ImportTimes import_result_states(PriorityModule& master,
     std::vector<EnergyPriority::GlobalImport> imports(states.size());
     side_by_side(check_cpu, [&](size_t k) {
       imports[k] = e->check_global(states[k]->energy, uint32_t(k), owners);
+      covers(k);
     });
     side_by_side(apply_cpu, [&](size_t k) { e->apply_global(states[k]->energy, imports[k]); });
     const auto wedges = std::chrono::steady_clock::now();

@@ -41,17 +41,26 @@ void import_result_state(PriorityModule& master, const MetricState& state);
 // naming another subset's face would have two threads write it); then all are taken, side by
 // side (their faces, vertices and points are disjoint; a curve sample on an edge between two
 // subsets is written by the subset of its first end), then the wedges, one state after the
-// other. The master's result is import_result_state's of each, in any order.
+// other. The master's result is import_result_state's of each, in any order. With `records`
+// (records[k]: the records of state k's job, in global ids), each state must also cover what
+// they changed (check_state_covers).
 struct ImportTimes {
   double seconds = 0;                // wall
   double critical_seconds = 0;       // with a core per state: the steps' slowest ones, in turn
   double slowest_check_seconds = 0;  // CPU
   double slowest_apply_seconds = 0;  // CPU
 };
-ImportTimes import_result_states(PriorityModule& master,
-                                 const std::vector<const MetricState*>& states,
-                                 const std::vector<uint32_t>& vertex_subset,
-                                 const std::vector<uint32_t>& face_subset, unsigned threads);
+ImportTimes import_result_states(
+    PriorityModule& master, const std::vector<const MetricState*>& states,
+    const std::vector<uint32_t>& vertex_subset, const std::vector<uint32_t>& face_subset,
+    unsigned threads, const std::vector<const std::vector<CollapseRecord>*>& records = {});
+
+// Throws Error(kInvalidInput) unless `state`, a job's returned state, covers what its job's
+// `records` (global ids) changed: the two ends of every collapse and, for the energy, the two
+// faces it removed, its lists in increasing order as exports write them. The checks of a
+// state's entries (check_global) cannot see what it leaves out: a reply without a removed face
+// would leave that face's points in the master, held twice; without vs, a stale quadric.
+void check_state_covers(const MetricState& state, const std::vector<CollapseRecord>& records);
 
 // Forwards to `inner` except initialize(), which does nothing: for a module whose state was
 // imported or carried over (the master's, continued by the final pass).

@@ -261,18 +261,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
   CollapseMesh whole(mesh);
   std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
   // The first round's partition needs the mesh only: it is drawn beside the master's
-  // initialisation (both read `whole`, neither through its marks; each writes its own data).
+  // initialisation, whose independent parts run side by side too (all read `whole`, none
+  // through its marks; each writes its own data).
   std::vector<uint32_t> first_partition;
-  double first_partition_seconds = 0, initialize_seconds = 0;
+  double first_partition_seconds = 0;
   const uint32_t first_subsets = round_subsets(parallel, whole.live_faces());
   const bool first_round = first_subsets >= std::min(2u, parallel.subsets) &&
                            whole.live_vertices() >= 4 * size_t(first_subsets) &&
                            whole.live_faces() > handover;
-  auto initialize_master = [&] {
-    const auto ti = std::chrono::steady_clock::now();
-    master->initialize(whole);
-    initialize_seconds = seconds_since(ti);
-  };
   auto partition_first_round = [&] {
     const auto tp = std::chrono::steady_clock::now();
     PartitionOptions partition_options;
@@ -280,12 +276,22 @@ ProgressiveMesh build_progressive_mesh_parallel(
     first_partition = partition_live(whole, first_subsets, partition_options);
     first_partition_seconds = seconds_since(tp);
   };
+  std::vector<std::function<void()>> setup_tasks;
+  if (first_round) setup_tasks.push_back(partition_first_round);
+  const size_t first_part = setup_tasks.size();
+  for (std::function<void()>& part : master->initialization_parts(whole))
+    setup_tasks.push_back(std::move(part));
+  std::vector<double> task_seconds(setup_tasks.size(), 0);
   const auto section = std::chrono::steady_clock::now();
-  if (first_round)
-    run_jobs(2, parallel.threads,
-             [&](size_t i) { i == 0 ? initialize_master() : partition_first_round(); });
-  else
-    initialize_master();
+  run_jobs(setup_tasks.size(), parallel.threads, [&](size_t i) {
+    const auto ti = std::chrono::steady_clock::now();
+    setup_tasks[i]();
+    task_seconds[i] = seconds_since(ti);
+  });
+  // With a core per task, as the critical path assumes: the slowest part.
+  double initialize_seconds = 0;
+  for (size_t i = first_part; i < task_seconds.size(); ++i)
+    initialize_seconds = std::max(initialize_seconds, task_seconds[i]);
   const double section_seconds = seconds_since(section);
   // The master's queue keys: the water level's sample, the jobs' keys after a round,
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
@@ -559,8 +565,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (!parallel.replay_state) {
         std::vector<const MetricState*> states;
         for (const SubsetResult& r : results) states.push_back(&r.state);
-        const ImportTimes import =
-            import_result_states(*master, states, vertex_subset, face_subset, parallel.threads);
+        std::vector<const std::vector<CollapseRecord>*> changes;
+        for (const std::vector<CollapseRecord>& list : lists) changes.push_back(&list);
+        const ImportTimes import = import_result_states(*master, states, vertex_subset, face_subset,
+                                                        parallel.threads, changes);
         import_saved = std::max(0.0, import.seconds - import.critical_seconds);
       }
       std::vector<double> costs;

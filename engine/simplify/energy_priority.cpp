@@ -48,14 +48,25 @@ double spring_constant(double points_per_face) {
 }
 
 void EnergyPriority::initialize(const CollapseMesh& mesh) {
-  const std::vector<SurfaceSample> samples =
-      sample_surface(mesh, options_.samples_per_face, options_.seed);
+  for (const std::function<void()>& part : initialization_parts(mesh)) part();
+}
+
+std::vector<std::function<void()>> EnergyPriority::initialization_parts(const CollapseMesh& mesh) {
+  return {[this, &mesh] { initialize_curves(mesh); }, [this, &mesh] { initialize_points(mesh); }};
+}
+
+void EnergyPriority::initialize_curves(const CollapseMesh& mesh) {
   if (options_.discontinuities) {
     curves_.initialize(mesh, options_.sharp);
   } else {
     curves_ = SharpCurves{};
     curves_.initialize_empty(mesh);
   }
+}
+
+void EnergyPriority::initialize_points(const CollapseMesh& mesh) {
+  const std::vector<SurfaceSample> samples =
+      sample_surface(mesh, options_.samples_per_face, options_.seed);
   const double diagonal = diagonal_of(mesh);
   // Large against any ordinary change of energy (each point costs at most diagonal^2), and the
   // same for every subset of a mesh, so that penalised costs still compare across subsets.

@@ -136,6 +136,8 @@ class EnergyPriority : public PriorityModule {
   std::string name() const override { return "energy"; }
   bool costly() const override { return true; }
   void initialize(const CollapseMesh& mesh) override;
+  // The sharp curves, and the rest (the sample points, the per-face lists, E_scalar).
+  std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) override;
   // With Costing::kQueue each start's solve is costed on the model it was solved on, not
   // measured again (see evaluate()).
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
@@ -283,6 +285,8 @@ class EnergyPriority : public PriorityModule {
   void unpark(VertexId v);
   FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
   double diagonal_of(const CollapseMesh& mesh) const;
+  void initialize_curves(const CollapseMesh& mesh);  // curves_ only
+  void initialize_points(const CollapseMesh& mesh);  // everything else
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
                     EnergyState& out) const;

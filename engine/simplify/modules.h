@@ -3,6 +3,7 @@
 // per-vertex state (quadrics, sample points) belongs to the module.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,6 +38,14 @@ class PriorityModule {
   virtual ~PriorityModule() = default;
   virtual std::string name() const = 0;
   virtual void initialize(const CollapseMesh& mesh) = 0;
+  // initialize() cut into independent parts, which may run in any order or side by side (each
+  // writes its own part of the module; all only read `mesh`, which must outlive them): running
+  // them all is initialize(). The parallel build runs them on its pool, beside the first
+  // partition (the energy's sharp curves took 0.13 s of its 0.19 s on the 871k dragon). A
+  // wrapper keeps this default: its parts are its own initialize(), whatever it does.
+  virtual std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) {
+    return {[this, &mesh] { initialize(mesh); }};
+  }
   // Costs the collapse of edge {a, b}, choosing which end survives and where. Returns false
   // when the collapse cannot be placed (the edge is then left alone).
   virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,

@@ -381,8 +381,8 @@ TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
 // The states of a round go into the master side by side (import_result_states), so each may
 // name only its own subset's faces, vertices and points: a state naming another subset's (a
 // worker's reply is untrusted; taken side by side, two threads would write the same face) is
-// refused before the master changes, and the honest states give the master what taking them
-// one after the other gives.
+// refused before the master changes, as is one that leaves out a face its job's collapses
+// removed; the honest states give the master what taking them one after the other gives.
 TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
   TwoHalves halves;
   const std::unique_ptr<PriorityModule>& master = halves.master;
@@ -392,10 +392,14 @@ TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
   one_by_one->initialize(whole);
   const std::vector<uint32_t> face_subset = face_subsets(whole, vertex_subset);
   std::vector<MetricState> honest;
+  std::vector<std::vector<CollapseRecord>> records;
   for (const SubsetJob& job : halves.jobs) {
-    honest.push_back(simplify_subset(job).state);
+    SubsetResult result = simplify_subset(job);
+    honest.push_back(std::move(result.state));
+    records.push_back(std::move(result.records));
     ASSERT_GT(honest.back().energy.faces.size(), 10u);
   }
+  const std::vector<const std::vector<CollapseRecord>*> changes = {&records[0], &records[1]};
   const auto* energy = dynamic_cast<EnergyPriority*>(master.get());
   ASSERT_NE(energy, nullptr);
   const auto before = energy->point_states();
@@ -420,18 +424,30 @@ TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
       {"is another subset's", [&](std::vector<MetricState>& s) { s[1] = s[0]; }},
       {"is not the job's",
        [&](std::vector<MetricState>& s) { s[0].energy.points.front().id = foreign_point; }},
+      // A face its job's collapse removed, left out (a dead face holds no points: nothing else
+      // in the state names it, and the master would keep its old points, held twice).
+      {"does not cover face",
+       [&](std::vector<MetricState>& s) {
+         std::vector<FaceId>& faces = s[1].energy.faces;
+         faces.erase(std::find(faces.begin(), faces.end(), records[1].back().fl));
+       }},
+      {"not in increasing order",
+       [&](std::vector<MetricState>& s) {
+         std::swap(s[0].energy.faces.front(), s[0].energy.faces.back());
+       }},
   };
   for (const Tamper& tamper : tampers) {
     std::vector<MetricState> states = honest;
     tamper.change(states);
     expect_refused_and_unchanged(
         [&] {
-          import_result_states(*master, {&states[0], &states[1]}, vertex_subset, face_subset, 2);
+          import_result_states(*master, {&states[0], &states[1]}, vertex_subset, face_subset, 2,
+                               changes);
         },
         tamper.what, *energy, before);
   }
 
-  import_result_states(*master, {&honest[0], &honest[1]}, vertex_subset, face_subset, 2);
+  import_result_states(*master, {&honest[0], &honest[1]}, vertex_subset, face_subset, 2, changes);
   for (const MetricState& state : honest) import_result_state(*one_by_one, state);
   const auto* other = dynamic_cast<EnergyPriority*>(one_by_one.get());
   const auto a = energy->point_states(), b = other->point_states();
@@ -454,17 +470,22 @@ TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
     ASSERT_EQ(ca.sharp_neighbors(v), cb.sharp_neighbors(v)) << "vertex " << v;
 }
 
-// The quadric's states too: a vertex of another subset's is refused, the master unchanged.
+// The quadric's states too: a vertex of another subset's, or one without the surviving end of
+// one of its job's collapses, is refused, the master unchanged.
 TEST(JobState, QuadricStatesSideBySideTakeOnlyTheirOwnSubsets) {
   testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
   std::vector<uint32_t> vertex_subset(round.whole.vertex_capacity(), kNoId);
   std::vector<MetricState> states;
+  std::vector<std::vector<CollapseRecord>> records;
   for (SubsetJob& job : round.jobs) {
     for (VertexId v = 0; v < job.mesh.vertex_count(); ++v)
       if (job.owned[v]) vertex_subset[job.global_vertex[v]] = job.subset;
     job.options.target_faces = job.mesh.face_count() / 2;
-    states.push_back(simplify_subset(job).state);
+    SubsetResult result = simplify_subset(job);
+    states.push_back(std::move(result.state));
+    records.push_back(std::move(result.records));
   }
+  const std::vector<const std::vector<CollapseRecord>*> changes = {&records[0], &records[1]};
   const auto* q = dynamic_cast<QuadricPriority*>(round.master.get());
   ASSERT_NE(q, nullptr);
   const VertexId foreign = states[1].quadric.vertices.front();
@@ -482,7 +503,27 @@ TEST(JobState, QuadricStatesSideBySideTakeOnlyTheirOwnSubsets) {
   }
   EXPECT_EQ(q->quadric(foreign).c, kept.c);
   EXPECT_EQ(q->quadric(foreign).weight, kept.weight);
-  import_result_states(*round.master, {&states[0], &states[1]}, vertex_subset, faces, 2);
+  // Without the surviving end of one of its job's collapses: its quadric would stay stale.
+  tampered = states;
+  const VertexId survivor = records[1].back().vs;
+  std::vector<VertexId>& listed = tampered[1].quadric.vertices;
+  const auto at = std::find(listed.begin(), listed.end(), survivor);
+  ASSERT_NE(at, listed.end());
+  tampered[1].quadric.quadrics.erase(tampered[1].quadric.quadrics.begin() + (at - listed.begin()));
+  listed.erase(at);
+  const Quadric survivor_kept = q->quadric(survivor);
+  try {
+    import_result_states(*round.master, {&tampered[0], &tampered[1]}, vertex_subset, faces, 2,
+                         changes);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
+    EXPECT_NE(std::string(e.what()).find("does not cover vertex " + std::to_string(survivor)),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(q->quadric(survivor).c, survivor_kept.c);
+  import_result_states(*round.master, {&states[0], &states[1]}, vertex_subset, faces, 2, changes);
   EXPECT_EQ(q->quadric(foreign).c, states[1].quadric.quadrics.front().c);
 }
 

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <thread>
 #include <vector>
 
 #include "io/mesh_io.h"
@@ -321,6 +323,49 @@ TEST(EnergyCosting, ARequeuedEdgeKeepsItsCostingWhileItsStarStays) {
     std::printf("%-36s %llu collapses, %llu requeued, %llu taken out again unchanged\n", name,
                 (unsigned long long)stats.collapses, (unsigned long long)stats.requeued,
                 (unsigned long long)stats.requeue_reused);
+  }
+}
+
+// The energy's initialisation parts (its sharp curves, its points and the rest) run side by side
+// in the parallel build; in any order and on other threads, they give the module initialize()
+// gives: the same collapses, bit for bit, on meshes with creases and with attribute seams.
+TEST(EnergyPriority, InitializationPartsSideBySideEqualInitialize) {
+  // Keeps the state its parts made: the simplifier would initialise the module again.
+  class Initialized : public PriorityWrapper {
+   public:
+    using PriorityWrapper::PriorityWrapper;
+    void initialize(const CollapseMesh&) override {}
+  };
+  for (const char* name : {"cad-featuretype-3k.stl", "pymeshlab-colored-airplane-11k.ply"}) {
+    const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data(name)));
+    SimplifyOptions options;
+    options.metric = "energy";
+    const std::vector<uint8_t> locked = locked_vertices(repaired);
+    auto run = [&](bool by_parts) {
+      CollapseMesh mesh(repaired.mesh);
+      std::unique_ptr<PriorityModule> energy = make_priority_module(options, repaired.mesh, locked);
+      std::unique_ptr<PriorityModule> priority;
+      if (by_parts) {
+        std::vector<std::function<void()>> parts = energy->initialization_parts(mesh);
+        EXPECT_EQ(parts.size(), 2u) << name;
+        std::vector<std::thread> threads;
+        for (auto part = parts.rbegin(); part != parts.rend(); ++part) threads.emplace_back(*part);
+        for (std::thread& t : threads) t.join();
+        priority = std::make_unique<Initialized>(*energy);
+      }
+      Simplifier simplifier(mesh, priority ? *priority : *energy, standard_constraints(locked));
+      return simplifier.run({mesh.live_faces() / 10}, {}, nullptr);
+    };
+    const std::vector<CollapseRecord> whole = run(false), parts = run(true);
+    ASSERT_EQ(whole.size(), parts.size()) << name;
+    EXPECT_GT(whole.size(), repaired.mesh.vertex_count() / 2) << name;
+    for (size_t i = 0; i < whole.size(); ++i) {
+      ASSERT_EQ(whole[i].vs, parts[i].vs) << name << " collapse " << i;
+      ASSERT_EQ(whole[i].vt, parts[i].vt) << name << " collapse " << i;
+      ASSERT_EQ(whole[i].position, parts[i].position) << name << " collapse " << i;
+      ASSERT_EQ(whole[i].cost, parts[i].cost) << name << " collapse " << i;
+      ASSERT_EQ(whole[i].changed_values, parts[i].changed_values) << name << " collapse " << i;
+    }
   }
 }
 
