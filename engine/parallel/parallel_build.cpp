@@ -114,6 +114,32 @@ Beside run_beside(unsigned threads, const std::function<void()>& work,
   return out;
 }
 
+// Whether a partition drawn on the mesh as the last round found it keeps that round's borders:
+// more than half of the last round's bound vertices still alive are bound again. The greedy
+// partitioner is deterministic from its start vertex, the seed's pick among a few vertices of
+// least degree: two seeds can pick the same one and draw the same partition of the same mesh
+// (the stratocaster, gears-19k at p = 4; the bunny and fandisk too before kStartCandidates),
+// and a round on it would leave the last round's borders as they were (fandisk's 50% level went
+// from 1.14 to 1.62 of the sequential RMS at p = 8). Different partitions bind 1-13% again.
+// `bound`: the partition's bound vertices, found here.
+bool repeats_borders(const CollapseMesh& mesh, const std::vector<uint32_t>& vertex_subset,
+                     const std::vector<uint8_t>& bound_before, std::vector<uint8_t>& bound) {
+  bound = bound_vertices(mesh, vertex_subset);
+  size_t before = 0, again = 0;
+  for (VertexId v = 0; v < bound_before.size() && v < bound.size(); ++v)
+    if (bound_before[v] && mesh.vertex_alive(v)) {
+      ++before;
+      again += bound[v];
+    }
+  spdlog::debug("the partition drawn ahead binds {} of the last round's {} bound vertices again",
+                again, before);
+  if (2 * again > before) {
+    bound.clear();
+    return true;
+  }
+  return false;
+}
+
 // The subsets of a round starting at `faces` (ParallelOptions::min_subset_faces); below 2 (with
 // p >= 2), no round.
 uint32_t round_subsets(const ParallelOptions& parallel, uint64_t faces) {
@@ -321,6 +347,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   std::vector<std::vector<CollapseRecord>> pending_lists;
   auto append_pending = [&] { append_merged_by_cost(pending_lists, records); };
   std::vector<uint8_t> bound_before;  // the previous round's bound vertices (subset_rule.h)
+  std::vector<uint8_t> early_bound;   // round 1's, found while checking its early partition
   std::vector<uint32_t> face_subset;  // the round's: per face, the job owning its corners
   double subsets_cpu = 0;
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
@@ -418,13 +445,29 @@ ProgressiveMesh build_progressive_mesh_parallel(
     // A new partition of the current mesh: the previous round's borders, whose vertices could
     // not move, are inside subsets now.
     t = std::chrono::steady_clock::now();
+    // Round 1's partition drawn beside round 0's jobs, unless it keeps round 0's borders.
+    const bool early_drawn = foreseen.drawn && !foreseen.beside_band && foreseen.subsets == subsets;
+    const bool early_taken =
+        early_drawn && !repeats_borders(whole, foreseen.vertex_subset, bound_before, early_bound);
+    const double early_check_seconds = seconds_since(t);
     std::vector<uint32_t> vertex_subset;
     if (round == 0 && first_round) {
       // Drawn during the setup (whose first_round repeats the checks above).
       vertex_subset = std::move(first_partition);
       rs.partition_seconds = first_partition_seconds;
       rs.partition_overlap_seconds = std::min(first_partition_seconds, initialize_seconds);
-    } else if (foreseen.drawn && foreseen.subsets == subsets) {
+    } else if (early_taken) {
+      // Drawn beside round 0's jobs: the critical path counts what of it outlasted the slowest
+      // of them, its check, and the previous round's records, appended now.
+      vertex_subset = std::move(foreseen.vertex_subset);
+      rs.partition_foreseen = true;
+      rs.partition_seconds = foreseen.partition_seconds + early_check_seconds;
+      rs.partition_overlap_seconds =
+          std::min(foreseen.partition_seconds, st.round_stats.back().slowest_subset_cpu_seconds);
+      const auto ta = std::chrono::steady_clock::now();
+      append_pending();
+      rs.append_seconds = seconds_since(ta);
+    } else if (foreseen.drawn && foreseen.beside_band && foreseen.subsets == subsets) {
       // Drawn beside the last band pass, the previous round's records appended beside it too:
       // the critical path counts what of them outlasted the band pass.
       vertex_subset = std::move(foreseen.vertex_subset);
@@ -436,6 +479,11 @@ ProgressiveMesh build_progressive_mesh_parallel(
       rs.partition_overlap_seconds =
           foreseen.partition_seconds + foreseen.append_seconds - (longest - foreseen.band_seconds);
     } else {
+      if (early_drawn)
+        spdlog::debug(
+            "parallel round {}: the partition drawn beside the last round's jobs keeps "
+            "its borders; drawn anew",
+            round);
       forgo_foreseen();
       PartitionOptions partition_options;
       partition_options.seed = round_seed(options.seed, round);
@@ -443,7 +491,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
           run_beside(parallel.threads,
                      [&] { vertex_subset = partition_live(whole, subsets, partition_options); },
                      {append_pending});
-      rs.partition_seconds = timed.work_seconds;
+      rs.partition_seconds = timed.work_seconds + early_check_seconds;
       rs.append_seconds = timed.side_seconds[0];
       rs.partition_overlap_seconds = std::min(timed.work_seconds, timed.side_seconds[0]);
       subsets_cpu += timed.side_cpu_elsewhere;
@@ -452,7 +500,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
     if (events.partitioned) events.partitioned(round, subsets, rs.faces_before);
     // The partition's border (sequential, O(faces), counted with the partition).
     t = std::chrono::steady_clock::now();
-    std::vector<uint8_t> bound = bound_vertices(whole, vertex_subset);
+    std::vector<uint8_t> bound =
+        early_bound.empty() ? bound_vertices(whole, vertex_subset) : std::move(early_bound);
+    early_bound.clear();
     rs.border_faces = border_faces(whole, bound);
     rs.partition_seconds += seconds_since(t);
     if (scheduled && parallel.border_excess > 0) {
@@ -530,10 +580,32 @@ ProgressiveMesh build_progressive_mesh_parallel(
     rs.extract_seconds = seconds_since(t);
     rs.extract_critical_seconds = sequential_extract + rs.slowest_extract_cpu_seconds;
 
+    // Round 1's partition, drawn beside round 0's jobs on the mesh as round 0 found it (the
+    // master only waits for them, and `whole` changes only at their merge): round 0 has no
+    // band pass to draw it beside, and drawn after the merge it was all on the critical path
+    // (0.12-0.13 s on the 871k dragon at p = 8 and 16). Its subsets, balanced for round 0's
+    // faces, hold round 1's unevenly (round 0's jobs stop at its water level): on the 871k,
+    // the largest 4% / 7% / 9% above the mean at p = 4 / 8 / 16.
+    std::vector<SubsetResult> results;
+    auto draw_round_one = [&] {
+      PartitionOptions next_options;
+      next_options.seed = round_seed(options.seed, 1);
+      foreseen.vertex_subset = partition_live(whole, subsets, next_options);
+    };
     t = std::chrono::steady_clock::now();
-    std::vector<SubsetResult> results = runner->run(jobs, cancel);
+    const bool draw_early = round == 0 && parallel.early_partition;
+    const Beside timed_jobs = run_beside(
+        parallel.threads, [&] { results = runner->run(jobs, cancel); },
+        draw_early ? std::vector<std::function<void()>>{draw_round_one}
+                   : std::vector<std::function<void()>>{});
     jobs.clear();
-    rs.subsets_seconds = seconds_since(t);
+    rs.subsets_seconds = timed_jobs.work_seconds;
+    if (draw_early) {
+      foreseen.drawn = true;
+      foreseen.subsets = subsets;
+      foreseen.partition_seconds = timed_jobs.side_seconds[0];
+      subsets_cpu += timed_jobs.side_cpu_elsewhere;
+    }
     if (cancel) cancel->check();
     if (results.size() != subsets)
       throw Error(ErrorCode::kInternal, "the subset runner returned " +

@@ -37,7 +37,7 @@ std::vector<uint32_t> spread_seeds(const VertexGraph& graph, uint32_t count, uin
       }
     }
   };
-  add_seed(first_start_vertex(graph, by_degree, seed));
+  add_seed(first_start_vertex(graph, by_degree, seed, 1));
   while (seeds.size() < count) {
     uint32_t best = kNoId;
     for (int pass = 0; pass < 2 && best == kNoId; ++pass) {

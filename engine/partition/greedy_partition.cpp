@@ -159,7 +159,7 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
     // updated degree (ties to the smallest id), so that subsets follow each other.
     uint32_t start = kNoId;
     if (first) {
-      start = first_start_vertex(graph, by_degree, seed);
+      start = first_start_vertex(graph, by_degree, seed, kStartCandidates);
       first = false;
     } else {
       for (uint32_t v : previous_members) {

@@ -127,10 +127,17 @@ std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph) {
 }
 
 uint32_t first_start_vertex(const VertexGraph& graph, const std::vector<uint32_t>& by_degree,
-                            uint64_t seed) {
+                            uint64_t seed, size_t candidates) {
   const uint32_t min_degree = graph.degree(by_degree.front());
   size_t count = 0;
   while (count < by_degree.size() && graph.degree(by_degree[count]) == min_degree) ++count;
+  // Where few vertices have the least degree (a CAD part's corners, a scan's odd vertices: the
+  // bunny, fandisk, gears), most seeds would start at the same one and draw the same partition:
+  // the next degrees join them, a degree at a time, until there are `candidates`.
+  while (count < candidates && count < by_degree.size() && graph.degree(by_degree[count]) > 0) {
+    const uint32_t next_degree = graph.degree(by_degree[count]);
+    while (count < by_degree.size() && graph.degree(by_degree[count]) == next_degree) ++count;
+  }
   return by_degree[seed % count];
 }
 

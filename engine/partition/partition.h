@@ -36,7 +36,9 @@ struct PartitionOptions {
   // positive finite values. Only ratios matter.
   std::vector<double> weights;
   // Picks the start vertex among the vertices of minimal degree: the (seed mod count)-th of
-  // them in id order. Different seeds give different, equally valid partitions.
+  // them in id order (for the greedy algorithm, where fewer than 16 have the minimal degree,
+  // the vertices of the next degrees join them, after them). Different seeds give different,
+  // equally valid partitions.
   uint64_t seed = 1;
   Balance balance = Balance::kFaces;
   // After the algorithm: move boundary vertices and stray components to cut fewer edges,

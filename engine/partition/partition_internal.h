@@ -82,9 +82,13 @@ class BucketQueue {
 std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph);
 
 // The start vertex of the first subset: among the vertices of minimal (non-zero) degree, the
-// (seed mod count)-th in id order.
+// (seed mod count)-th in id order; where fewer than `candidates` have it, the vertices of the
+// next degrees join them, a whole degree at a time, until there are that many (by degree, then
+// id). The greedy algorithm asks for kStartCandidates, the BFS baseline for 1 (its quarters of
+// a grid start at its corners).
+inline constexpr size_t kStartCandidates = 16;
 uint32_t first_start_vertex(const VertexGraph& graph, const std::vector<uint32_t>& by_degree,
-                            uint64_t seed);
+                            uint64_t seed, size_t candidates);
 
 // Fills partition.face_subset from partition.vertex_subset (the rule in partition.h).
 void assign_faces(const Mesh& mesh, Partition& partition);

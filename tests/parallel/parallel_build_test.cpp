@@ -268,13 +268,16 @@ TEST(ParallelBuild, SameBytesWhateverTheThreadCount) {
   }
 }
 
-// After a band pass, the next round's partition is drawn beside it, on a copy of the mesh as
-// it was before the band pass; the round after it takes it when it has as many subsets as
-// foreseen. On two threads (the band pass and the partition really side by side) the PM is
-// the one-thread PM (SameBytesWhateverTheThreadCount) and lossless.
-TEST(ParallelBuild, TheNextPartitionIsDrawnBesideTheBandPass) {
+// Partitions are drawn ahead: round 1's beside round 0's jobs (on the mesh as round 0 found
+// it), every later one beside the band pass before it (on a copy of the mesh as it was before
+// the band pass); a round takes it when it has as many subsets as foreseen. On two threads
+// (really side by side) the PM is the one-thread PM and lossless. Without early_partition,
+// round 1's is drawn after the merge, on the mesh round 0 left: another PM. One that would keep
+// round 0's borders is drawn anew.
+TEST(ParallelBuild, PartitionsAreDrawnAhead) {
   const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
   const SimplifyOptions options = metric_options("energy", 0.01);
+  std::string one_thread;
   for (unsigned threads : {1u, 2u}) {
     ParallelStats stats;
     const ProgressiveMesh pm = build_progressive_mesh_parallel(
@@ -282,17 +285,43 @@ TEST(ParallelBuild, TheNextPartitionIsDrawnBesideTheBandPass) {
     size_t foreseen = 0, band_passes = 0;
     for (const RoundStats& r : stats.round_stats) {
       foreseen += r.partition_foreseen ? 1 : 0;
-      EXPECT_FALSE(r.partition_foreseen && r.round < 2) << "round " << r.round;
+      EXPECT_EQ(r.partition_foreseen, r.round >= 1) << "round " << r.round;
       EXPECT_GE(r.partition_overlap_seconds, 0) << "round " << r.round;
+      EXPECT_LE(r.partition_overlap_seconds, r.partition_seconds + r.append_seconds)
+          << "round " << r.round;
       band_passes += r.round >= 1 ? 1 : 0;
     }
     ASSERT_GE(band_passes, 2u) << "threads " << threads;
-    EXPECT_GE(foreseen, band_passes - 1) << "threads " << threads;
-    std::istringstream in(testing::pm_bytes(pm));
+    EXPECT_GE(foreseen, band_passes) << "threads " << threads;
+    const std::string bytes = testing::pm_bytes(pm);
+    if (threads == 1) one_thread = bytes;
+    EXPECT_TRUE(bytes == one_thread) << "threads " << threads;
+    std::istringstream in(bytes);
     const MeshDifference diff = compare_meshes_exact(restore_input(read_pm(in, "foreseen")),
                                                      repaired_input(repaired), false);
     EXPECT_TRUE(diff.equal) << diff.first_difference;
   }
+  ParallelOptions late = with_p(4, 2, /*rounds=*/0);
+  late.early_partition = false;
+  ParallelStats stats;
+  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, late, &stats);
+  ASSERT_GE(stats.round_stats.size(), 2u);
+  EXPECT_FALSE(stats.round_stats[1].partition_foreseen);
+  EXPECT_FALSE(testing::pm_bytes(pm) == one_thread);
+
+  // The stratocaster's round 1 partition drawn beside round 0's jobs is round 0's again (the
+  // same mesh, the same start vertex): refused, drawn anew after the merge, round 0's records
+  // still in the PM.
+  const RepairedMesh guitar = testing::repaired_test_mesh("stratocaster-9k.ply");
+  ParallelStats guitar_stats;
+  const ProgressiveMesh redrawn =
+      build_progressive_mesh_parallel(guitar, options, with_p(4, 2, /*rounds=*/0), &guitar_stats);
+  ASSERT_GE(guitar_stats.round_stats.size(), 2u);
+  EXPECT_FALSE(guitar_stats.round_stats[1].partition_foreseen);
+  std::istringstream again(testing::pm_bytes(redrawn));
+  const MeshDifference guitar_diff =
+      compare_meshes_exact(restore_input(read_pm(again, "redrawn")), repaired_input(guitar), false);
+  EXPECT_TRUE(guitar_diff.equal) << guitar_diff.first_difference;
 }
 
 // With one subset nothing is a border: the job is the whole mesh and runs the sequential

@@ -2,10 +2,12 @@
 // checks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
+#include "drawn_meshes.h"
 #include "mesh/mesh.h"
 #include "partition/partition.h"
 #include "partition/partition_metrics.h"
@@ -227,6 +229,22 @@ TEST(GreedyPartition, ByFacesEverySubsetGetsAVertexWhenSharesAreTiny) {
     for (uint32_t s : partition.vertex_subset) ++vertices[s];
     for (uint32_t k = 0; k < p; ++k) EXPECT_GE(vertices[k], 1u) << "p = " << p << ", subset " << k;
   }
+}
+
+// The greedy partitioner starts at the seed's pick among the vertices of least degree; where
+// fewer than 16 have it, the next degrees join them. A UV sphere's two poles alone have the
+// least degree (4): with them only, every seed drew one of two partitions, and the parallel
+// build's round 1, drawn on round 0's mesh with another seed, could draw round 0's again.
+TEST(GreedyPartition, FewVerticesOfLeastDegreeStillLetSeedsStartElsewhere) {
+  const Mesh sphere = testing::uv_sphere(12, 4);
+  std::vector<Subsets> drawn;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    PartitionOptions by_faces;
+    by_faces.seed = seed;
+    const Subsets subsets = partition_mesh(sphere, 4, by_faces).vertex_subset;
+    if (std::find(drawn.begin(), drawn.end(), subsets) == drawn.end()) drawn.push_back(subsets);
+  }
+  EXPECT_GE(drawn.size(), 4u);
 }
 
 TEST(PartitionMesh, GridQuartersAreConnectedAndDeterministic) {
