@@ -116,7 +116,9 @@ void add_partition_command(CLI::App& app, int& exit_code) {
                   "What the subset sizes count: faces (each vertex weighs its faces) or vertices")
       ->check(CLI::IsMember({"faces", "vertices"}))
       ->capture_default_str();
-  cmd->add_option("--seed", args->seed, "Chooses among equally good start vertices")
+  cmd->add_option("--seed", args->seed,
+                  "Picks the start vertex among those of least degree (greedy: at least 16, "
+                  "the next degrees joining the least)")
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
                   "Write the mesh with one vertex colour per subset (.ply or .obj)");
