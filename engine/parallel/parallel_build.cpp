@@ -120,7 +120,7 @@ Beside run_beside(unsigned threads, const std::function<void()>& work,
 // least degree: two seeds can pick the same one and draw the same partition of the same mesh
 // (the stratocaster, gears-19k at p = 4; the bunny and fandisk too before kStartCandidates),
 // and a round on it would leave the last round's borders as they were (fandisk's 50% level went
-// from 1.14 to 1.62 of the sequential RMS at p = 8). Different partitions bind 1-13% again.
+// to 1.62 of the sequential RMS at p = 8, from 1.19). Different partitions bind 1-13% again.
 // `bound`: the partition's bound vertices, found here.
 bool repeats_borders(const CollapseMesh& mesh, const std::vector<uint32_t>& vertex_subset,
                      const std::vector<uint8_t>& bound_before, std::vector<uint8_t>& bound) {
