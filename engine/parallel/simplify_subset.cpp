@@ -46,12 +46,7 @@ std::vector<EdgeKey> current_keys_in_global_ids(const KeyMemo& memo, const Colla
 
 SimplifyOptions simplify_options_of(const SubsetOptions& subset) {
   SimplifyOptions options;
-  options.metric = subset.metric;
-  options.samples_per_face = subset.samples_per_face;
-  options.crease_angle_degrees = subset.crease_angle_degrees;
-  options.attribute_weight = subset.attribute_weight;
-  options.energy = subset.energy;
-  options.seed = subset.seed;
+  copy_metric_options(subset, options);
   check_simplify_options(options);
   return options;
 }

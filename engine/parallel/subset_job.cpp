@@ -183,12 +183,7 @@ void validate_subset_job(const SubsetJob& job) {
 
 SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh) {
   SubsetOptions s;
-  s.metric = options.metric;
-  s.samples_per_face = options.samples_per_face;
-  s.crease_angle_degrees = options.crease_angle_degrees;
-  s.attribute_weight = options.attribute_weight;
-  s.energy = options.energy;
-  s.seed = options.seed;
+  copy_metric_options(options, s);
   s.reference_diagonal = bounding_box(mesh).diagonal();
   return s;
 }

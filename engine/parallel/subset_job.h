@@ -52,6 +52,18 @@ struct SubsetOptions {
   bool defer_recosting = false;
 };
 
+// The options a job's metric is made from, named alike in SimplifyOptions and SubsetOptions:
+// one list, for both directions (subset_options_of, simplify_options_of).
+template <typename To, typename From>
+void copy_metric_options(const From& from, To& to) {
+  to.metric = from.metric;
+  to.samples_per_face = from.samples_per_face;
+  to.crease_angle_degrees = from.crease_angle_degrees;
+  to.attribute_weight = from.attribute_weight;
+  to.energy = from.energy;
+  to.seed = from.seed;
+}
+
 // The subset options a simplification with `options` gives its jobs, measured against the
 // whole `mesh` (its bounding-box diagonal); target_faces and max_cost are left to the caller.
 SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh);
