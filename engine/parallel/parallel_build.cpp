@@ -594,10 +594,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
     };
     t = std::chrono::steady_clock::now();
     const bool draw_early = round == 0 && parallel.early_partition;
+    std::vector<std::function<void()>> beside_jobs;
+    if (draw_early) beside_jobs.push_back(draw_round_one);
     const Beside timed_jobs = run_beside(
-        parallel.threads, [&] { results = runner->run(jobs, cancel); },
-        draw_early ? std::vector<std::function<void()>>{draw_round_one}
-                   : std::vector<std::function<void()>>{});
+        parallel.threads, [&] { results = runner->run(jobs, cancel); }, beside_jobs);
     jobs.clear();
     rs.subsets_seconds = timed_jobs.work_seconds;
     if (draw_early) {
