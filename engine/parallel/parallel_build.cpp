@@ -7,6 +7,7 @@
 #include <functional>
 #include <future>
 #include <limits>
+#include <memory>
 
 #include <spdlog/spdlog.h>
 
@@ -322,6 +323,18 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // The master's queue keys: the water level's sample, the jobs' keys after a round,
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
   KeyMemo keys(*master, whole.vertex_capacity());
+  // The whole mesh's connected components, found once, at the first band pass or the final
+  // pass, for the size rule of each one after it (standard_constraints: collapses neither merge
+  // nor split components).
+  std::shared_ptr<const std::vector<uint32_t>> components;
+  auto whole_components = [&] {
+    if (!components) {
+      auto found = std::make_shared<std::vector<uint32_t>>();
+      connected_components(whole, *found);
+      components = std::move(found);
+    }
+    return components;
+  };
   // Keys are worth carrying only where a costing costs more than remembering it (costly()).
   const bool carry_keys = parallel.carry_keys && master->costly();
   // The setup's own time: the first partition is round 0's (which the critical path counts
@@ -695,7 +708,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
         if (bound_before[v]) lagging.push_back(VertexId(v));
       }
       BandPriority band(keys, std::move(bound_before), ceiling);
-      Simplifier pass(whole, band, standard_constraints(locked));
+      Simplifier pass(whole, band, standard_constraints(locked, whole_components()));
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
       band_limits.first_queue_around = &lagging;  // the band refuses every other edge
@@ -769,7 +782,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   keys.reset(carried);
   const uint64_t reused_before = keys.reused();
   std::unique_ptr<PriorityModule> continued = without_initialize(keys);
-  Simplifier final_pass(whole, *continued, standard_constraints(locked));
+  Simplifier final_pass(whole, *continued, standard_constraints(locked, whole_components()));
   SimplifierLimits limits;
   limits.target_faces = target;
   if (options.defer_recosting) limits.defer_above_faces = defer_line;

@@ -6,6 +6,7 @@
 
 #include "simplify/face_fold.h"
 #include "simplify/modules.h"
+#include "util/error.h"
 
 namespace parapm {
 namespace {
@@ -29,14 +30,30 @@ class LockedVertices : public ConstraintModule {
 // under legal collapses, so the counts only go down by one per collapse.
 class ComponentMinimum : public ConstraintModule {
  public:
+  explicit ComponentMinimum(std::shared_ptr<const std::vector<uint32_t>> components)
+      : given_(std::move(components)) {}
   std::string name() const override { return "component-minimum"; }
   bool topological() const override { return true; }
   void initialize(const CollapseMesh& mesh) override {
-    const uint32_t components = connected_components(mesh, component_);
+    uint32_t components = 0;
+    if (given_) {
+      if (given_->size() != mesh.vertex_capacity())
+        throw_internal("component-minimum: the given components are of another mesh");
+      component_ = given_->data();
+      for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
+        if (!mesh.vertex_alive(v)) continue;
+        if (component_[v] == kNoId)
+          throw_internal("component-minimum: a live vertex has no given component");
+        components = std::max(components, component_[v] + 1);
+      }
+    } else {
+      components = connected_components(mesh, found_);
+      component_ = found_.data();
+    }
     count_.assign(components, 0);
     closed_.assign(components, 1);
     for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
-      if (component_[v] == kNoId) continue;
+      if (!mesh.vertex_alive(v)) continue;
       ++count_[component_[v]];
       if (mesh.is_boundary(v)) closed_[component_[v]] = 0;
     }
@@ -50,7 +67,9 @@ class ComponentMinimum : public ConstraintModule {
   }
 
  private:
-  std::vector<uint32_t> component_;
+  std::shared_ptr<const std::vector<uint32_t>> given_;
+  std::vector<uint32_t> found_;
+  const uint32_t* component_ = nullptr;  // per vertex: given_'s or found_'s
   std::vector<uint32_t> count_;
   std::vector<uint8_t> closed_;
 };
@@ -107,10 +126,10 @@ class FaceGeometry : public ConstraintModule {
 }  // namespace
 
 std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
-    const std::vector<uint8_t>& locked) {
+    const std::vector<uint8_t>& locked, std::shared_ptr<const std::vector<uint32_t>> components) {
   std::vector<std::unique_ptr<ConstraintModule>> modules;
   modules.push_back(std::make_unique<LockedVertices>(locked));
-  modules.push_back(std::make_unique<ComponentMinimum>());
+  modules.push_back(std::make_unique<ComponentMinimum>(std::move(components)));
   modules.push_back(std::make_unique<BoundaryRule>());
   modules.push_back(std::make_unique<LinkCondition>());
   modules.push_back(std::make_unique<FaceGeometry>());

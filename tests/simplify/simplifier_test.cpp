@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "drawn_meshes.h"
 #include "io/mesh_io.h"
@@ -343,6 +344,44 @@ TEST(Simplifier, AFirstQueueAroundTheBandGivesTheSameRun) {
               listed.size(), (unsigned long long)all_evaluations,
               (unsigned long long)band_evaluations);
   EXPECT_LT(band_evaluations * 4, all_evaluations);
+}
+
+// The size rule with the components found once, before some collapses (as the parallel build's
+// band passes and final pass take them), decides as it does finding them anew: a second run,
+// down to where the rule stops every component, performs the same collapses either way.
+TEST(Simplifier, ComponentsFoundBeforeCollapsesDecideAsFoundAnew) {
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("stratocaster-9k.ply")));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh before(repaired.mesh);
+  auto found = std::make_shared<std::vector<uint32_t>>();
+  const uint32_t components = connected_components(before, *found);
+  ASSERT_GE(components, 3u) << "a mesh of one piece would not test the rule";
+  auto run = [&](std::shared_ptr<const std::vector<uint32_t>> given) {
+    CollapseMesh cm(repaired.mesh);
+    QuadricPriority priority(locked, QuadricOptions{});
+    Simplifier first(cm, priority, standard_constraints(locked, given));
+    first.run({cm.live_faces() / 2}, {}, nullptr);
+    Simplifier second(cm, priority, standard_constraints(locked, given));
+    std::vector<CollapseRecord> records = second.run({0}, {}, nullptr);
+    return std::make_pair(std::move(records), cm.live_faces());
+  };
+  const auto [anew, anew_faces] = run(nullptr);
+  const auto [given, given_faces] = run(found);
+  EXPECT_GT(anew.size(), 100u);
+  EXPECT_EQ(given_faces, anew_faces);
+  ASSERT_EQ(given.size(), anew.size());
+  for (size_t i = 0; i < anew.size(); ++i)
+    ASSERT_TRUE(given[i].vs == anew[i].vs && given[i].vt == anew[i].vt &&
+                given[i].position == anew[i].position)
+        << "collapse " << i << " differs";
+  std::printf("%u components; the second run: %zu collapses down to %zu faces\n", components,
+              anew.size(), anew_faces);
+  // Components of another mesh are refused, not read out of range.
+  CollapseMesh cm(repaired.mesh);
+  QuadricPriority priority(locked, QuadricOptions{});
+  auto other = std::make_shared<std::vector<uint32_t>>(found->size() / 2, 0u);
+  Simplifier wrong(cm, priority, standard_constraints(locked, other));
+  EXPECT_THROW(wrong.run({0}, {}, nullptr), Error);
 }
 
 }  // namespace
