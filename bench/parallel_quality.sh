@@ -8,18 +8,22 @@
 # prints one TSV row per mesh and p: metro's RMS and Hausdorff of the parallel level over the
 # sequential level of the same face count at 50%, 10% and 2% of the input faces (1.000: as
 # good), the rounds performed, the parallel build's seconds and its work (CPU over the sequential
-# build's seconds). A summary per p follows on
+# build's seconds: the median over WORK_REPEATS pairs, default 3, of a parallel build and a
+# sequential build timed one after the other, so that both see the machine of the same minute;
+# a sequential time kept from another run made the small meshes' work swing by 30%, their
+# builds lasting a fifth of a second). A summary per p follows on
 # stderr and in BENCH_OUT/LABEL.summary: geometric means over the meshes, cells above 1.05
 # (RMS) and 1.10 (Hausdorff), the worst cell.
 # Timing is not the point here (see bench/parallel.sh): meshes run JOBS at a time (default 2).
 # Environment: METRIC, PS, RATIO (default 0.01), PAR_ARGS, LABEL (default "default"), JOBS,
+# WORK_REPEATS (default 3),
 # BENCH_OUT (default ./bench-out-quality), PARAPM_BUILD_DIR (default build/), METRO (default
 # $PEERS_BUILD/metro, PEERS_BUILD defaulting to ./.peers-build).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 [[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
 export METRIC="${METRIC:-energy}" PS="${PS:-2 4 8 16}" RATIO="${RATIO:-0.01}"
-export PAR_ARGS="${PAR_ARGS:-}" LABEL="${LABEL:-default}"
+export PAR_ARGS="${PAR_ARGS:-}" LABEL="${LABEL:-default}" WORK_REPEATS="${WORK_REPEATS:-3}"
 export OUT="${BENCH_OUT:-$PWD/bench-out-quality}"
 export BIN="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
 export METRO="${METRO:-${PEERS_BUILD:-$PWD/.peers-build}/metro}"
@@ -58,11 +62,25 @@ one_mesh() {
     pj="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$METRIC" --ratio "$RATIO" \
       --parallel "$p" --threads 1 $PAR_ARGS --json)"
     local row
-    # work: the parallel build's CPU (jobs, merges, passes) over the sequential build's seconds
+    # work: the parallel build's CPU (jobs, merges, passes) over the sequential build's seconds,
+    # each pair timed together; the median of the pairs' ratios
+    local ratios="" r par_cpu seq_s
+    par_cpu="$(jq .parallel.cpu_seconds <<< "$pj")"
+    for ((r = 0; r < WORK_REPEATS; r++)); do
+      if ((r > 0)); then
+        # shellcheck disable=SC2086
+        par_cpu="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm.time" --metric "$METRIC" \
+          --ratio "$RATIO" --parallel "$p" --threads 1 $PAR_ARGS --json | jq .parallel.cpu_seconds)"
+      fi
+      seq_s="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm.time" --metric "$METRIC" \
+        --ratio "$RATIO" --json | jq .seconds)"
+      ratios+="$(jq -n --argjson a "$par_cpu" --argjson b "$seq_s" '$a / $b') "
+    done
+    rm -f "$par_pm.time"
     row="$(printf '%s\t%s\t%s\t%s\t%.2f\t%.2f' "$name" "$LABEL" "$p" \
       "$(jq -r .parallel.rounds <<< "$pj")" "$(jq -r .seconds <<< "$pj")" \
-      "$(jq -n --argjson a "$(jq .parallel.cpu_seconds <<< "$pj")" \
-        --argjson b "$(jq .seconds "$seq_json")" '$a / $b')")"
+      "$(tr ' ' '\n' <<< "$ratios" | grep -v '^$' | sort -g | \
+        awk '{a[NR] = $1} END {print (NR % 2 ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2)}')")"
     for level in 50 10 2; do
       n=$(( in_faces * level / 100 ))
       local prms phd srms shd
