@@ -35,27 +35,27 @@ class ComponentMinimum : public ConstraintModule {
   std::string name() const override { return "component-minimum"; }
   bool topological() const override { return true; }
   void initialize(const CollapseMesh& mesh) override {
-    uint32_t components = 0;
     if (given_) {
       if (given_->size() != mesh.vertex_capacity())
         throw_internal("component-minimum: the given components are of another mesh");
       component_ = given_->data();
-      for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
-        if (!mesh.vertex_alive(v)) continue;
-        if (component_[v] == kNoId)
-          throw_internal("component-minimum: a live vertex has no given component");
-        components = std::max(components, component_[v] + 1);
-      }
     } else {
-      components = connected_components(mesh, found_);
+      connected_components(mesh, found_);
       component_ = found_.data();
     }
-    count_.assign(components, 0);
-    closed_.assign(components, 1);
+    // One pass over the live vertices, the counts growing to the largest component seen.
+    count_.clear();
+    closed_.clear();
     for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
       if (!mesh.vertex_alive(v)) continue;
-      ++count_[component_[v]];
-      if (mesh.is_boundary(v)) closed_[component_[v]] = 0;
+      const uint32_t c = component_[v];
+      if (c == kNoId) throw_internal("component-minimum: a live vertex has no component");
+      if (c >= count_.size()) {
+        count_.resize(size_t(c) + 1, 0);
+        closed_.resize(size_t(c) + 1, 1);
+      }
+      ++count_[c];
+      if (mesh.is_boundary(v)) closed_[c] = 0;
     }
   }
   bool allows(const CollapseMesh&, const CollapseCandidate& c, const EdgeFaces&) const override {
