@@ -30,6 +30,9 @@ export METRO="${METRO:-${PEERS_BUILD:-$PWD/.peers-build}/metro}"
 [[ -x "$BIN" ]] || { echo "no $BIN (build the parapm target)" >&2; exit 2; }
 [[ -x "$METRO" ]] || { echo "no metro (set METRO, or build ../shared/tools)" >&2; exit 2; }
 mkdir -p "$OUT"
+# shellcheck source=bench/common.sh
+source "$root/bench/common.sh"
+export -f median
 
 one_mesh() {
   set -euo pipefail
@@ -79,8 +82,7 @@ one_mesh() {
     rm -f "$par_pm.time"
     row="$(printf '%s\t%s\t%s\t%s\t%.2f\t%.2f' "$name" "$LABEL" "$p" \
       "$(jq -r .parallel.rounds <<< "$pj")" "$(jq -r .seconds <<< "$pj")" \
-      "$(tr ' ' '\n' <<< "$ratios" | grep -v '^$' | sort -g | \
-        awk '{a[NR] = $1} END {print (NR % 2 ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2)}')")"
+      "$(median <<< "$ratios")")"
     for level in 50 10 2; do
       n=$(( in_faces * level / 100 ))
       local prms phd srms shd

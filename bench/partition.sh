@@ -59,7 +59,8 @@ elif command -v jq > /dev/null; then
 else
   jget() { sed -nE "s/.*\"$2\":(\"?)([^,\"}]*)\1.*/\2/p" <<< "$1"; }
   jlist() { sed -nE "s/.*\"$2\":\[([^]]*)\].*/\1/p" <<< "$1" | tr ',' '\n'; }
-  median() { sort -g | awk '{a[NR]=$1} END{if(NR%2)printf "%.6f\n",a[(NR+1)/2]; else printf "%.6f\n",(a[NR/2]+a[NR/2+1])/2}'; }
+  # shellcheck source=bench/common.sh
+  source "$root/bench/common.sh"
   summarize() {
     local lines last
     lines="$(cat)"; last="$(tail -n 1 <<< "$lines")"

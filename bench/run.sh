@@ -35,7 +35,8 @@ if [[ ! -x "$peers_build/metro" ]]; then
 fi
 mkdir -p "$out"
 jget() { sed -nE "s/.*\"$2\":(\"?)([^,\"}]*)\1.*/\2/p" <<< "$1"; }
-median() { tr ' ' '\n' | grep -v '^$' | sort -g | awk '{a[NR]=$1} END{if(NR%2)print a[(NR+1)/2]; else printf "%.6f\n",(a[NR/2]+a[NR/2+1])/2}'; }
+# shellcheck source=bench/common.sh
+source "$root/bench/common.sh"
 
 quality="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm-triangle-quality"
 [[ -x "$quality" ]] || { echo "no $quality (build the parapm-triangle-quality target)" >&2; exit 2; }
