@@ -157,10 +157,11 @@ TEST_F(ServiceFaults, SigtermMidJobRerunsAtTheNextStart) {
 TEST_F(ServiceFaults, CancelStopsTheJobAndTheWorkers) {
   start(2, {"--heartbeat-ms", "200"});
   const fs::path file = mesh("cad-cycloidal-43k.ply");
-  // Heavy subsets (energy, 4 extra points per face, one round: over a second each).
+  // Heavy subsets (energy, 32 extra points per face, one round: 0.7-1.0 s each in-process;
+  // with 4 they took 0.3-0.4 s, and one ended at the round's water level before the cancel).
   parapm::v1::JobOptions o = options(4, parapm::v1::METRIC_ENERGY, 0);
   o.set_rounds(1);
-  o.set_samples_per_face(4);
+  o.set_samples_per_face(32);
   const auto upload = service().upload_file(file);
   const auto submitted = service().submit(upload.mesh_id(), o);
   size_t started = 0;
