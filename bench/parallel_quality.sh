@@ -8,12 +8,14 @@
 # prints one TSV row per mesh and p: metro's RMS and Hausdorff of the parallel level over the
 # sequential level of the same face count at 50%, 10% and 2% of the input faces (1.000: as
 # good), the rounds performed, the parallel build's seconds and its work (CPU over the sequential
-# build's seconds: the median over WORK_REPEATS pairs, default 3, of a parallel build and a
+# build's CPU: the median over WORK_REPEATS pairs, default 3, of a parallel build and a
 # sequential build timed one after the other, so that both see the machine of the same minute;
 # a sequential time kept from another run made the small meshes' work swing by 30%, their
-# builds lasting a fifth of a second). A summary per p follows on
-# stderr and in BENCH_OUT/LABEL.summary: geometric means over the meshes, cells above 1.05
-# (RMS) and 1.10 (Hausdorff), the worst cell.
+# builds lasting a fifth of a second), and its costings (the edges all its modules costed over
+# the sequential build's: the same work without the machine's noise, which still moves a
+# small mesh's pairs by 10-30% from one run to the next). A summary per p follows on
+# stderr and in BENCH_OUT/LABEL.summary: geometric means over the meshes, cells above 1.15
+# (costings), 1.05 (RMS) and 1.10 (Hausdorff), the worst cell.
 # Timing is not the point here (see bench/parallel.sh): meshes run JOBS at a time (default 2).
 # Environment: METRIC, PS, RATIO (default 0.01), PAR_ARGS, LABEL (default "default"), JOBS,
 # WORK_REPEATS (default 3),
@@ -65,9 +67,10 @@ one_mesh() {
     pj="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$METRIC" --ratio "$RATIO" \
       --parallel "$p" --threads 1 $PAR_ARGS --json)"
     local row
-    # work: the parallel build's CPU (jobs, merges, passes) over the sequential build's seconds,
-    # each pair timed together; the median of the pairs' ratios
-    local ratios="" r par_cpu seq_s
+    # work: the parallel build's CPU (jobs, merges, passes) over the sequential build's CPU
+    # (not its wall time, which counts waits for a busy machine), each pair timed together;
+    # the median of the pairs' ratios
+    local ratios="" r par_cpu seq_s seq_json_now seq_costings=""
     par_cpu="$(jq .parallel.cpu_seconds <<< "$pj")"
     for ((r = 0; r < WORK_REPEATS; r++)); do
       if ((r > 0)); then
@@ -75,14 +78,20 @@ one_mesh() {
         par_cpu="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm.time" --metric "$METRIC" \
           --ratio "$RATIO" --parallel "$p" --threads 1 $PAR_ARGS --json | jq .parallel.cpu_seconds)"
       fi
-      seq_s="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm.time" --metric "$METRIC" \
-        --ratio "$RATIO" --json | jq .seconds)"
+      seq_json_now="$("$BIN" --log-level warn simplify "$mesh" -o "$par_pm.time" \
+        --metric "$METRIC" --ratio "$RATIO" --json)"
+      seq_s="$(jq .cpu_seconds <<< "$seq_json_now")"
+      seq_costings="$(jq .costings <<< "$seq_json_now")"
       ratios+="$(jq -n --argjson a "$par_cpu" --argjson b "$seq_s" '$a / $b') "
     done
     rm -f "$par_pm.time"
-    row="$(printf '%s\t%s\t%s\t%s\t%.2f\t%.2f' "$name" "$LABEL" "$p" \
+    # costings: the edges the parallel build's modules costed over the sequential build's
+    # (deterministic: the work without the machine's noise)
+    row="$(printf '%s\t%s\t%s\t%s\t%.2f\t%.2f\t%.3f' "$name" "$LABEL" "$p" \
       "$(jq -r .parallel.rounds <<< "$pj")" "$(jq -r .seconds <<< "$pj")" \
-      "$(median <<< "$ratios")")"
+      "$(median <<< "$ratios")" \
+      "$(jq -n --argjson a "$(jq .parallel.costings <<< "$pj")" --argjson b "$seq_costings" \
+        '$a / $b')")"
     for level in 50 10 2; do
       n=$(( in_faces * level / 100 ))
       local prms phd srms shd
@@ -98,14 +107,16 @@ one_mesh() {
 export -f one_mesh
 
 tsv="$OUT/$LABEL.tsv"
-printf 'mesh\tlabel\tp\trounds\tseconds\twork\trms_50\thd_50\trms_10\thd_10\trms_2\thd_2\n' | tee "$tsv"
+printf 'mesh\tlabel\tp\trounds\tseconds\twork\tcostings\trms_50\thd_50\trms_10\thd_10\trms_2\thd_2\n' |
+  tee "$tsv"
 printf '%s\n' "$@" | xargs -P "${JOBS:-2}" -I{} bash -c 'one_mesh "$1"' _ {} | tee -a "$tsv"
 
 # Geometric means per p and level; cells above 1.05 (RMS) / 1.10 (Hausdorff); the worst.
 awk -F'\t' 'NR > 1 {
-    p = $3; n[p]++; lw[p] += log($6); sr[p] += $4
+    p = $3; n[p]++; lw[p] += log($6); lc[p] += log($7); sr[p] += $4
+    if ($7 > 1.15) cc[p]++
     for (k = 0; k < 3; k++) {
-      r = $(7 + 2 * k); h = $(8 + 2 * k)
+      r = $(8 + 2 * k); h = $(9 + 2 * k)
       lr[p, k] += log(r); lh[p, k] += log(h)
       if (r > 1.05) cr[p, k]++
       if (h > 1.10) ch[p, k]++
@@ -115,7 +126,8 @@ awk -F'\t' 'NR > 1 {
   END {
     split("50 10 2", lv, " ")
     for (p in n) {
-      line = sprintf("p = %s (%d meshes): rounds %.1f, work %.2f;", p, n[p], sr[p] / n[p], exp(lw[p] / n[p]))
+      line = sprintf("p = %s (%d meshes): rounds %.1f, work %.2f, costings %.3f (%d above 1.15);",
+        p, n[p], sr[p] / n[p], exp(lw[p] / n[p]), exp(lc[p] / n[p]), cc[p])
       for (k = 0; k < 3; k++)
         line = line sprintf("  %s%% RMS %.3f (%d above 1.05, worst %.3f %s), Hausdorff %.3f (%d above 1.1)",
           lv[k + 1], exp(lr[p, k] / n[p]), cr[p, k], wr[p, k], wm[p, k], exp(lh[p, k] / n[p]), ch[p, k])

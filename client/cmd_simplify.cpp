@@ -37,6 +37,7 @@ struct SimplifyArgs {
   uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
   uint64_t min_subset_faces = ParallelOptions{}.min_subset_faces;
   bool no_carry_keys = false;
+  bool no_carry_deferred = false;
   bool no_deferred_recosting = false;
   bool json = false;
 };
@@ -74,6 +75,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"slowest_subset_cpu_seconds", r.slowest_subset_cpu_seconds},
                       {"water_level", r.water_level},
                       {"keys_carried", r.keys_carried},
+                      {"deferred_carried", r.deferred_carried},
                       {"keys_reused", r.keys_reused},
                       {"band_pass_collapses", r.band_pass_collapses},
                       {"band_pass_seconds", r.band_pass_seconds},
@@ -89,6 +91,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
           {"final_append_seconds", stats.final_append_seconds},
           {"pm_build_seconds", stats.pm_build_seconds},
           {"cpu_seconds", stats.cpu_seconds},
+          {"costings", stats.costings},
           {"critical_path_seconds", stats.critical_path_seconds}};
 }
 
@@ -123,11 +126,14 @@ int run_simplify(const SimplifyArgs& args) {
     parallel.extra_round_subset_faces = args.extra_round_faces;
     parallel.min_subset_faces = args.min_subset_faces;
     parallel.carry_keys = !args.no_carry_keys;
+    parallel.carry_deferred = !args.no_carry_deferred;
     pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
                                          bar.callback(), nullptr);
     stats.collapses = parallel_stats.collapses;
     stats.stop_reason = parallel_stats.stop_reason;
     stats.seconds = parallel_stats.seconds;
+    stats.costings = parallel_stats.costings;
+    stats.cpu_seconds = parallel_stats.cpu_seconds;
   } else {
     pm = build_progressive_mesh(loaded.repaired, options, &stats, bar.callback(), nullptr);
   }
@@ -159,6 +165,8 @@ int run_simplify(const SimplifyArgs& args) {
                           {"write_seconds", write_seconds},
                           {"metric", pm.info.metric},
                           {"stop_reason", stats.stop_reason},
+                          {"costings", stats.costings},
+                          {"cpu_seconds", stats.cpu_seconds},
                           {"pm_bytes", pm_bytes},
                           {"binary_ply_bytes", ply_bytes},
                           {"peak_memory_bytes", peak},
@@ -312,17 +320,22 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_flag("--no-carry-keys", args->no_carry_keys,
                 "With --parallel: every round's jobs cost all their edges again instead of "
-                "starting from the queue keys the round before left (for measuring the work "
-                "they save; the PM differs a little, docs/BENCHMARKS.md)");
+                "starting from the queue keys (and deferred edges) the round before left (for "
+                "measuring the work they save; the PM differs a little, docs/BENCHMARKS.md)");
+  cmd->add_flag("--no-carry-deferred", args->no_carry_deferred,
+                "With --parallel: the edges a round's jobs left deferred are costed afresh by "
+                "the next round's jobs, not queued deferred again (for measuring the work it "
+                "saves; the PM differs a little, docs/BENCHMARKS.md)");
   cmd->add_flag("--no-deferred-recosting", args->no_deferred_recosting,
                 "Energy: cost the edges around each collapse at once, not when they reach the "
                 "top of the queue (for measuring the costings deferral saves; the PM differs a "
                 "little, docs/BENCHMARKS.md)");
   cmd->add_flag("--json", args->json,
-                "Print one JSON object on stdout (with --parallel, under \"parallel\": p, rounds "
-                "performed, per round the partition, extraction, subset (per subset wall and "
-                "CPU) and merge seconds, the queue keys carried and reused, the final pass, the "
-                "CPU in all and the critical path)");
+                "Print one JSON object on stdout: sizes, seconds, CPU seconds and costings (edges "
+                "the metric costed); with --parallel, under \"parallel\": p, rounds performed, "
+                "per round the partition, extraction, subset (per subset wall and CPU) and merge "
+                "seconds, the queue keys and deferred edges carried, the keys reused, the final "
+                "pass, the CPU and costings in all and the critical path");
   cmd->callback([args, &exit_code] { exit_code = run_simplify(*args); });
 }
 

@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 4;
+constexpr uint8_t kVersion = 5;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -49,10 +49,11 @@ constexpr uint8_t kResiduals = 1;
 
 // The fewest bytes an element can take, for ByteReader::check_fits: a count that cannot fit
 // in what remains is refused before anything is reserved.
-constexpr uint64_t kMinVertexBytes = 12 + 1 + 1;  // f32 position, flags, global id
-constexpr uint64_t kMinFaceBytes = 3 + 1;         // corners, global id
-constexpr uint64_t kMinWedgeBytes = 1 + 1;        // its vertex, global id
-constexpr uint64_t kMinKeyBytes = 1 + 1 + 8;      // a's gap, b's span, cost
+constexpr uint64_t kMinVertexBytes = 12 + 1 + 1;   // f32 position, flags, global id
+constexpr uint64_t kMinFaceBytes = 3 + 1;          // corners, global id
+constexpr uint64_t kMinWedgeBytes = 1 + 1;         // its vertex, global id
+constexpr uint64_t kMinKeyBytes = 1 + 1 + 8;       // a's gap, b's span, cost
+constexpr uint64_t kMinDeferredBytes = 1 + 1 + 4;  // a's gap, b's span, key
 // A record: flags, vs vt, vl fl vr fr, 9 f32, 6 corner wedges, cost, error, change count.
 constexpr uint64_t kMinRecordBytes = 1 + 2 + 4 + 36 + 6 + 8 + 4 + 1;
 constexpr uint64_t kMinSampleBytes = 1 + 24 + 8 + 1 + 1;  // id, position, distance, u, w
@@ -525,28 +526,33 @@ void check_job_state(ByteReader& in, const SubsetJob& job) {
 
 // ---- Queue keys ---------------------------------------------------------------------------
 
-// Sorted by (a, b), a < b: a as its gap from the previous key's a, b as b - a - 1.
-void write_keys(ByteWriter& out, const std::vector<EdgeKey>& keys) {
-  out.varint(keys.size());
+// Sorted by (a, b), a < b: a as its gap from the previous edge's a, b as b - a - 1, then the
+// edge's value (write_value). Queue keys (EdgeKey, cost f64) and deferred edges
+// (DeferredEdge, key f32) alike.
+template <typename Edge, typename WriteValue>
+void write_edges(ByteWriter& out, const std::vector<Edge>& edges, const char* what,
+                 WriteValue write_value) {
+  out.varint(edges.size());
   VertexId previous_a = 0;
-  for (size_t i = 0; i < keys.size(); ++i) {
-    const EdgeKey& k = keys[i];
+  for (size_t i = 0; i < edges.size(); ++i) {
+    const Edge& k = edges[i];
     if (k.a >= k.b || k.b == kNoId || k.a < previous_a ||
-        (i > 0 && k.a == previous_a && k.b <= keys[i - 1].b))
-      cannot_encode("queue keys not sorted by (a, b) with a < b");
+        (i > 0 && k.a == previous_a && k.b <= edges[i - 1].b))
+      cannot_encode(std::string(what) + " not sorted by (a, b) with a < b");
     out.varint(k.a - previous_a);
     out.varint(k.b - k.a - 1);
-    out.f64(k.cost);
+    write_value(k);
     previous_a = k.a;
   }
 }
 
-// Ids below `bound`. A cost may be NaN (the edge cannot be placed) or anything else: a key
-// only orders the queue, the edge is costed again before it is collapsed.
-void read_keys(ByteReader& in, uint64_t bound, std::vector<EdgeKey>& keys) {
-  in.set_context("queue keys");
-  const uint64_t n = read_count(in, kMinKeyBytes, "queue keys");
-  keys.resize(n);
+// Ids below `bound`; read_value(edge) reads the edge's value.
+template <typename Edge, typename ReadValue>
+void read_edges(ByteReader& in, uint64_t bound, uint64_t min_bytes, const char* what,
+                std::vector<Edge>& edges, ReadValue read_value) {
+  in.set_context(what);
+  const uint64_t n = read_count(in, min_bytes, what);
+  edges.resize(n);
   uint64_t previous_a = 0, previous_b = 0;
   for (uint64_t i = 0; i < n; ++i) {
     const uint64_t start = in.offset();
@@ -555,13 +561,37 @@ void read_keys(ByteReader& in, uint64_t bound, std::vector<EdgeKey>& keys) {
     const uint64_t a = gap < bound - previous_a ? previous_a + gap : bound;
     const uint64_t span = in.varint64();
     if (a + 1 >= bound || span >= bound - a - 1)
-      in.fail_at(start, "queue key " + std::to_string(i) + " out of range");
+      in.fail_at(start, std::string(what) + " " + std::to_string(i) + " out of range");
     const uint64_t b = a + 1 + span;
-    if (i > 0 && a == previous_a && b <= previous_b) in.fail_at(start, "queue keys not sorted");
-    keys[i] = {VertexId(a), VertexId(b), in.f64()};
+    if (i > 0 && a == previous_a && b <= previous_b)
+      in.fail_at(start, std::string(what) + " not sorted");
+    edges[i].a = VertexId(a);
+    edges[i].b = VertexId(b);
+    read_value(edges[i]);
     previous_a = a;
     previous_b = b;
   }
+}
+
+void write_keys(ByteWriter& out, const std::vector<EdgeKey>& keys) {
+  write_edges(out, keys, "queue keys", [&](const EdgeKey& k) { out.f64(k.cost); });
+}
+
+// A cost may be NaN (the edge cannot be placed) or anything else: a key only orders the
+// queue, the edge is costed again before it is collapsed.
+void read_keys(ByteReader& in, uint64_t bound, std::vector<EdgeKey>& keys) {
+  read_edges(in, bound, kMinKeyBytes, "queue keys", keys, [&](EdgeKey& k) { k.cost = in.f64(); });
+}
+
+void write_deferred(ByteWriter& out, const std::vector<DeferredEdge>& deferred) {
+  write_edges(out, deferred, "deferred edges", [&](const DeferredEdge& d) { out.f32(d.key); });
+}
+
+// Any key: it only places the edge in the queue, and a NaN one is no key (the edge is costed
+// at once).
+void read_deferred(ByteReader& in, uint64_t bound, std::vector<DeferredEdge>& deferred) {
+  read_edges(in, bound, kMinDeferredBytes, "deferred edges", deferred,
+             [&](DeferredEdge& d) { d.key = in.f32(); });
 }
 
 void write_job(ByteWriter& out, const SubsetJob& job) {
@@ -605,6 +635,7 @@ void write_job(ByteWriter& out, const SubsetJob& job) {
   out.varint(job.owned_faces);
   write_state(out, job.state);
   write_keys(out, job.keys);
+  write_deferred(out, job.deferred);
 }
 
 void read_job(ByteReader& in, SubsetJob& job) {
@@ -685,6 +716,7 @@ void read_job(ByteReader& in, SubsetJob& job) {
   in.set_context("state");
   check_job_state(in, job);
   read_keys(in, vertices, job.keys);
+  read_deferred(in, vertices, job.deferred);
   expect_end(in);
 }
 
@@ -740,7 +772,9 @@ void write_summary(ByteWriter& out, const SubsetResult& r) {
   out.varint(r.subset);
   write_state(out, r.state);
   write_keys(out, r.keys);
+  write_deferred(out, r.deferred);
   out.varint(r.keys_reused);
+  out.varint(r.costings);
   out.varint(r.faces);
   out.varint(r.owned_faces);
   out.varint(r.free_vertices);
@@ -759,8 +793,10 @@ void read_summary(ByteReader& in, SubsetResult& r) {
   r.subset = in.varint32();
   read_state(in, StateBounds{}, r.state);
   read_keys(in, kNoId, r.keys);
+  read_deferred(in, kNoId, r.deferred);
   in.set_context("counts");
   r.keys_reused = in.varint64();
+  r.costings = in.varint64();
   r.faces = in.varint64();
   r.owned_faces = in.varint64();
   r.free_vertices = in.varint64();

@@ -8,7 +8,8 @@
 // id then each gap minus one). Every message starts with a 4-byte magic naming its kind and a
 // version byte, so that one kind is never decoded as another.
 //
-//   (The version byte is 4 for every kind: 4 added the energy's tuning to the job's options.)
+//   (The version byte is 5 for every kind: 4 added the energy's tuning to the job's options,
+//   5 the deferred edges to the job and the summary, and the costings to the summary.)
 //   job     "PPJB" 4 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
 //           samples_per_face f64, crease_angle f64, attribute_weight f64, star_planes_weight
@@ -20,7 +21,7 @@
 //           vertex: position (3 f32 or 3 f64), owned | locked << 1 u8 | global_vertex ids+ |
 //           per face: 3 corners v | global_face ids+ | per wedge: wedge_vertex v, then all
 //           values f32, then (flag 16) per face 3 wedges v | global_wedge ids+ |
-//           owned_faces v | state | keys.
+//           owned_faces v | state | keys | deferred.
 //   state   metric u8, then the metric's part (the other part must be empty):
 //           quadric: n v, vertices ids+, n x 11 f64 (a00 a01 a02 a11 a12 a22 b0 b1 b2 c w).
 //           energy: faces n v + ids+, vertices n v + ids+, k u8 (floats per point and per
@@ -33,13 +34,16 @@
 //           k f32; its face or vertex is the one it is written under (export order).
 //   keys    n v, then per key (sorted by (a, b), a < b: edge_keys.h) a minus the previous
 //           key's a v, b - a - 1 v, cost f64 (NaN: the edge cannot be placed).
+//   deferred n v, then per edge (sorted by (a, b), a < b: simplifier.h, DeferredEdge) as a
+//           key, with its key f32 in place of the cost.
 //   records "PPCR" 4 | n v | k u8 (floats per changed wedge) | per record: flags u8 (1:
 //           positions as f32), vs v, vt v, vl fl vr fr id+1, vs_position vt_position position
 //           (3 f32 or 3 f64 each), corner_wedges 6 x id+1, cost f64, error f32, changed n v,
 //           n ids v, n x k f32.
-//   summary "PPSS" 4 | round v, subset v | state | keys | keys_reused v | faces v,
-//           owned_faces v, free_vertices v | collapses rejected stale reevaluated evaluations
-//           v, stop_reason (length v <= 4096, bytes) | wall_seconds f64, cpu_seconds f64.
+//   summary "PPSS" 4 | round v, subset v | state | keys | deferred | keys_reused v,
+//           costings v, faces v, owned_faces v, free_vertices v | collapses rejected stale
+//           reevaluated evaluations v, stop_reason (length v <= 4096, bytes) | wall_seconds
+//           f64, cpu_seconds f64.
 //
 // Decoding is written for hostile input (a network peer): every count is checked against the
 // bytes that remain before anything is reserved, every id against what it indexes, positions

@@ -221,6 +221,42 @@ std::vector<EdgeKey> keys_of_job(const KeyMemo& memo, const SubsetJob& job,
   return keys;
 }
 
+// The master's deferred edges (global ids, sorted) with two free ends in the job, in its
+// local ids, sorted, but those `keys` (the job's, sorted) answer: a costing known is better
+// than a deferral. Const reads: jobs may take theirs concurrently.
+std::vector<DeferredEdge> deferred_of_job(const std::vector<DeferredEdge>& deferred,
+                                          const SubsetJob& job, const std::vector<uint8_t>& free,
+                                          const std::vector<EdgeKey>& keys) {
+  const std::vector<VertexId>& global = job.global_vertex;
+  std::vector<DeferredEdge> out;
+  if (deferred.empty()) return out;
+  auto keyed = [&](VertexId a, VertexId b) {
+    const auto it = std::lower_bound(keys.begin(), keys.end(), std::pair{a, b},
+                                     [](const EdgeKey& k, const std::pair<VertexId, VertexId>& e) {
+                                       return k.a != e.first ? k.a < e.first : k.b < e.second;
+                                     });
+    return it != keys.end() && it->a == a && it->b == b;
+  };
+  for (VertexId a = 0; a < global.size(); ++a) {
+    if (!free[a]) continue;
+    auto d = std::lower_bound(deferred.begin(), deferred.end(), global[a],
+                              [](const DeferredEdge& e, VertexId v) { return e.a < v; });
+    for (; d != deferred.end() && d->a == global[a]; ++d) {
+      const auto it = std::lower_bound(global.begin() + a + 1, global.end(), d->b);
+      if (it == global.end() || *it != d->b) continue;
+      const auto b = VertexId(it - global.begin());
+      if (free[b] && !keyed(a, b)) out.push_back({a, b, d->key});
+    }
+  }
+  return out;  // sorted: by a, then by b (global order is local order)
+}
+
+// Drops the deferred edges with an end in `changed` (a collapse's vs or vt: the deferral
+// no longer stands for the edge as it is).
+void drop_changed(std::vector<DeferredEdge>& deferred, const std::vector<uint8_t>& changed) {
+  std::erase_if(deferred, [&](const DeferredEdge& d) { return changed[d.a] || changed[d.b]; });
+}
+
 }  // namespace
 
 std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
@@ -323,6 +359,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // The master's queue keys: the water level's sample, the jobs' keys after a round,
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
   KeyMemo keys(*master, whole.vertex_capacity());
+  // The edges jobs left deferred (global ids, sorted), kept until a collapse changes an end:
+  // the next round's jobs and the final pass queue them deferred (SubsetJob::deferred).
+  std::vector<DeferredEdge> deferred;
   // The whole mesh's connected components, found once, at the first band pass or the final
   // pass, for the size rule of each one after it (standard_constraints: collapses neither merge
   // nor split components).
@@ -337,6 +376,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   };
   // Keys are worth carrying only where a costing costs more than remembering it (costly()).
   const bool carry_keys = parallel.carry_keys && master->costly();
+  const bool carry_deferred = carry_keys && parallel.carry_deferred;
   // The setup's own time: the first partition is round 0's (which the critical path counts
   // only where it outlasts the initialisation: RoundStats::partition_overlap_seconds).
   st.setup_seconds = seconds_since(t) - section_seconds + initialize_seconds;
@@ -561,6 +601,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
         samples[i] = sample_subset(jobs[i], free, carry_keys, jobs[i].keys);
         sample_cpu[i] = thread_cpu_seconds() - sample_start;
       }
+      if (carry_deferred) jobs[i].deferred = deferred_of_job(deferred, jobs[i], free, jobs[i].keys);
       job_cpu[i] = thread_cpu_seconds() - cpu;
     });
     // The water level and the shares (sequential: a sort of the samples).
@@ -573,6 +614,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (parallel.water_level_factor > 0) rs.water_level = round_costs.ceiling;
       sequential_extract += seconds_since(ts);
       for (double c : sample_cpu) rs.share_seconds += c;
+      for (const SubsetSample& s : samples) st.costings += s.costings;
     }
     rs.asked_faces =
         set_targets(jobs, removable, rs.faces_before, rs.goal_faces, round_costs.cheap_fraction);
@@ -585,7 +627,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
         job.options.max_cost = job.options.max_cost > 0
                                    ? std::min(job.options.max_cost, rs.water_level)
                                    : rs.water_level;
-    for (const SubsetJob& job : jobs) rs.keys_carried += job.keys.size();
+    for (const SubsetJob& job : jobs) {
+      rs.keys_carried += job.keys.size();
+      rs.deferred_carried += job.deferred.size();
+    }
     for (double c : job_cpu) {
       subsets_cpu += c;  // master work, on the pool's threads
       rs.slowest_extract_cpu_seconds = std::max(rs.slowest_extract_cpu_seconds, c);
@@ -632,6 +677,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       rs.subsets.push_back({r.subset, r.faces, r.owned_faces, r.records.size(), r.wall_seconds,
                             r.cpu_seconds, r.stats.stop_reason});
       subsets_cpu += r.cpu_seconds;
+      st.costings += r.costings;
       rs.slowest_subset_cpu_seconds = std::max(rs.slowest_subset_cpu_seconds, r.cpu_seconds);
       lists.push_back(std::move(r.records));
       rs.keys_reused += r.keys_reused;
@@ -670,6 +716,29 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (carry_keys)
         for (SubsetResult& r : results)
           returned.insert(returned.end(), r.keys.begin(), r.keys.end());
+      if (carry_deferred) {
+        // The deferred edges of the jobs' free vertices are the jobs' to report (a job holds
+        // them all in its queue); the others stand unless a collapse changed an end.
+        std::vector<uint8_t> changed(whole.vertex_capacity(), 0);
+        for (const std::vector<CollapseRecord>& list : lists)
+          for (const CollapseRecord& r : list) changed[r.vs] = changed[r.vt] = 1;
+        drop_changed(deferred, changed);
+        // A job reports again what it was given and left as it was: its report first, so
+        // that the sort, stable, keeps it.
+        std::vector<DeferredEdge> now;
+        for (SubsetResult& r : results) now.insert(now.end(), r.deferred.begin(), r.deferred.end());
+        now.insert(now.end(), deferred.begin(), deferred.end());
+        auto by_edge = [](const DeferredEdge& x, const DeferredEdge& y) {
+          return x.a != y.a ? x.a < y.a : x.b < y.b;
+        };
+        std::stable_sort(now.begin(), now.end(), by_edge);
+        now.erase(std::unique(now.begin(), now.end(),
+                              [](const DeferredEdge& x, const DeferredEdge& y) {
+                                return x.a == y.a && x.b == y.b;
+                              }),
+                  now.end());
+        deferred = std::move(now);
+      }
       keys.reset(returned);
       bookkeeping_seconds = seconds_since(tb) - import_saved;
     };
@@ -743,6 +812,11 @@ ProgressiveMesh build_progressive_mesh_parallel(
       foreseen.partition_seconds = timed.side_seconds[1];
       subsets_cpu += timed.side_cpu_elsewhere;
       rs.band_pass_collapses = band_records.size();
+      if (carry_deferred && !band_records.empty()) {
+        std::vector<uint8_t> changed(whole.vertex_capacity(), 0);
+        for (const CollapseRecord& r : band_records) changed[r.vs] = changed[r.vt] = 1;
+        drop_changed(deferred, changed);
+      }
       records.insert(records.end(), std::make_move_iterator(band_records.begin()),
                      std::make_move_iterator(band_records.end()));
     }
@@ -786,6 +860,13 @@ ProgressiveMesh build_progressive_mesh_parallel(
   SimplifierLimits limits;
   limits.target_faces = target;
   if (options.defer_recosting) limits.defer_above_faces = defer_line;
+  // The jobs' deferred edges that no key answers (sorted: a subsequence of a sorted list).
+  std::erase_if(deferred, [&](const DeferredEdge& d) {
+    return std::binary_search(
+        carried.begin(), carried.end(), EdgeKey{d.a, d.b, 0},
+        [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  });
+  limits.first_deferred = &deferred;
   const uint64_t done_before = input_faces - whole.live_faces();
   const double final_setup_seconds = seconds_since(t);
   std::vector<CollapseRecord> final_records;
@@ -831,6 +912,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
                               st.pm_build_seconds;
   st.seconds = seconds_since(start);
   st.cpu_seconds = subsets_cpu + (thread_cpu_seconds() - master_cpu_start);
+  st.costings += master->costings();
   pm.info.seconds = st.seconds;
   spdlog::debug(
       "parallel build p={} rounds={}: {} -> {} faces in {:.3f} s ({:.3f} s CPU), final pass {} "

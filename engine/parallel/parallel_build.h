@@ -83,6 +83,10 @@ struct ParallelOptions {
   // Off: every job costs every edge afresh (for measuring; the PM differs a little,
   // docs/BENCHMARKS.md "Carried queue keys").
   bool carry_keys = true;
+  // With carry_keys: the edges the jobs left deferred travel too (SubsetJob::deferred), queued
+  // deferred again as the sequential build would hold them, not costed afresh. Off: for
+  // measuring what that saves (docs/BENCHMARKS.md, "Deferred edges carried").
+  bool carry_deferred = true;
   // Tests only: the master follows each round by re-running its module's collapsed() on every
   // merged record (the first step's path) instead of importing the jobs' returned states.
   bool replay_state = false;
@@ -139,6 +143,7 @@ struct RoundStats {
   double merge_overlap_seconds = 0;
   double slowest_subset_cpu_seconds = 0;
   uint64_t keys_carried = 0;         // queue keys given to the jobs (edge_keys.h)
+  uint64_t deferred_carried = 0;     // deferred edges given to the jobs (SubsetJob::deferred)
   uint64_t keys_reused = 0;          // the jobs' queue costings answered by them
   uint64_t band_pass_collapses = 0;  // sequential, after the merge (ParallelOptions::band_pass)
   // The band pass alone (the append and the next partition beside it are the next round's
@@ -163,6 +168,10 @@ struct ParallelStats {
   std::string stop_reason;  // of the final pass
   double seconds = 0;       // the whole construction, wall
   double cpu_seconds = 0;   // the subsets' CPU plus the master's (partition, merge, final pass)
+  // Edges costed by every module of the build (PriorityModule::costings): the jobs', their
+  // edge samples', the master's (band passes, final pass). Deterministic, unlike cpu_seconds:
+  // the build's work, to compare with SimplifyStats::costings of the sequential build.
+  uint64_t costings = 0;
   // What the build would take with one processor per subset: setup, then per round the
   // partition (or the previous round's append, if longer), extraction (its sequential steps
   // and the slowest job's), the slowest subset's CPU, the merge and the band pass, then the

@@ -17,10 +17,15 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
   SubsetSample out;
   const Mesh& mesh = job.mesh;
   auto inner = [&](VertexId a, VertexId b) { return a < b && job.owned[a] && job.owned[b]; };
+  uint64_t free_edges = 0;
   for (const Triangle& t : mesh.faces)
-    for (int k = 0; k < 3; ++k) out.inner_edges += inner(t[k], t[(k + 1) % 3]) ? 1 : 0;
-  if (out.inner_edges == 0) return out;
-  const uint64_t stride = std::max<uint64_t>(1, out.inner_edges / kSampledEdgesPerSubset);
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3];
+      out.inner_edges += inner(a, b) ? 1 : 0;
+      free_edges += inner(a, b) && free[a] && free[b] ? 1 : 0;
+    }
+  if (free_edges == 0) return out;
+  const uint64_t stride = std::max<uint64_t>(1, free_edges / kSampledEdgesPerSubset);
   CollapseMesh local(mesh);
   std::unique_ptr<PriorityModule> module = job_module(job, local);
   std::optional<KeyMemo> memo;
@@ -34,13 +39,14 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
   for (const Triangle& t : mesh.faces)
     for (int k = 0; k < 3; ++k) {
       const VertexId a = t[k], b = t[(k + 1) % 3];
-      if (!inner(a, b) || index++ % stride != 0) continue;
+      if (!inner(a, b) || !free[a] || !free[b] || index++ % stride != 0) continue;
       CollapseCandidate c;
       const bool placed = costing.evaluate(local, a, b, c, Costing::kQueue);
       out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
-      if (carry_keys && free[a] && free[b])
+      if (carry_keys)
         keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
     }
+  out.costings = module->costings();
   // Carried keys answered the edges they cover: those came back the same.
   if (keys.size() > carried) sort_unique_keys(keys);
   return out;

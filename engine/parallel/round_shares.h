@@ -13,7 +13,8 @@
 namespace parapm {
 
 // What a sample of a round's edges says about its costs: the live inner edges (both ends in
-// one subset; every stride-th of them, about kSampledEdgesPerSubset per subset).
+// one subset), represented by those with two free ends (every stride-th of them, about
+// kSampledEdgesPerSubset per subset).
 struct RoundCosts {
   // The jobs' cost ceiling: `factor` times the water level, the cost below which the sampled
   // edges, scaled to all edges, would give the round's collapses. A sequential run, cheapest
@@ -37,9 +38,15 @@ constexpr double kCheapEdgesPerCollapse = 2.5;
 // edges").
 constexpr uint64_t kSampledEdgesPerSubset = 1024;
 
-// One subset's part of the sample: its inner edges, and the costs of every stride-th one.
+// One subset's part of the sample: its inner edges, and the costs of every stride-th of those
+// with two free ends. Only those: the job costs only them, and joins their costs to its keys;
+// an edge next to the border costed here was costed for nothing (the rocker arm's samples at
+// p = 16: 9.0k of their 35k costings, 8% of the build's; docs/BENCHMARKS.md, "Deferred edges
+// carried"). Each cost stands for inner_edges / costs.size() edges: the subset's free edges
+// cost alike, for the round's quantiles, as all its inner edges.
 struct SubsetSample {
   uint64_t inner_edges = 0;
+  uint64_t costings = 0;      // edges the sample's module costed (the carried keys answer others)
   std::vector<double> costs;  // infinite: the module could not place the edge
 };
 
@@ -49,8 +56,8 @@ struct SubsetSample {
 // Costed on the master, one after the other, the sample was the largest sequential step of a
 // round: 0.04-0.09 s per round on the 871k dragon at p = 16.
 // `free`: free_vertices of the job. `keys` (with carry_keys): the job's carried keys (local
-// ids, sorted), which answer the edges they cover; the sampled edges with two free ends join
-// them, so that the job does not cost them again (its module costs them alike: same state).
+// ids, sorted), which answer the edges they cover; the sampled edges join them, so that the
+// job does not cost them again (its module costs them alike: same state).
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
                            std::vector<EdgeKey>& keys);
 

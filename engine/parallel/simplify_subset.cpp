@@ -1,8 +1,7 @@
 #include "parallel/simplify_subset.h"
 
-#include <time.h>
-
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <optional>
 
@@ -58,12 +57,6 @@ std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseM
   return module;
 }
 
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress,
                              const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
@@ -90,22 +83,31 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
     memo.emplace(module, working.vertex_capacity());
     memo->reset(job.keys);
   }
-  std::unique_ptr<PriorityModule> priority = make_subset_priority(
-      memo ? *memo : module, std::move(free_vertex),
-      job.options.max_cost > 0 ? job.options.max_cost : std::numeric_limits<double>::infinity());
+  std::unique_ptr<PriorityModule> priority =
+      make_subset_priority(memo ? *memo : module, std::move(free_vertex));
   auto constraints = standard_constraints(job.locked);
   constraints.push_back(make_subset_constraint(job.owned));
   Simplifier simplifier(working, *priority, std::move(constraints));
   SimplifierLimits limits;
   limits.target_faces = job.options.target_faces;
+  if (job.options.max_cost > 0) limits.max_cost = job.options.max_cost;
   if (job.options.defer_recosting) limits.defer_above_faces = 0;
+  limits.first_deferred = &job.deferred;
   result.records = simplifier.run(limits, progress, cancel);
   if (!job.state.empty()) result.state = export_result_state(*metric, working, job, result.records);
   for (CollapseRecord& r : result.records) globalise(r, job);
   // Keys mean something to the master only when the job's state is the master's.
-  if (memo && !job.state.empty()) result.keys = current_keys_in_global_ids(*memo, working, job);
+  if (memo && !job.state.empty()) {
+    result.keys = current_keys_in_global_ids(*memo, working, job);
+    // But those the module refused last (infinite key): the next round's jobs cost them at
+    // once, as before, rather than wait for their queues to empty.
+    for (const DeferredEdge& d : simplifier.deferred_edges())
+      if (!std::isinf(d.key))  // still sorted: local ids follow the global order
+        result.deferred.push_back({job.global_vertex[d.a], job.global_vertex[d.b], d.key});
+  }
   result.keys_reused = memo ? memo->reused() : 0;
   result.stats = simplifier.stats();
+  result.costings = metric->costings();
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   spdlog::debug(

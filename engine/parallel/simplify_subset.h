@@ -28,7 +28,11 @@ struct SubsetResult {
   // The queue keys still current at the end (edge_keys.h), in global ids, sorted by (a, b);
   // the next round's jobs take those of their free edges instead of costing them again.
   std::vector<EdgeKey> keys;
+  // With keys: the edges the job left deferred (Simplifier::deferred_edges()) from a finite
+  // key, in global ids, sorted; the next round's jobs queue them deferred (SubsetJob::deferred).
+  std::vector<DeferredEdge> deferred;
   uint64_t keys_reused = 0;  // queue costings the job answered from the job's keys
+  uint64_t costings = 0;     // edges the job's metric costed (PriorityModule::costings)
   uint64_t faces = 0;        // of the job's mesh, halo included
   uint64_t owned_faces = 0;  // of those, the faces with three owned vertices
   uint64_t free_vertices = 0;
@@ -48,8 +52,5 @@ SimplifyOptions simplify_options_of(const SubsetOptions& subset);
 // The job's metric module over `working` (a CollapseMesh of job.mesh), as simplify_subset
 // makes it: with a job state, the master's state imported (not yet initialised otherwise).
 std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseMesh& working);
-
-// CPU seconds used by the calling thread so far.
-double thread_cpu_seconds();
 
 }  // namespace parapm

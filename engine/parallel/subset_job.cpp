@@ -179,6 +179,15 @@ void validate_subset_job(const SubsetJob& job) {
     }
     if (!touches) throw_invalid(name + "face " + std::to_string(f) + " touches no owned vertex");
   }
+  // The job looks its deferred edges up by (a, b) (simplifier.h, first_deferred).
+  for (size_t i = 0; i < job.deferred.size(); ++i) {
+    const DeferredEdge& d = job.deferred[i];
+    if (d.a >= d.b || d.b >= m.vertex_count() ||
+        (i > 0 && !(job.deferred[i - 1].a < d.a ||
+                    (job.deferred[i - 1].a == d.a && job.deferred[i - 1].b < d.b))))
+      throw_invalid(name + "deferred edge " + std::to_string(i) +
+                    " out of range or not sorted once by (a, b)");
+  }
 }
 
 SubsetOptions subset_options_of(const SimplifyOptions& options, const Mesh& mesh) {

@@ -23,6 +23,7 @@
 #include "parallel/edge_keys.h"
 #include "simplify/collapse_mesh.h"
 #include "simplify/module_state.h"
+#include "simplify/simplifier.h"
 #include "simplify/simplify.h"
 
 namespace parapm {
@@ -86,6 +87,11 @@ struct SubsetJob {
   // Queue keys still current on the master (edge_keys.h), in local ids, a < b, sorted; only
   // of edges with two free ends (subset_rule.h), the only ones the job costs.
   std::vector<EdgeKey> keys;
+  // Edges with two free ends that a job of an earlier round left deferred (its
+  // Simplifier::deferred_edges(), still so on the master), in local ids, sorted, none of them
+  // among `keys`: the job queues them deferred while it defers, as the sequential build holds
+  // them, instead of costing them at once (SimplifierLimits::first_deferred).
+  std::vector<DeferredEdge> deferred;
 };
 
 // Builds the job of every subset of `vertex_subset` (per global vertex its subset in

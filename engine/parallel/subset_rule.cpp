@@ -53,17 +53,16 @@ class SubsetConstraint : public ConstraintModule {
 
 class SubsetPriority : public PriorityWrapper {
  public:
-  SubsetPriority(PriorityModule& inner, std::vector<uint8_t> free_vertex, double max_cost)
-      : PriorityWrapper(inner), free_(std::move(free_vertex)), max_cost_(max_cost) {}
+  SubsetPriority(PriorityModule& inner, std::vector<uint8_t> free_vertex)
+      : PriorityWrapper(inner), free_(std::move(free_vertex)) {}
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {
     if (!free_[a] || !free_[b]) return false;
-    return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= max_cost_;
+    return inner_.evaluate(mesh, a, b, out, costing);
   }
 
  private:
   std::vector<uint8_t> free_;
-  double max_cost_;
 };
 
 }  // namespace
@@ -111,9 +110,8 @@ std::unique_ptr<ConstraintModule> make_subset_constraint(std::vector<uint8_t> ow
 }
 
 std::unique_ptr<PriorityModule> make_subset_priority(PriorityModule& inner,
-                                                     std::vector<uint8_t> free_vertex,
-                                                     double max_cost) {
-  return std::make_unique<SubsetPriority>(inner, std::move(free_vertex), max_cost);
+                                                     std::vector<uint8_t> free_vertex) {
+  return std::make_unique<SubsetPriority>(inner, std::move(free_vertex));
 }
 
 }  // namespace parapm

@@ -69,10 +69,9 @@ std::unique_ptr<ConstraintModule> make_subset_constraint(std::vector<uint8_t> ow
 
 // Wraps the subset's priority module so that an edge without two free ends is never costed
 // nor queued (by (3) above it can never become collapsible during the round): the job does
-// no work on its border. An edge costing more than max_cost is left alone too (until its star
-// changes, when the simplifier costs it again). Forwards everything else.
-std::unique_ptr<PriorityModule> make_subset_priority(
-    PriorityModule& inner, std::vector<uint8_t> free_vertex,
-    double max_cost = std::numeric_limits<double>::infinity());
+// no work on its border. Forwards everything else. (The job's cost ceiling is the simplifier's:
+// SimplifierLimits::max_cost.)
+std::unique_ptr<PriorityModule> make_subset_priority(PriorityModule& inner,
+                                                     std::vector<uint8_t> free_vertex);
 
 }  // namespace parapm

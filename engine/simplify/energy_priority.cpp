@@ -607,6 +607,7 @@ bool EnergyPriority::folds(const Vec3& v) const {
 
 bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                               CollapseCandidate& out, Costing costing) const {
+  ++costings_;
   const bool locked_a = !locked_.empty() && locked_[a];
   const bool locked_b = !locked_.empty() && locked_[b];
   if (locked_a && locked_b) return false;

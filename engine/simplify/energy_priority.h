@@ -143,6 +143,7 @@ class EnergyPriority : public PriorityModule {
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
+  uint64_t costings() const override { return costings_; }
 
   // State export/import for the parallel construction (module_state.h). export_local: the
   // state of a job's faces and vertices (maps: its local -> global ids; the points on its
@@ -299,7 +300,8 @@ class EnergyPriority : public PriorityModule {
   std::vector<std::vector<FacePoint>> face_points_;  // per face: the points projecting onto it
   std::vector<uint32_t> parked_point_;  // per vertex: its sample while it has not moved
   SharpCurves curves_;
-  WedgeAttributes attributes_;       // the input's; initialize copies them into scalar_
+  WedgeAttributes attributes_;  // the input's; initialize copies them into scalar_
+  mutable uint64_t costings_ = 0;
   mutable ScalarAttributes scalar_;  // its star scratch is used by the const evaluate
   double topology_penalty_ = 0;      // added to a collapse that changes the curves' topology
   std::vector<uint32_t> point_id_;   // a job's: per point, the master's id (empty: identity)

@@ -66,6 +66,11 @@ class PriorityModule {
   // (edge_keys.h): the quadric's costings take tens of nanoseconds, and on the 871k dragon the
   // memo's bookkeeping cost three times its costings.
   virtual bool costly() const { return false; }
+  // The edges this module has costed itself so far (its evaluate calls; a wrapper's own
+  // answers, such as a carried key or a subset rule's refusal, are not counted). Summed over a
+  // build's modules it is the build's work in costings, the figure the parallel build's work
+  // is compared with the sequential one's by, free of the machine's timing noise.
+  virtual uint64_t costings() const { return 0; }
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every
@@ -76,6 +81,7 @@ class PriorityWrapper : public PriorityModule {
   explicit PriorityWrapper(PriorityModule& inner) : inner_(inner) {}
   std::string name() const override { return inner_.name(); }
   bool costly() const override { return inner_.costly(); }
+  uint64_t costings() const override { return inner_.costings(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {

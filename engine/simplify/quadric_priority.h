@@ -28,6 +28,7 @@ class QuadricPriority : public PriorityModule {
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override;  // (both costings alike: it is cheap)
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
+  uint64_t costings() const override { return costings_; }
 
   // State export/import for the parallel construction (module_state.h). export_local: the
   // quadrics of a job's vertices (maps: its local -> global ids), in its local ids.
@@ -47,6 +48,7 @@ class QuadricPriority : public PriorityModule {
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 
  private:
+  mutable uint64_t costings_ = 0;
   std::vector<uint8_t> locked_;
   QuadricOptions options_;
   std::vector<Quadric> quadrics_;

@@ -65,7 +65,7 @@ void Simplifier::remember_key(VertexId a, VertexId b, float key) {
     if (slot) *slot = key;
 }
 
-bool Simplifier::defer_edge(VertexId a, VertexId b) {
+bool Simplifier::deferred_entry(VertexId a, VertexId b, Entry& entry) {
   if (a > b) std::swap(a, b);
   float key = std::numeric_limits<float>::quiet_NaN();
   for (const float* slot : key_slots(a, b))
@@ -75,9 +75,51 @@ bool Simplifier::defer_edge(VertexId a, VertexId b) {
   // and an edge that comes out too early only costs one costing. A refused edge (infinite)
   // comes out when nothing else is left.
   if (!std::isinf(key)) key -= 0.5f * std::abs(key);
-  heap_.push({key, a, b, (version_[a] + version_[b]) | kDeferred});
+  entry = {key, a, b, (version_[a] + version_[b]) | kDeferred};
   ++stats_.deferred;
   return true;
+}
+
+bool Simplifier::defer_edge(VertexId a, VertexId b) {
+  Entry entry;
+  if (!deferred_entry(a, b, entry)) return false;
+  heap_.push(entry);
+  return true;
+}
+
+float Simplifier::hinted_key(const std::vector<DeferredEdge>& hints, VertexId a, VertexId b) {
+  if (a > b) std::swap(a, b);
+  const auto it =
+      std::lower_bound(hints.begin(), hints.end(), std::pair{a, b},
+                       [](const DeferredEdge& h, const std::pair<VertexId, VertexId>& e) {
+                         return h.a != e.first ? h.a < e.first : h.b < e.second;
+                       });
+  return it != hints.end() && it->a == a && it->b == b ? it->key
+                                                       : std::numeric_limits<float>::quiet_NaN();
+}
+
+std::vector<DeferredEdge> Simplifier::deferred_edges() {
+  std::vector<DeferredEdge> out;
+  if (!defer_) return out;
+  for (const Entry& e : heap_.items()) {
+    if (!(e.stamp & kDeferred) || is_stale(e)) continue;
+    // The key it was deferred from: its faces' remembered keys, which only a costing of the
+    // edge itself rewrites (and that would have made this entry current, not deferred).
+    float key = std::numeric_limits<float>::quiet_NaN();
+    for (const float* slot : key_slots(e.a, e.b))
+      if (slot && !std::isnan(*slot)) key = std::isnan(key) ? *slot : std::min(key, *slot);
+    if (!std::isnan(key)) out.push_back({e.a, e.b, key});
+  }
+  // An edge deferred twice without an end changing in between is listed once.
+  std::sort(out.begin(), out.end(), [](const DeferredEdge& x, const DeferredEdge& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  });
+  out.erase(std::unique(out.begin(), out.end(),
+                        [](const DeferredEdge& x, const DeferredEdge& y) {
+                          return x.a == y.a && x.b == y.b;
+                        }),
+            out.end());
+  return out;
 }
 
 void Simplifier::retry_edge(VertexId a, VertexId b) {
@@ -211,6 +253,11 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     heap_.reserve(mesh_.face_capacity() * 3);
     // (12 bytes per face, freed before the first collapse.)
     const std::vector<FaceId> twin = mesh_.twin_faces();
+    const std::vector<DeferredEdge>* hints = defer_ && limits.first_deferred &&
+                                                     !limits.first_deferred->empty() &&
+                                                     mesh_.live_faces() > limits.defer_above_faces
+                                                 ? limits.first_deferred
+                                                 : nullptr;
     for (FaceId f = 0; f < mesh_.face_capacity(); ++f) {
       if (!mesh_.face_alive(f)) continue;
       // The first costing of every edge takes a while with the energy: stay cancellable.
@@ -220,6 +267,14 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
         const VertexId a = t[k], b = t[(k + 1) % 3];
         if (a > b && twin[3 * size_t(f) + size_t(k)] != kNoId) continue;  // counted from b->a
         Entry entry;
+        if (hints) {
+          const float key = hinted_key(*hints, a, b);
+          if (!std::isnan(key)) {
+            remember_key(a, b, key);
+            if (deferred_entry(a, b, entry)) heap_.items().push_back(entry);
+            continue;
+          }
+        }
         if (queue_entry(a, b, entry)) heap_.items().push_back(entry);
       }
     }
@@ -254,6 +309,11 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.stale;
       continue;
     }
+    if (double(entry.cost) > limits.max_cost) {  // and so does every entry after it
+      heap_.push(entry);                         // (deferred_edges() lists what the queue holds)
+      stats_.stop_reason = "cost ceiling reached";
+      break;
+    }
     if (entry.stamp & kDeferred) {  // costed now, back at its true key
       push_edge(entry.a, entry.b);
       continue;
@@ -279,6 +339,13 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
     if (edge.left == kNoId && edge.right == kNoId) {  // a re-costed edge that is gone
       ++stats_.stale;
+      continue;
+    }
+    // Its key was under the ceiling (a float, or a star changed since) but its cost is not:
+    // left out of the queue, like an edge refused, until its star changes; its key stays
+    // remembered for a deferral.
+    if (candidate.cost > limits.max_cost) {
+      ++stats_.over_ceiling;
       continue;
     }
     if (!legal(candidate, edge, topology_checked)) {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -39,6 +40,13 @@ struct CollapseRecord {
   std::vector<float> changed_values;
 };
 
+// An edge waiting in the queue for a costing (SimplifierLimits::first_deferred), a < b.
+struct DeferredEdge {
+  VertexId a = kNoId;
+  VertexId b = kNoId;
+  float key = 0;  // its last costing's key; infinite: the module refused it then
+};
+
 struct SimplifierLimits {
   size_t target_faces = 0;  // stop once the live face count is <= this (0: go as far as legal)
   // Deferred re-costing, with a costly priority module: while more faces than this are live,
@@ -57,6 +65,22 @@ struct SimplifierLimits {
   // large mesh), the same run, without costing the whole mesh's edges to refuse them (0.28 of
   // the band passes' 0.43 s on the 871k dragon at p = 16).
   const std::vector<VertexId>* first_queue_around = nullptr;
+  // Edges whose last costing is known to be outdated (a collapse changed an end since), each
+  // with that costing's key, sorted by (a, b): while the run defers (above
+  // defer_above_faces), its first queue takes them deferred, below that key, as a run that had
+  // made those collapses itself would hold them, instead of costing them at once. Another
+  // key (infinite: refused), or an edge that is not live, is taken as it is or ignored. The
+  // parallel build carries a job's still-deferred edges (deferred_edges()) into the next
+  // round's jobs: costed afresh, they were a fifth of a small mesh's work at p = 4
+  // (docs/BENCHMARKS.md, "Deferred edges carried").
+  const std::vector<DeferredEdge>* first_deferred = nullptr;
+  // An edge costing more is not collapsed: it stays in the queue at its cost, as a run without
+  // the ceiling would hold it, and the run ends once the queue's cheapest edge costs more
+  // ("cost ceiling reached"). A parallel build's job stops at its round's water level so; its
+  // queue at the end, real keys throughout, is what the next round starts from
+  // (deferred_edges()). A deferred edge comes out below its last key, so one whose cost has
+  // fallen under the ceiling since is still taken unless its last key was twice the ceiling.
+  double max_cost = std::numeric_limits<double>::infinity();
 };
 
 // The sequential build defers re-costing down to this fraction of the input's faces (the
@@ -80,9 +104,10 @@ struct SimplifierStats {
   // With a costly priority module: edges the topological rules vetoed before any costing
   // (retried after their star changed, or on top of the queue: those count as rejected too).
   uint64_t screened = 0;
-  uint64_t deferred = 0;     // edges queued below their last key instead of costed at once
-  uint64_t compactions = 0;  // passes dropping the queue's stale entries at once
-  std::string stop_reason;   // why the loop ended
+  uint64_t deferred = 0;      // edges queued below their last key instead of costed at once
+  uint64_t compactions = 0;   // passes dropping the queue's stale entries at once
+  uint64_t over_ceiling = 0;  // popped edges whose cost was above SimplifierLimits::max_cost
+  std::string stop_reason;    // why the loop ended
 };
 
 class Simplifier {
@@ -96,6 +121,10 @@ class Simplifier {
   std::vector<CollapseRecord> run(const SimplifierLimits& limits, const ProgressCallback& progress,
                                   const CancelToken* cancel);
   const SimplifierStats& stats() const { return stats_; }
+  // After run(): the edges still waiting in the queue to be costed (deferred, neither end
+  // changed since), with the key they were deferred from, sorted by (a, b). Empty when the run
+  // did not defer.
+  std::vector<DeferredEdge> deferred_edges();
 
  private:
   // 16 bytes, so that more of the heap stays in cache. The stamp is the sum of the two
@@ -121,6 +150,10 @@ class Simplifier {
   void queue_edges_around(const std::vector<VertexId>& vertices, const CancelToken* cancel);
   // Queues edge {a, b} below its remembered key, uncosted; false when it has none.
   bool defer_edge(VertexId a, VertexId b);
+  // The entry defer_edge would push; false when the edge has no remembered key.
+  bool deferred_entry(VertexId a, VertexId b, Entry& entry);
+  // Its key in `hints` (SimplifierLimits::first_deferred), or NaN.
+  static float hinted_key(const std::vector<DeferredEdge>& hints, VertexId a, VertexId b);
   // The key last computed for edge {a, b} stays with its faces (the two corners' slots of
   // face_keys_), through collapses that rename an end: the faces keep their ids and corners.
   void remember_key(VertexId a, VertexId b, float key);

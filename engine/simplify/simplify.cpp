@@ -99,6 +99,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
                                        SimplifyStats* stats, const ProgressCallback& progress,
                                        const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_seconds();
   check_simplify_options(options);
   const Mesh& mesh = repaired.mesh;
 
@@ -124,6 +125,8 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
     stats->rejected = simplifier.stats().rejected;
     stats->stop_reason = simplifier.stats().stop_reason;
     stats->seconds = seconds;
+    stats->costings = priority->costings();
+    stats->cpu_seconds = thread_cpu_seconds() - cpu_start;
   }
   spdlog::debug(
       "simplified {} -> {} faces in {:.3f} s ({} collapses, {} vetoed, {} screened, {} "

@@ -65,7 +65,11 @@ struct SimplifyStats {
   uint64_t collapses = 0;
   uint64_t rejected = 0;
   std::string stop_reason;
-  double seconds = 0;  // simplification and PM assembly, not reading or repair
+  double seconds = 0;     // simplification and PM assembly, not reading or repair
+  uint64_t costings = 0;  // edges the metric costed (PriorityModule::costings)
+  // The calling thread's CPU over `seconds` (what the parallel build's cpu_seconds is compared
+  // with: the wall time also counts waits for a busy machine).
+  double cpu_seconds = 0;
 };
 
 // Throws Error(kInvalidInput) for unknown options, Error(kCancelled / kDeadlineExceeded) when

@@ -13,6 +13,7 @@
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
 #include "parallel_test_support.h"
+#include "simplify/simplifier.h"
 #include "simplify/simplify.h"
 
 namespace parapm {
@@ -148,6 +149,65 @@ TEST(EdgeKeys, AJobGivenFreshKeysSimplifiesAsWithout) {
                 name, job.mesh.face_count(), job.keys.size(), (unsigned long long)with.keys_reused,
                 with.records.size());
   }
+}
+
+// The edges a run leaves deferred (Simplifier::deferred_edges) are live edges, each with the
+// key it was deferred from. Another run of the same module on the mesh, given them
+// (SimplifierLimits::first_deferred), queues them deferred without costing them while it
+// defers, and holds them exactly as the first run left them; not deferring, it costs them.
+TEST(DeferredEdges, ARunGivenTheDeferredEdgesQueuesThemUncosted) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
+  SimplifyOptions options;
+  options.metric = "energy";
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh mesh(repaired.mesh);
+  std::unique_ptr<PriorityModule> module = make_priority_module(options, repaired.mesh, locked);
+  Simplifier first(mesh, *module, standard_constraints(locked));
+  SimplifierLimits limits;
+  limits.defer_above_faces = 0;
+  limits.target_faces = mesh.live_faces() * 3 / 5;
+  ASSERT_GT(first.run(limits, {}, nullptr).size(), 1000u);
+  const std::vector<DeferredEdge> deferred = first.deferred_edges();
+  ASSERT_GT(deferred.size(), 200u);
+  for (size_t i = 0; i < deferred.size(); ++i) {
+    const DeferredEdge& d = deferred[i];
+    ASSERT_TRUE(d.a < d.b && !std::isnan(d.key)) << i;
+    if (i > 0)
+      ASSERT_TRUE(deferred[i - 1].a < d.a || (deferred[i - 1].a == d.a && deferred[i - 1].b < d.b))
+          << "sorted, once each: " << i;
+    const EdgeFaces e = mesh.edge_faces(d.a, d.b);
+    ASSERT_TRUE(mesh.vertex_alive(d.a) && mesh.vertex_alive(d.b) &&
+                (e.left != kNoId || e.right != kNoId))
+        << d.a << "-" << d.b;
+  }
+  const size_t edges = edges_of(mesh).size();
+
+  // Stopped before its first collapse: only the first queue is built.
+  std::unique_ptr<PriorityModule> continued = without_initialize(*module);
+  SimplifierLimits again;
+  again.target_faces = mesh.live_faces();
+  again.first_deferred = &deferred;
+  again.defer_above_faces = 0;
+  Simplifier second(mesh, *continued, standard_constraints(locked));
+  ASSERT_TRUE(second.run(again, {}, nullptr).empty());
+  EXPECT_EQ(second.stats().evaluations, edges - deferred.size());
+  EXPECT_EQ(second.stats().deferred, deferred.size());
+  const std::vector<DeferredEdge> held = second.deferred_edges();
+  ASSERT_EQ(held.size(), deferred.size());
+  for (size_t i = 0; i < held.size(); ++i)
+    ASSERT_TRUE(held[i].a == deferred[i].a && held[i].b == deferred[i].b &&
+                std::memcmp(&held[i].key, &deferred[i].key, sizeof(float)) == 0)
+        << i;
+
+  // Not deferring (below its line), every edge is costed.
+  again.defer_above_faces = SIZE_MAX;
+  Simplifier third(mesh, *continued, standard_constraints(locked));
+  ASSERT_TRUE(third.run(again, {}, nullptr).empty());
+  EXPECT_EQ(third.stats().evaluations, edges);
+  EXPECT_EQ(third.stats().deferred, 0u);
+  EXPECT_TRUE(third.deferred_edges().empty());
+  std::printf("%zu edges after %zu faces removed: %zu left deferred, queued uncosted again\n",
+              edges, repaired.mesh.face_count() - mesh.live_faces(), deferred.size());
 }
 
 }  // namespace

@@ -90,6 +90,14 @@ void expect_same_keys(const std::vector<EdgeKey>& a, const std::vector<EdgeKey>&
         << what << " key " << i;
 }
 
+void expect_same_deferred(const std::vector<DeferredEdge>& a, const std::vector<DeferredEdge>& b,
+                          const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (size_t i = 0; i < a.size(); ++i)
+    ASSERT_TRUE(a[i].a == b[i].a && a[i].b == b[i].b && same_bits(a[i].key, b[i].key))
+        << what << " deferred edge " << i;
+}
+
 void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& what) {
   ASSERT_EQ(a.round, b.round) << what;
   ASSERT_EQ(a.subset, b.subset) << what;
@@ -122,6 +130,7 @@ void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& 
       << what;
   expect_same_state(a.state, b.state, what);
   expect_same_keys(a.keys, b.keys, what);
+  expect_same_deferred(a.deferred, b.deferred, what);
 }
 
 void expect_same_records(const std::vector<CollapseRecord>& a, const std::vector<CollapseRecord>& b,
@@ -152,13 +161,16 @@ void expect_same_summary(const SubsetResult& a, const SubsetResult& b, const std
       << what;
   expect_same_state(a.state, b.state, what);
   ASSERT_EQ(a.keys_reused, b.keys_reused) << what;
+  ASSERT_EQ(a.costings, b.costings) << what;
   expect_same_keys(a.keys, b.keys, what + " keys");
+  expect_same_deferred(a.deferred, b.deferred, what + " deferred edges");
 }
 
 // ---- Jobs as the parallel build makes them ---------------------------------------------------
 
 // Round 0 of a p-subset build of a test mesh: the jobs with the master's state and its queue
-// keys of their free edges.
+// keys of their free edges; with the energy, every fifth of those edges given as deferred
+// instead (its cost as the key), and the jobs deferring, so that they return deferred edges.
 std::vector<SubsetJob> jobs_of(const std::string& name, const std::string& metric, uint32_t p) {
   SimplifyOptions options;
   options.metric = metric;
@@ -168,6 +180,17 @@ std::vector<SubsetJob> jobs_of(const std::string& name, const std::string& metri
   for (SubsetJob& job : round.jobs) {
     job.options.target_faces = job.mesh.face_count() * 2 / 5;
     job.keys = testing::fresh_keys(*round.master, round.whole, job);
+    if (metric != "energy") continue;
+    job.options.defer_recosting = true;
+    std::vector<EdgeKey> kept;
+    for (size_t i = 0; i < job.keys.size(); ++i) {
+      const EdgeKey& k = job.keys[i];
+      if (i % 5 == 0)
+        job.deferred.push_back({k.a, k.b, float(k.cost)});
+      else
+        kept.push_back(k);
+    }
+    job.keys = std::move(kept);
   }
   return std::move(round.jobs);
 }
@@ -209,6 +232,7 @@ TEST(JobCodec, JobsRecordsAndSummariesComeBackBitForBit) {
     ASSERT_FALSE(job.keys.empty()) << what;
     // Only the energy's keys are worth carrying (edge_keys.h): a quadric job ignores them.
     ASSERT_EQ(remote.keys.empty(), std::string(c.metric) == "quadric") << what;
+    ASSERT_EQ(remote.deferred.empty(), std::string(c.metric) == "quadric") << what;
     expect_same_records(original.records, remote.records, what + " simplified remotely");
     expect_same_state(original.state, remote.state, what + " result state");
     expect_same_records(original.records, records_round_trip(remote.records, 97),
@@ -339,27 +363,27 @@ TEST(JobCodec, HugeCountsAreRefusedBeforeAllocating) {
   // A job of 3 vertices and 2^40 faces, and one of 2^40 vertices.
   std::string message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(4);  // the codec's version
+    out.u8(5);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), uint64_t(3), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 faces"), std::string::npos) << message;
   EXPECT_NE(message.find("subset job: byte "), std::string::npos) << message;
   message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(4);  // the codec's version
+    out.u8(5);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 vertices"), std::string::npos) << message;
   message = message_of(Kind::kRecords, [&](ByteWriter& out) {
     out.bytes("PPCR", 4);
-    out.u8(4);
+    out.u8(5);
     out.varint(kHuge);
   });
   EXPECT_NE(message.find("1099511627776 records"), std::string::npos) << message;
   // A summary whose energy state claims 2^40 faces.
   message = message_of(Kind::kSummary, [&](ByteWriter& out) {
     out.bytes("PPSS", 4);
-    out.u8(4);
+    out.u8(5);
     out.varint(0);
     out.varint(0);
     out.u8(2);  // energy

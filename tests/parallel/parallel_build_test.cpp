@@ -203,35 +203,59 @@ TEST(ParallelBuild, ExtraRoundsAfterAShortRoundTakeLargerSubsets) {
 }
 
 // Keys carried from round to round (edge_keys.h): with the energy, every round after the first
-// gives its jobs most of their edges' keys, the jobs answer their first costing of them from the
-// keys, and the PM stays lossless; without carrying, or with the quadric (whose costings are
-// cheaper than carrying them), no key travels.
+// gives its jobs most of their edges' keys, and the edges the last round's jobs left deferred;
+// the jobs answer their first costing of the keys from them, and the PM stays lossless; without
+// carrying, or with the quadric (whose costings are cheaper than carrying them), neither
+// travels.
 TEST(ParallelBuild, CarriedKeysSpareTheJobsTheirFirstCosting) {
   const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
   ParallelOptions parallel = with_p(2);
-  ParallelStats carried, fresh, quadric;
+  ParallelStats carried, keys_only, fresh, quadric;
   const ProgressiveMesh pm =
       build_progressive_mesh_parallel(repaired, metric_options("energy"), parallel, &carried);
   build_progressive_mesh_parallel(repaired, metric_options("quadric"), parallel, &quadric);
+  parallel.carry_deferred = false;
+  const ProgressiveMesh keys_only_pm =
+      build_progressive_mesh_parallel(repaired, metric_options("energy"), parallel, &keys_only);
   parallel.carry_keys = false;
   build_progressive_mesh_parallel(repaired, metric_options("energy"), parallel, &fresh);
+  // Each carried thing spares costings (the modules' own count, PriorityModule::costings):
+  // every edge is costed at least once.
+  EXPECT_LT(carried.costings, keys_only.costings);
+  EXPECT_LT(keys_only.costings, fresh.costings);
+  EXPECT_GT(carried.costings, repaired.mesh.face_count() * 3 / 2);
+  std::printf(
+      "costings: %llu with keys and deferred edges carried, %llu with keys only, %llu "
+      "with neither\n",
+      (unsigned long long)carried.costings, (unsigned long long)keys_only.costings,
+      (unsigned long long)fresh.costings);
+  for (const RoundStats& round : keys_only.round_stats)
+    EXPECT_EQ(round.deferred_carried, 0u) << "round " << round.round;
   ASSERT_GE(carried.round_stats.size(), 2u);
   for (size_t r = 1; r < carried.round_stats.size(); ++r) {
     const RoundStats& round = carried.round_stats[r];
     EXPECT_GT(round.keys_carried, round.faces_before / 2) << "round " << r;
     EXPECT_GE(round.keys_reused, round.keys_carried) << "round " << r;
-    std::printf("energy round %zu: %llu faces, %llu keys carried, %llu answered\n", r,
-                (unsigned long long)round.faces_before, (unsigned long long)round.keys_carried,
-                (unsigned long long)round.keys_reused);
+    // (Deferring rounds: those above a tenth of the input's faces.)
+    if (round.goal_faces >= repaired.mesh.face_count() / 10)
+      EXPECT_GT(round.deferred_carried, 0u) << "round " << r;
+    std::printf(
+        "energy round %zu: %llu faces, %llu keys carried, %llu answered, %llu deferred "
+        "edges carried\n",
+        r, (unsigned long long)round.faces_before, (unsigned long long)round.keys_carried,
+        (unsigned long long)round.keys_reused, (unsigned long long)round.deferred_carried);
   }
   for (const ParallelStats* none : {&fresh, &quadric})
     for (const RoundStats& round : none->round_stats) {
       EXPECT_EQ(round.keys_carried, 0u) << "round " << round.round;
       EXPECT_EQ(round.keys_reused, 0u) << "round " << round.round;
+      EXPECT_EQ(round.deferred_carried, 0u) << "round " << round.round;
     }
-  const MeshDifference diff =
-      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
-  EXPECT_TRUE(diff.equal) << diff.first_difference;
+  for (const ProgressiveMesh* built : {&pm, &keys_only_pm}) {
+    const MeshDifference diff =
+        compare_meshes_exact(restore_input(*built), repaired_input(repaired), false);
+    EXPECT_TRUE(diff.equal) << diff.first_difference;
+  }
 }
 
 TEST(ParallelBuild, TargetFaceCountIsReached) {

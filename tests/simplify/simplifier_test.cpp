@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <string>
 
 #include "drawn_meshes.h"
 #include "io/mesh_io.h"
@@ -382,6 +384,52 @@ TEST(Simplifier, ComponentsFoundBeforeCollapsesDecideAsFoundAnew) {
   auto other = std::make_shared<std::vector<uint32_t>>(found->size() / 2, 0u);
   Simplifier wrong(cm, priority, standard_constraints(locked, other));
   EXPECT_THROW(wrong.run({0}, {}, nullptr), Error);
+}
+
+// A cost ceiling (SimplifierLimits::max_cost) on a real mesh, both metrics: the run makes the
+// unlimited run's collapses up to the first that costs more, never one that costs more, and
+// ends at the ceiling. (With the energy a deferred edge whose last key was above twice the
+// ceiling is not costed again: the run may end a little earlier than the first such collapse.)
+TEST(Simplifier, ACostCeilingTakesTheCollapsesBelowItInOrder) {
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("stratocaster-9k.ply")));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  for (const char* metric : {"quadric", "energy"}) {
+    SimplifyOptions options;
+    options.metric = metric;
+    auto run = [&](double max_cost) {
+      CollapseMesh cm(repaired.mesh);
+      std::unique_ptr<PriorityModule> priority =
+          make_priority_module(options, repaired.mesh, locked);
+      Simplifier simplifier(cm, *priority, standard_constraints(locked));
+      SimplifierLimits limits;
+      limits.max_cost = max_cost;
+      limits.defer_above_faces = defer_recosting_line(repaired.mesh.face_count());
+      std::vector<CollapseRecord> records = simplifier.run(limits, {}, nullptr);
+      return std::make_pair(std::move(records), simplifier.stats());
+    };
+    const auto [unlimited, unlimited_stats] = run(std::numeric_limits<double>::infinity());
+    // The cost of the collapse that ends the first third of the unlimited run.
+    const double ceiling = unlimited[unlimited.size() / 3].cost;
+    const auto [limited, stats] = run(ceiling);
+    size_t first_above = 0;
+    while (first_above < unlimited.size() && unlimited[first_above].cost <= ceiling) ++first_above;
+    EXPECT_EQ(stats.stop_reason, "cost ceiling reached") << metric;
+    ASSERT_GT(limited.size(), unlimited.size() / 4) << metric;
+    for (const CollapseRecord& r : limited) ASSERT_LE(r.cost, ceiling) << metric;
+    const size_t same = std::min(first_above, limited.size());
+    for (size_t i = 0; i < same; ++i) {
+      const CollapseRecord &x = unlimited[i], &y = limited[i];
+      ASSERT_TRUE(x.vs == y.vs && x.vt == y.vt && x.position == y.position && x.cost == y.cost)
+          << metric << " collapse " << i;
+    }
+    if (std::string(metric) == "quadric") {  // nothing deferred: every cheaper collapse taken
+      EXPECT_GE(limited.size(), first_above);
+    }
+    std::printf(
+        "%-8s ceiling %.3g: %zu collapses (the unlimited run's first %zu below it), %llu "
+        "costed above it\n",
+        metric, ceiling, limited.size(), first_above, (unsigned long long)stats.over_ceiling);
+  }
 }
 
 }  // namespace
