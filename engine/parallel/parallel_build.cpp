@@ -359,6 +359,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // The master's queue keys: the water level's sample, the jobs' keys after a round,
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
   KeyMemo keys(*master, whole.vertex_capacity());
+  uint64_t job_costings = 0, sample_costings = 0;  // (ParallelStats::costings)
   // The edges jobs left deferred (global ids, sorted), kept until a collapse changes an end:
   // the next round's jobs and the final pass queue them deferred (SubsetJob::deferred).
   std::vector<DeferredEdge> deferred;
@@ -614,7 +615,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (parallel.water_level_factor > 0) rs.water_level = round_costs.ceiling;
       sequential_extract += seconds_since(ts);
       for (double c : sample_cpu) rs.share_seconds += c;
-      for (const SubsetSample& s : samples) st.costings += s.costings;
+      for (const SubsetSample& s : samples) sample_costings += s.costings;
     }
     rs.asked_faces =
         set_targets(jobs, removable, rs.faces_before, rs.goal_faces, round_costs.cheap_fraction);
@@ -677,7 +678,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       rs.subsets.push_back({r.subset, r.faces, r.owned_faces, r.records.size(), r.wall_seconds,
                             r.cpu_seconds, r.stats.stop_reason});
       subsets_cpu += r.cpu_seconds;
-      st.costings += r.costings;
+      job_costings += r.costings;
       rs.slowest_subset_cpu_seconds = std::max(rs.slowest_subset_cpu_seconds, r.cpu_seconds);
       lists.push_back(std::move(r.records));
       rs.keys_reused += r.keys_reused;
@@ -912,13 +913,17 @@ ProgressiveMesh build_progressive_mesh_parallel(
                               st.pm_build_seconds;
   st.seconds = seconds_since(start);
   st.cpu_seconds = subsets_cpu + (thread_cpu_seconds() - master_cpu_start);
-  st.costings += master->costings();
+  // The master's: band passes and final pass.
+  const uint64_t master_costings = master->costings();
+  st.costings = job_costings + sample_costings + master_costings;
   pm.info.seconds = st.seconds;
   spdlog::debug(
-      "parallel build p={} rounds={}: {} -> {} faces in {:.3f} s ({:.3f} s CPU), final pass {} "
+      "parallel build p={} rounds={}: {} -> {} faces in {:.3f} s ({:.3f} s CPU; costings: {} "
+      "by the jobs, {} by their samples, {} by the band passes and final pass), final pass {} "
       "collapses in {:.3f} s ({})",
       parallel.subsets, st.rounds, input_faces, pm.base.face_count(), st.seconds, st.cpu_seconds,
-      st.final_pass_collapses, st.final_pass_seconds, st.stop_reason);
+      job_costings, sample_costings, master_costings, st.final_pass_collapses,
+      st.final_pass_seconds, st.stop_reason);
   return pm;
 }
 
