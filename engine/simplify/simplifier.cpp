@@ -243,8 +243,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
                     std::numeric_limits<float>::quiet_NaN());
   screen_ = priority_.costly();
 
-  // Every undirected edge once: from the face holding a->b with a < b, or from the only face
-  // of a boundary edge. The heap's order does not depend on the order of insertion.
+  // Every undirected edge once. The heap's order does not depend on the order of insertion.
   heap_.clear();
   compacted_size_ = 0;
   if (limits.first_queue_around) {
@@ -256,9 +255,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
                                                      mesh_.live_faces() > limits.defer_above_faces
                                                  ? limits.first_deferred
                                                  : nullptr;
-    // Every edge once, from its smaller end. (From the faces, an edge had to be told apart
-    // from its twin: a table of every face's twins, built by comparing every two faces around
-    // each vertex, took 2% of a small mesh's parallel build, which starts a queue per job.)
+    // From each edge's smaller end. (From the faces, an edge had to be told apart from its
+    // twin: a table of every face's twins, built by comparing every two faces around each
+    // vertex, took 2% of a small mesh's parallel build, which starts a queue per job.)
     std::vector<VertexId> ring;
     for (VertexId a = 0; a < mesh_.vertex_capacity(); ++a) {
       if (!mesh_.vertex_alive(a)) continue;
