@@ -22,6 +22,14 @@ void sort_unique_keys(std::vector<EdgeKey>& keys) {
       keys.end());
 }
 
+void check_deferred_edges(const std::vector<DeferredEdge>& edges, size_t vertex_capacity) {
+  for (const DeferredEdge& d : edges)
+    if (d.a >= d.b || d.b >= vertex_capacity)
+      throw_invalid("deferred edge (" + std::to_string(d.a) + ", " + std::to_string(d.b) +
+                    ") is not an edge of a mesh of " + std::to_string(vertex_capacity) +
+                    " vertices");
+}
+
 KeyMemo::KeyMemo(PriorityModule& inner, size_t vertex_capacity)
     : PriorityWrapper(inner), head_(vertex_capacity, kEnd), changed_at_(vertex_capacity, 0) {}
 

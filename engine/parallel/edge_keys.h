@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "simplify/modules.h"
+#include "simplify/simplifier.h"
 
 namespace parapm {
 
@@ -32,6 +33,11 @@ struct EdgeKey {
 
 // By (a, b).
 void sort_keys(std::vector<EdgeKey>& keys);
+
+// Throws Error(kInvalidInput) for a deferred edge that is not (a, b) with a < b below
+// `vertex_capacity`: a job's deferred edges may come from a worker, and the master indexes its
+// per-vertex arrays with them.
+void check_deferred_edges(const std::vector<DeferredEdge>& edges, size_t vertex_capacity);
 // By (a, b), one key per edge (the first of equal ones: std::sort is not stable, so only for
 // keys whose duplicates are equal).
 void sort_unique_keys(std::vector<EdgeKey>& keys);

@@ -727,7 +727,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
         // A job reports again what it was given and left as it was: its report first, so
         // that the sort, stable, keeps it.
         std::vector<DeferredEdge> now;
-        for (SubsetResult& r : results) now.insert(now.end(), r.deferred.begin(), r.deferred.end());
+        for (SubsetResult& r : results) {
+          check_deferred_edges(r.deferred, whole.vertex_capacity());
+          now.insert(now.end(), r.deferred.begin(), r.deferred.end());
+        }
         now.insert(now.end(), deferred.begin(), deferred.end());
         auto by_edge = [](const DeferredEdge& x, const DeferredEdge& y) {
           return x.a != y.a ? x.a < y.a : x.b < y.b;

@@ -435,8 +435,9 @@ TEST(JobCodec, MasterRefusesAReturnedStateOutsideItsMesh) {
   import_result_state(*round.master, result.state);  // the genuine one still goes in
 }
 
-// Queue keys name vertices: a job's must be its own (the decoder checks), a summary's the
-// master's (KeyMemo::reset checks, before they index anything).
+// Queue keys and deferred edges name vertices: a job's must be its own (the decoder checks), a
+// summary's the master's (KeyMemo::reset and check_deferred_edges check, before they index
+// anything).
 TEST(JobCodec, KeysOutsideTheMeshAreRefused) {
   std::vector<SubsetJob> jobs = jobs_of("stratocaster-9k.ply", "energy", 4);
   SubsetJob& job = jobs[2];
@@ -465,6 +466,24 @@ TEST(JobCodec, KeysOutsideTheMeshAreRefused) {
   try {
     memo.reset(decoded.keys);
     ADD_FAILURE() << "a key outside the mesh went in";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << e.what();
+  }
+
+  // Deferred edges alike: a job's own are checked by the decoder, a summary's by the master.
+  ASSERT_FALSE(job.deferred.empty());
+  job.deferred.push_back({job.deferred.back().a + 1, VertexId(job.mesh.vertex_count()), 1.0f});
+  EXPECT_FALSE(decodes(Kind::kJob, encode_subset_job(job), &message));
+  EXPECT_NE(message.find("deferred edge"), std::string::npos) << message;
+  ASSERT_FALSE(result.deferred.empty());
+  check_deferred_edges(result.deferred, repaired.mesh.vertex_count());  // the genuine ones pass
+  bad = result;
+  bad.deferred.push_back({VertexId(repaired.mesh.vertex_count()) - 1,
+                          VertexId(repaired.mesh.vertex_count()) + 5, 1.0f});
+  decode_subset_summary(encode_subset_summary(bad), decoded);
+  try {
+    check_deferred_edges(decoded.deferred, repaired.mesh.vertex_count());
+    ADD_FAILURE() << "a deferred edge outside the mesh went in";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << e.what();
   }
