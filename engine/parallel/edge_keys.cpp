@@ -9,18 +9,7 @@
 
 namespace parapm {
 
-void sort_keys(std::vector<EdgeKey>& keys) {
-  std::sort(keys.begin(), keys.end(),
-            [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
-}
-
-void sort_unique_keys(std::vector<EdgeKey>& keys) {
-  sort_keys(keys);
-  keys.erase(
-      std::unique(keys.begin(), keys.end(),
-                  [](const EdgeKey& x, const EdgeKey& y) { return x.a == y.a && x.b == y.b; }),
-      keys.end());
-}
+void sort_keys(std::vector<EdgeKey>& keys) { std::sort(keys.begin(), keys.end(), ByEdge{}); }
 
 void check_deferred_edges(const std::vector<DeferredEdge>& edges, size_t vertex_capacity) {
   for (const DeferredEdge& d : edges)

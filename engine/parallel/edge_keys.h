@@ -38,9 +38,6 @@ void sort_keys(std::vector<EdgeKey>& keys);
 // `vertex_capacity`: a job's deferred edges may come from a worker, and the master indexes its
 // per-vertex arrays with them.
 void check_deferred_edges(const std::vector<DeferredEdge>& edges, size_t vertex_capacity);
-// By (a, b), one key per edge (the first of equal ones: std::sort is not stable, so only for
-// keys whose duplicates are equal).
-void sort_unique_keys(std::vector<EdgeKey>& keys);
 
 // A priority module that remembers the inner module's queue keys, and answers the first queue
 // costing of an edge whose key was carried in (reset()) and whose ends no collapse has changed

@@ -231,11 +231,7 @@ std::vector<DeferredEdge> deferred_of_job(const std::vector<DeferredEdge>& defer
   std::vector<DeferredEdge> out;
   if (deferred.empty()) return out;
   auto keyed = [&](VertexId a, VertexId b) {
-    const auto it = std::lower_bound(keys.begin(), keys.end(), std::pair{a, b},
-                                     [](const EdgeKey& k, const std::pair<VertexId, VertexId>& e) {
-                                       return k.a != e.first ? k.a < e.first : k.b < e.second;
-                                     });
-    return it != keys.end() && it->a == a && it->b == b;
+    return std::binary_search(keys.begin(), keys.end(), EdgeKey{a, b, 0}, ByEdge{});
   };
   for (VertexId a = 0; a < global.size(); ++a) {
     if (!free[a]) continue;
@@ -251,9 +247,13 @@ std::vector<DeferredEdge> deferred_of_job(const std::vector<DeferredEdge>& defer
   return out;  // sorted: by a, then by b (global order is local order)
 }
 
-// Drops the deferred edges with an end in `changed` (a collapse's vs or vt: the deferral
-// no longer stands for the edge as it is).
-void drop_changed(std::vector<DeferredEdge>& deferred, const std::vector<uint8_t>& changed) {
+// Drops the deferred edges with an end that one of `lists`' collapses changed (its vs or vt:
+// the deferral no longer stands for the edge as it is).
+void drop_changed(std::vector<DeferredEdge>& deferred, size_t vertex_capacity,
+                  const std::vector<const std::vector<CollapseRecord>*>& lists) {
+  std::vector<uint8_t> changed(vertex_capacity, 0);
+  for (const std::vector<CollapseRecord>* list : lists)
+    for (const CollapseRecord& r : *list) changed[r.vs] = changed[r.vt] = 1;
   std::erase_if(deferred, [&](const DeferredEdge& d) { return changed[d.a] || changed[d.b]; });
 }
 
@@ -720,27 +720,18 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (carry_deferred) {
         // The deferred edges of the jobs' free vertices are the jobs' to report (a job holds
         // them all in its queue); the others stand unless a collapse changed an end.
-        std::vector<uint8_t> changed(whole.vertex_capacity(), 0);
-        for (const std::vector<CollapseRecord>& list : lists)
-          for (const CollapseRecord& r : list) changed[r.vs] = changed[r.vt] = 1;
-        drop_changed(deferred, changed);
+        std::vector<const std::vector<CollapseRecord>*> changes;
+        for (const std::vector<CollapseRecord>& list : lists) changes.push_back(&list);
+        drop_changed(deferred, whole.vertex_capacity(), changes);
         // A job reports again what it was given and left as it was: its report first, so
-        // that the sort, stable, keeps it.
+        // that the stable sort keeps it.
         std::vector<DeferredEdge> now;
         for (SubsetResult& r : results) {
           check_deferred_edges(r.deferred, whole.vertex_capacity());
           now.insert(now.end(), r.deferred.begin(), r.deferred.end());
         }
         now.insert(now.end(), deferred.begin(), deferred.end());
-        auto by_edge = [](const DeferredEdge& x, const DeferredEdge& y) {
-          return x.a != y.a ? x.a < y.a : x.b < y.b;
-        };
-        std::stable_sort(now.begin(), now.end(), by_edge);
-        now.erase(std::unique(now.begin(), now.end(),
-                              [](const DeferredEdge& x, const DeferredEdge& y) {
-                                return x.a == y.a && x.b == y.b;
-                              }),
-                  now.end());
+        sort_unique_edges(now);
         deferred = std::move(now);
       }
       keys.reset(returned);
@@ -816,11 +807,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
       foreseen.partition_seconds = timed.side_seconds[1];
       subsets_cpu += timed.side_cpu_elsewhere;
       rs.band_pass_collapses = band_records.size();
-      if (carry_deferred && !band_records.empty()) {
-        std::vector<uint8_t> changed(whole.vertex_capacity(), 0);
-        for (const CollapseRecord& r : band_records) changed[r.vs] = changed[r.vt] = 1;
-        drop_changed(deferred, changed);
-      }
+      if (carry_deferred && !band_records.empty())
+        drop_changed(deferred, whole.vertex_capacity(), {&band_records});
       records.insert(records.end(), std::make_move_iterator(band_records.begin()),
                      std::make_move_iterator(band_records.end()));
     }
@@ -866,9 +854,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   if (options.defer_recosting) limits.defer_above_faces = defer_line;
   // The jobs' deferred edges that no key answers (sorted: a subsequence of a sorted list).
   std::erase_if(deferred, [&](const DeferredEdge& d) {
-    return std::binary_search(
-        carried.begin(), carried.end(), EdgeKey{d.a, d.b, 0},
-        [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+    return std::binary_search(carried.begin(), carried.end(), EdgeKey{d.a, d.b, 0}, ByEdge{});
   });
   limits.first_deferred = &deferred;
   const uint64_t done_before = input_faces - whole.live_faces();

@@ -48,7 +48,7 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
     }
   out.costings = module->costings();
   // Carried keys answered the edges they cover: those came back the same.
-  if (keys.size() > carried) sort_unique_keys(keys);
+  if (keys.size() > carried) sort_unique_edges(keys);
   return out;
 }
 

@@ -65,11 +65,16 @@ void Simplifier::remember_key(VertexId a, VertexId b, float key) {
     if (slot) *slot = key;
 }
 
-bool Simplifier::deferred_entry(VertexId a, VertexId b, Entry& entry) {
-  if (a > b) std::swap(a, b);
+float Simplifier::remembered_key(VertexId a, VertexId b) {
   float key = std::numeric_limits<float>::quiet_NaN();
   for (const float* slot : key_slots(a, b))
     if (slot && !std::isnan(*slot)) key = std::isnan(key) ? *slot : std::min(key, *slot);
+  return key;
+}
+
+bool Simplifier::deferred_entry(VertexId a, VertexId b, Entry& entry) {
+  if (a > b) std::swap(a, b);
+  float key = remembered_key(a, b);
   if (std::isnan(key)) return false;
   // Below it: a collapse beside an edge mostly raises its cost (points move into its star),
   // and an edge that comes out too early only costs one costing. A refused edge (infinite)
@@ -87,17 +92,6 @@ bool Simplifier::defer_edge(VertexId a, VertexId b) {
   return true;
 }
 
-float Simplifier::hinted_key(const std::vector<DeferredEdge>& hints, VertexId a, VertexId b) {
-  if (a > b) std::swap(a, b);
-  const auto it =
-      std::lower_bound(hints.begin(), hints.end(), std::pair{a, b},
-                       [](const DeferredEdge& h, const std::pair<VertexId, VertexId>& e) {
-                         return h.a != e.first ? h.a < e.first : h.b < e.second;
-                       });
-  return it != hints.end() && it->a == a && it->b == b ? it->key
-                                                       : std::numeric_limits<float>::quiet_NaN();
-}
-
 std::vector<DeferredEdge> Simplifier::deferred_edges() {
   std::vector<DeferredEdge> out;
   if (!defer_) return out;
@@ -105,20 +99,11 @@ std::vector<DeferredEdge> Simplifier::deferred_edges() {
     if (!(e.stamp & kDeferred) || is_stale(e)) continue;
     // The key it was deferred from: its faces' remembered keys, which only a costing of the
     // edge itself rewrites (and that would have made this entry current, not deferred).
-    float key = std::numeric_limits<float>::quiet_NaN();
-    for (const float* slot : key_slots(e.a, e.b))
-      if (slot && !std::isnan(*slot)) key = std::isnan(key) ? *slot : std::min(key, *slot);
+    const float key = remembered_key(e.a, e.b);
     if (!std::isnan(key)) out.push_back({e.a, e.b, key});
   }
   // An edge deferred twice without an end changing in between is listed once.
-  std::sort(out.begin(), out.end(), [](const DeferredEdge& x, const DeferredEdge& y) {
-    return x.a != y.a ? x.a < y.a : x.b < y.b;
-  });
-  out.erase(std::unique(out.begin(), out.end(),
-                        [](const DeferredEdge& x, const DeferredEdge& y) {
-                          return x.a == y.a && x.b == y.b;
-                        }),
-            out.end());
+  sort_unique_edges(out);
   return out;
 }
 
@@ -264,16 +249,25 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       // The first costing of every edge takes a while with the energy: stay cancellable.
       if (cancel && (a & 1023) == 0) cancel->check();
       mesh_.neighbors(a, ring);
+      // The hints at a: sorted by (a, b), searched once per vertex, not once per edge.
+      const DeferredEdge* hint_first = nullptr;
+      const DeferredEdge* hint_end = nullptr;
+      if (hints) {
+        const auto first =
+            std::lower_bound(hints->begin(), hints->end(), DeferredEdge{a, 0, 0}, ByEdge{});
+        const auto end = std::lower_bound(first, hints->end(), DeferredEdge{a + 1, 0, 0}, ByEdge{});
+        hint_first = hints->data() + (first - hints->begin());
+        hint_end = hints->data() + (end - hints->begin());
+      }
       for (const VertexId b : ring) {
         if (b < a) continue;
         Entry entry;
-        if (hints) {
-          const float key = hinted_key(*hints, a, b);
-          if (!std::isnan(key)) {
-            remember_key(a, b, key);
-            if (deferred_entry(a, b, entry)) heap_.items().push_back(entry);
-            continue;
-          }
+        const DeferredEdge* hint =
+            std::find_if(hint_first, hint_end, [&](const DeferredEdge& h) { return h.b == b; });
+        if (hint != hint_end && !std::isnan(hint->key)) {  // (a NaN key is no key)
+          remember_key(a, b, hint->key);
+          if (deferred_entry(a, b, entry)) heap_.items().push_back(entry);
+          continue;
         }
         if (queue_entry(a, b, entry)) heap_.items().push_back(entry);
       }

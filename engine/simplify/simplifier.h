@@ -4,6 +4,7 @@
 // Progressive Mesh is built, and which a worker streams back to the coordinator.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -46,6 +47,24 @@ struct DeferredEdge {
   VertexId b = kNoId;
   float key = 0;  // its last costing's key; infinite: the module refused it then
 };
+
+// Edge records (DeferredEdge, the parallel build's EdgeKey: anything with ends a < b) in
+// (a, b) order, the order their lists are kept and searched in.
+struct ByEdge {
+  template <typename X, typename Y>
+  bool operator()(const X& x, const Y& y) const {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  }
+};
+
+// Sorts `edges` by (a, b) and keeps one record per edge: the first of its records (stable).
+template <typename Edge>
+void sort_unique_edges(std::vector<Edge>& edges) {
+  std::stable_sort(edges.begin(), edges.end(), ByEdge{});
+  edges.erase(std::unique(edges.begin(), edges.end(),
+                          [](const Edge& x, const Edge& y) { return x.a == y.a && x.b == y.b; }),
+              edges.end());
+}
 
 struct SimplifierLimits {
   size_t target_faces = 0;  // stop once the live face count is <= this (0: go as far as legal)
@@ -152,8 +171,8 @@ class Simplifier {
   bool defer_edge(VertexId a, VertexId b);
   // The entry defer_edge would push; false when the edge has no remembered key.
   bool deferred_entry(VertexId a, VertexId b, Entry& entry);
-  // Its key in `hints` (SimplifierLimits::first_deferred), or NaN.
-  static float hinted_key(const std::vector<DeferredEdge>& hints, VertexId a, VertexId b);
+  // The lower of edge {a, b}'s faces' remembered keys; NaN for none.
+  float remembered_key(VertexId a, VertexId b);
   // The key last computed for edge {a, b} stays with its faces (the two corners' slots of
   // face_keys_), through collapses that rename an end: the faces keep their ids and corners.
   void remember_key(VertexId a, VertexId b, float key);

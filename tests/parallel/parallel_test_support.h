@@ -70,7 +70,7 @@ inline std::vector<EdgeKey> fresh_keys(const PriorityModule& master, const Colla
           master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], c, Costing::kQueue);
       keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
     }
-  sort_unique_keys(keys);  // an inner edge is listed by both its faces
+  sort_unique_edges(keys);  // an inner edge is listed by both its faces
   return keys;
 }
 
