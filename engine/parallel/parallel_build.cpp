@@ -257,6 +257,13 @@ void drop_changed(std::vector<DeferredEdge>& deferred, size_t vertex_capacity,
   std::erase_if(deferred, [&](const DeferredEdge& d) { return changed[d.a] || changed[d.b]; });
 }
 
+// `requested` with its kByMetric floors set for `master`'s metric.
+ParallelOptions with_metric_floors(ParallelOptions requested, const PriorityModule& master) {
+  for (uint64_t* floor : {&requested.min_subset_faces, &requested.extra_round_subset_faces})
+    if (*floor == kByMetric) *floor = subset_faces_by_metric(master.costly());
+  return requested;
+}
+
 }  // namespace
 
 std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
@@ -289,29 +296,31 @@ uint32_t scheduled_rounds(const ParallelOptions& parallel) {
   return parallel.rounds ? parallel.rounds : default_rounds(parallel.subsets);
 }
 
+uint64_t subset_faces_by_metric(bool costly_metric) { return costly_metric ? 2000 : 8000; }
+
 ProgressiveMesh build_progressive_mesh_parallel(
-    const RepairedMesh& repaired, const SimplifyOptions& options, const ParallelOptions& parallel,
+    const RepairedMesh& repaired, const SimplifyOptions& options, const ParallelOptions& requested,
     ParallelStats* stats, const ProgressCallback& progress, const CancelToken* cancel,
     SubsetRunner* runner, const ParallelEvents& events) {
   const auto start = std::chrono::steady_clock::now();
   const double master_cpu_start = thread_cpu_seconds();
   check_simplify_options(options);
   const Mesh& mesh = repaired.mesh;
-  check_parallel_options(parallel, mesh.vertex_count());
+  check_parallel_options(requested, mesh.vertex_count());
   ParallelStats local_stats;
   ParallelStats& st = stats ? *stats : local_stats;
   st = {};
-  st.subsets = parallel.subsets;
-  const uint32_t rounds = scheduled_rounds(parallel);
+  st.subsets = requested.subsets;
+  const uint32_t rounds = scheduled_rounds(requested);
   st.rounds = rounds;
-  st.threads = pool_threads(parallel.threads, parallel.subsets);
-  ThreadPoolRunner pool(parallel.threads);
+  st.threads = pool_threads(requested.threads, requested.subsets);
+  ThreadPoolRunner pool(requested.threads);
   if (!runner) runner = &pool;
 
   const uint64_t input_faces = mesh.face_count();
   const uint64_t target = target_face_count(input_faces, options);
   const uint64_t handover = std::max<uint64_t>(
-      target, uint64_t(std::llround(parallel.handover_ratio * double(input_faces))));
+      target, uint64_t(std::llround(requested.handover_ratio * double(input_faces))));
   const std::vector<uint8_t> locked = locked_vertices(repaired, options.free_copies);
   // Above it, edges are costed when they reach the top of the queue (SimplifierLimits).
   const uint64_t defer_line = defer_recosting_line(input_faces);
@@ -323,6 +332,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   auto t = std::chrono::steady_clock::now();
   CollapseMesh whole(mesh);
   std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
+  const ParallelOptions parallel = with_metric_floors(requested, *master);
   // The first round's partition needs the mesh only: it is drawn beside the master's
   // initialisation, whose independent parts run side by side too (all read `whole`, none
   // through its marks; each writes its own data).
@@ -378,6 +388,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // Keys are worth carrying only where a costing costs more than remembering it (costly()).
   const bool carry_keys = parallel.carry_keys && master->costly();
   const bool carry_deferred = carry_keys && parallel.carry_deferred;
+  // What the band passes and the final pass cost with. Without carried keys the memo would
+  // answer nothing, and its lookups (a walk of every edge ever costed at the vertex) took the
+  // quadric's final pass on fandisk-13k to 1.7x the sequential build's time.
+  PriorityModule& master_queue = carry_keys ? static_cast<PriorityModule&>(keys) : *master;
   // The setup's own time: the first partition is round 0's (which the critical path counts
   // only where it outlasts the initialisation: RoundStats::partition_overlap_seconds).
   st.setup_seconds = seconds_since(t) - section_seconds + initialize_seconds;
@@ -771,7 +785,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
         bound_before[v] &= bound[v];
         if (bound_before[v]) lagging.push_back(VertexId(v));
       }
-      BandPriority band(keys, std::move(bound_before), ceiling);
+      BandPriority band(master_queue, std::move(bound_before), ceiling);
       Simplifier pass(whole, band, standard_constraints(locked, whole_components()));
       SimplifierLimits band_limits;
       band_limits.target_faces = std::max<uint64_t>(1, target);
@@ -847,7 +861,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       carry_keys ? keys.current_keys(whole) : std::vector<EdgeKey>{};
   keys.reset(carried);
   const uint64_t reused_before = keys.reused();
-  std::unique_ptr<PriorityModule> continued = without_initialize(keys);
+  std::unique_ptr<PriorityModule> continued = without_initialize(master_queue);
   Simplifier final_pass(whole, *continued, standard_constraints(locked, whole_components()));
   SimplifierLimits limits;
   limits.target_faces = target;

@@ -13,6 +13,7 @@
 #include <grpcpp/generic/generic_stub.h>
 
 #include "io/mesh_io.h"
+#include "parallel/parallel_build.h"
 #include "pm/levels.h"
 #include "pm/pm_file.h"
 #include "rpc_security.h"
@@ -98,7 +99,10 @@ class ServiceJobs : public ServiceTest {
 TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   start(3);
   const std::set<std::string> names = {"w1", "w2", "w3"};
-  build_and_compare("stratocaster-9k.ply", options(4, parapm::v1::METRIC_QUADRIC, 0.05, 7), names);
+  // (The quadric's own floor, 8000 faces a subset, would leave the 9k-face guitar no round.)
+  parapm::v1::JobOptions guitar = options(4, parapm::v1::METRIC_QUADRIC, 0.05, 7);
+  guitar.set_min_subset_faces(2000);
+  build_and_compare("stratocaster-9k.ply", guitar, names);
   // The energy metric's state (points, curves, wedge classes) travels in the subset jobs;
   // the airplane has colours, so the wedge changes do too. So does its tuning, here not the
   // defaults: `--star-planes-weight 3 --volume-weight 0 --spring-scale 0.01
@@ -122,9 +126,10 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   parapm::v1::JobOptions free_copies = options(2, parapm::v1::METRIC_QUADRIC, 0);
   free_copies.set_free_copies(true);
   build_and_compare("cad-cycloidal-43k.ply", free_copies, names);
-  // At p = 12 the 20k-face vessel's rounds take at most one subset per 2000 faces (the
-  // default, as `parapm simplify` builds it: 10 in round 0), or 12 in every round with
-  // `--min-subset-faces 0` (negative in the message).
+  // At p = 12 the 20k-face vessel's rounds take at most one subset per 8000 faces (the
+  // quadric's default, as `parapm simplify` builds it: 2 in round 0), or 12 in every round
+  // with `--min-subset-faces 0` (negative in the message).
+  const uint64_t floor = subset_faces_by_metric(false);
   for (const int64_t min_subset_faces : {0, -1}) {
     parapm::v1::JobOptions capped = options(12, parapm::v1::METRIC_QUADRIC, 0.01);
     capped.set_min_subset_faces(min_subset_faces);
@@ -137,9 +142,9 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
       if (min_subset_faces < 0) {
         EXPECT_EQ(partitioned.subsets(), 12u) << describe(e);
       } else {
-        EXPECT_LE(partitioned.subsets(), partitioned.faces() / 2000) << describe(e);
+        EXPECT_LE(partitioned.subsets(), partitioned.faces() / floor) << describe(e);
         if (partitioned.round() == 0) {
-          EXPECT_EQ(partitioned.subsets(), 10u) << describe(e);
+          EXPECT_EQ(partitioned.subsets(), 2u) << describe(e);
         }
       }
       ++rounds;
@@ -162,6 +167,13 @@ TEST_F(ServiceJobs, EightConcurrentJobsAllComplete) {
                                           "pymeshlab-colored-airplane-11k.ply",
                                           "pymeshlab-bunny-textured-10k.obj"};
   constexpr size_t kJobs = 8;
+  // Rounds on the workers: the quadric's own floor (8000 faces a subset) would leave these
+  // meshes of 3k-11k faces none.
+  auto job_options = [](size_t i) {
+    parapm::v1::JobOptions o = options(2 + uint32_t(i % 3), parapm::v1::METRIC_QUADRIC, 0.1);
+    o.set_min_subset_faces(2000);
+    return o;
+  };
   struct Outcome {
     std::string mesh_id, job_id, error;
     parapm::v1::Job job;
@@ -173,8 +185,7 @@ TEST_F(ServiceJobs, EightConcurrentJobsAllComplete) {
       try {
         const auto upload = service().upload_file(mesh(files[i % files.size()]));
         outcomes[i].mesh_id = upload.mesh_id();
-        const auto job = service().submit(
-            upload.mesh_id(), options(2 + uint32_t(i % 3), parapm::v1::METRIC_QUADRIC, 0.1));
+        const auto job = service().submit(upload.mesh_id(), job_options(i));
         outcomes[i].job_id = job.job_id();
         outcomes[i].job = service().wait_for_job(job.job_id(), seconds(90));
       } catch (const std::exception& e) {
@@ -188,9 +199,7 @@ TEST_F(ServiceJobs, EightConcurrentJobsAllComplete) {
     EXPECT_EQ(outcomes[i].job.state(), parapm::v1::DONE) << outcomes[i].job.failure_reason();
     const std::string pm = service().download(outcomes[i].job_id);
     EXPECT_EQ(lossless_failure(pm, mesh(files[i % files.size()]), dir()), "");
-    const auto reference =
-        reference_pm(mesh(files[i % files.size()]),
-                     options(2 + uint32_t(i % 3), parapm::v1::METRIC_QUADRIC, 0.1), dir());
+    const auto reference = reference_pm(mesh(files[i % files.size()]), job_options(i), dir());
     EXPECT_TRUE(pm == reference) << "differs from parapm simplify";
   }
   // The proto's promise: the same bytes uploaded twice give the same mesh id, also when the
