@@ -34,8 +34,8 @@ struct SimplifyArgs {
   uint32_t rounds = ParallelOptions{}.rounds;
   double handover = ParallelOptions{}.handover_ratio;
   double border_excess = ParallelOptions{}.border_excess;
-  int64_t extra_round_faces = -1;  // -1: by the metric (subset_faces_by_metric)
-  int64_t min_subset_faces = -1;
+  uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
+  int64_t min_subset_faces = -1;  // -1: by the metric (subset_faces_by_metric)
   bool no_carry_keys = false;
   bool no_carry_deferred = false;
   bool no_deferred_recosting = false;
@@ -123,7 +123,7 @@ int run_simplify(const SimplifyArgs& args) {
     parallel.rounds = args.rounds;
     parallel.handover_ratio = args.handover;
     parallel.border_excess = args.border_excess;
-    if (args.extra_round_faces >= 0) parallel.extra_round_subset_faces = args.extra_round_faces;
+    parallel.extra_round_subset_faces = args.extra_round_faces;
     if (args.min_subset_faces >= 0) parallel.min_subset_faces = args.min_subset_faces;
     parallel.carry_keys = !args.no_carry_keys;
     parallel.carry_deferred = !args.no_carry_deferred;
@@ -307,23 +307,19 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                   "resolution; it removes at least 15% (0: geometric rounds only)")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
-  // The floors' defaults, as the build sets them by the metric.
-  const std::string by_metric =
-      "(default: " + std::to_string(subset_faces_by_metric(true)) + " for the energy, " +
-      std::to_string(subset_faces_by_metric(false)) +
-      " for the quadric, which does a tenth of the energy's work per face)";
   cmd->add_option("--extra-round-faces", args->extra_round_faces,
                   "With --parallel: past the handover, more rounds at the same ratio while the "
                   "next would leave each subset at least this many faces and the last one removed "
                   "at least 90% of what it was asked (or at least half, with 2.5x as many faces "
-                  "per subset); 0: none " +
-                      by_metric)
-      ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
+                  "per subset) (0: none)")
+      ->capture_default_str();
   cmd->add_option("--min-subset-faces", args->min_subset_faces,
                   "With --parallel: every round cuts the mesh into at most (its faces / this) "
                   "subsets, so a small mesh gets fewer than P (below 2, the rounds end and the "
-                  "final pass does the rest); 0: P subsets in every scheduled round " +
-                      by_metric)
+                  "final pass does the rest); 0: P subsets in every scheduled round (default: " +
+                      std::to_string(subset_faces_by_metric(true)) + " for the energy, " +
+                      std::to_string(subset_faces_by_metric(false)) +
+                      " for the quadric, which does a tenth of the energy's work per face)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
   cmd->add_flag("--no-carry-keys", args->no_carry_keys,
                 "With --parallel: every round's jobs cost all their edges again instead of "

@@ -168,11 +168,10 @@ void add_submit_command(CLI::App& app, int& exit_code) {
                   "a round ends where the faces along its cut hold at most this fraction of the "
                   "faces in excess (default 0.05; 0: none, geometric rounds only)")
       ->check(CLI::Range(0.0, 0.5));
-  cmd->add_option(
-         "--extra-round-faces", args->extra_round_faces,
-         "past the handover, more rounds while every subset keeps this many faces and "
-         "the last round did 90% of its share (2.5x as many faces after one that did "
-         "half) (default by the metric: 2000 for the energy, 8000 for the quadric; 0: none)")
+  cmd->add_option("--extra-round-faces", args->extra_round_faces,
+                  "past the handover, more rounds while every subset keeps this many faces and "
+                  "the last round did 90% of its share (2.5x as many faces after one that did "
+                  "half) (default 2000; 0: none)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
   cmd->add_option("--min-subset-faces", args->min_subset_faces,
                   "every round cuts the mesh into at most (its faces / this) subsets (default "

@@ -257,10 +257,10 @@ void drop_changed(std::vector<DeferredEdge>& deferred, size_t vertex_capacity,
   std::erase_if(deferred, [&](const DeferredEdge& d) { return changed[d.a] || changed[d.b]; });
 }
 
-// `requested` with its kByMetric floors set for `master`'s metric.
-ParallelOptions with_metric_floors(ParallelOptions requested, const PriorityModule& master) {
-  for (uint64_t* floor : {&requested.min_subset_faces, &requested.extra_round_subset_faces})
-    if (*floor == kByMetric) *floor = subset_faces_by_metric(master.costly());
+// `requested` with a kByMetric floor set for `master`'s metric.
+ParallelOptions with_metric_floor(ParallelOptions requested, const PriorityModule& master) {
+  if (requested.min_subset_faces == kByMetric)
+    requested.min_subset_faces = subset_faces_by_metric(master.costly());
   return requested;
 }
 
@@ -296,7 +296,7 @@ uint32_t scheduled_rounds(const ParallelOptions& parallel) {
   return parallel.rounds ? parallel.rounds : default_rounds(parallel.subsets);
 }
 
-uint64_t subset_faces_by_metric(bool costly_metric) { return costly_metric ? 2000 : 8000; }
+uint64_t subset_faces_by_metric(bool costly_metric) { return costly_metric ? 4000 : 8000; }
 
 ProgressiveMesh build_progressive_mesh_parallel(
     const RepairedMesh& repaired, const SimplifyOptions& options, const ParallelOptions& requested,
@@ -332,7 +332,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   auto t = std::chrono::steady_clock::now();
   CollapseMesh whole(mesh);
   std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
-  const ParallelOptions parallel = with_metric_floors(requested, *master);
+  const ParallelOptions parallel = with_metric_floor(requested, *master);
   // The first round's partition needs the mesh only: it is drawn beside the master's
   // initialisation, whose independent parts run side by side too (all read `whole`, none
   // through its marks; each writes its own data).

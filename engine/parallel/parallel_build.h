@@ -20,16 +20,18 @@
 
 namespace parapm {
 
-// ParallelOptions' subset floors chosen by the metric (subset_faces_by_metric).
+// ParallelOptions::min_subset_faces chosen by the metric (subset_faces_by_metric).
 inline constexpr uint64_t kByMetric = ~uint64_t{0};
 
 // The faces a subset needs to be worth its round, for a metric whose costings are costly
-// (PriorityModule::costly(): the energy) or cheap (the quadric). A round's fixed work
-// (partition, extraction, edge sample, merge) is about the same per face for both, while the
-// quadric does about a tenth of the energy's work per face: with the energy's 2000 faces per
-// subset, the quadric's parallel build of a 20k-face mesh took 1.3-2.2x the sequential build's
-// CPU in 5-7 rounds of a few milliseconds each; with 8000, 0.9-1.07x, and a critical path as
-// short (docs/BENCHMARKS.md, "Subset floors by the metric").
+// (PriorityModule::costly(): the energy) or cheap (the quadric): 4000 and 8000. A round's
+// fixed work (partition, extraction, edge sample, merge, band pass, the jobs' set-up) is about
+// the same per face for both, while the quadric does about a tenth of the energy's work per
+// face. At 2000 faces a subset for both, 18 meshes at p = 16 took 1.09x (energy) and 1.37x
+// (quadric) the sequential build's CPU (geometric means; 10-25k-face meshes 1.2-1.35x and
+// 1.5-2.1x, in 5-7 rounds); at 4000 and 8000, 0.99x and 1.05x, with RMS as close to the
+// sequential PM's or closer, and the 871k dragon's build unchanged (docs/BENCHMARKS.md, "Subset
+// floors by the metric").
 uint64_t subset_faces_by_metric(bool costly_metric);
 
 struct ParallelOptions {
@@ -46,13 +48,13 @@ struct ParallelOptions {
   double handover_ratio = 0.1;
   // Past the handover, further rounds at the same ratio per round, while the last round
   // removed at least 90% of the faces its jobs were asked to, each with as many subsets (up to p,
-  // at least 2) as leave each subset at least this many faces (0: none; kByMetric:
-  // subset_faces_by_metric); after a round that removed only half of it (stopped at its cost
-  // ceiling), 2.5 times this many. A large mesh gets its final pass shorter (the 871k dragon
-  // at p = 16: 7 rounds, the last ones on 11, 6 and 3 subsets; the 203k dragon: one more round
-  // on 2 subsets at any p); a small one does not (docs/BENCHMARKS.md, "After the energy's queue
-  // keys", "Narrower extra rounds", "Extra rounds after a short round").
-  uint64_t extra_round_subset_faces = kByMetric;
+  // at least 2) as leave each subset at least this many faces (0: none); after a round that
+  // removed only half of it (stopped at its cost ceiling), 2.5 times this many. A large mesh gets
+  // its final pass shorter (the 871k dragon at p = 16: 7 rounds, the last ones on 11, 6 and 3
+  // subsets; the 203k dragon: one more round on 2 subsets at any p); a small one does not
+  // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds", "Extra
+  // rounds after a short round").
+  uint64_t extra_round_subset_faces = 2000;
   // Every round cuts the mesh into at most (its faces / this) subsets (at least 2, else the
   // rounds end and the final pass does the rest): a subset of few faces is mostly border, which
   // its job cannot touch, and a round whose border band is a large part of the mesh is shortened

@@ -519,23 +519,24 @@ TEST(ParallelBuild, RoundsBoundedByTheirBorderBand) {
 }
 
 // A round cuts the mesh into at most (its faces / min_subset_faces) subsets: the 20k-face
-// vessel at p = 16 gets 10 subsets in its first round and fewer as it shrinks (never below 2),
-// and it takes fewer rounds (each of fixed work: partition, extraction, merge) than with 16
-// subsets of 1.2k faces, a fifth of which are border band.
+// vessel at p = 16 gets 5 subsets in its first round (the energy's floor, 4000 faces a
+// subset) and fewer as it shrinks (never below 2), and it takes fewer rounds (each of fixed
+// work: partition, extraction, merge) than with 16 subsets of 1.2k faces, a fifth of which are
+// border band.
 TEST(ParallelBuild, SmallMeshesTakeFewerSubsets) {
   const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
   const SimplifyOptions options = metric_options("energy", 0.01);
   ParallelOptions capped;  // the defaults: the energy's floor
   capped.subsets = 16;
   ASSERT_EQ(capped.min_subset_faces, kByMetric);
-  ASSERT_EQ(subset_faces_by_metric(true), 2000u);
+  const uint64_t floor = subset_faces_by_metric(true);
   ParallelStats stats, uncapped_stats;
   const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, capped, &stats);
   ASSERT_FALSE(stats.round_stats.empty());
-  EXPECT_EQ(stats.round_stats[0].subsets.size(), repaired.mesh.face_count() / 2000);
+  EXPECT_EQ(stats.round_stats[0].subsets.size(), repaired.mesh.face_count() / floor);
   for (const RoundStats& r : stats.round_stats) {
     EXPECT_GE(r.subsets.size(), 2u) << "round " << r.round;
-    EXPECT_LE(r.subsets.size(), r.faces_before / 2000) << "round " << r.round;
+    EXPECT_LE(r.subsets.size(), r.faces_before / floor) << "round " << r.round;
   }
   const MeshDifference diff =
       compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
@@ -551,15 +552,15 @@ TEST(ParallelBuild, SmallMeshesTakeFewerSubsets) {
   EXPECT_LT(stats.round_stats.size(), uncapped_stats.round_stats.size());
 }
 
-// The quadric's subsets hold four times the energy's faces (subset_faces_by_metric): its work
-// per face is a tenth of the energy's, a round's fixed work per face the same. The 20k-face
-// vessel at p = 16 gets 2 subsets in its first round, not 10, and fewer rounds; given the
-// energy's floor explicitly, the quadric gets the energy's subsets.
+// The quadric's subsets hold twice the energy's faces (subset_faces_by_metric): its work per
+// face is a tenth of the energy's, a round's fixed work per face the same. The 20k-face vessel
+// at p = 16 gets 2 subsets in its first round, not 5, and fewer rounds; given the energy's
+// floor explicitly, the quadric gets the energy's subsets.
 TEST(ParallelBuild, TheQuadricsSubsetsHoldMoreFaces) {
   const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
   const SimplifyOptions options = metric_options("quadric", 0.01);
   const uint64_t floor = subset_faces_by_metric(false);
-  ASSERT_EQ(floor, 4 * subset_faces_by_metric(true));
+  ASSERT_EQ(floor, 2 * subset_faces_by_metric(true));
   ParallelOptions by_metric;  // the defaults
   by_metric.subsets = 16;
   ParallelStats stats, energy_floor_stats;
@@ -575,8 +576,7 @@ TEST(ParallelBuild, TheQuadricsSubsetsHoldMoreFaces) {
   EXPECT_TRUE(diff.equal) << diff.first_difference;
 
   ParallelOptions energy_floor = by_metric;
-  energy_floor.min_subset_faces = energy_floor.extra_round_subset_faces =
-      subset_faces_by_metric(true);
+  energy_floor.min_subset_faces = subset_faces_by_metric(true);
   build_progressive_mesh_parallel(repaired, options, energy_floor, &energy_floor_stats);
   EXPECT_EQ(energy_floor_stats.round_stats[0].subsets.size(),
             repaired.mesh.face_count() / subset_faces_by_metric(true));
