@@ -370,6 +370,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   // the band pass's; carried into the next round's jobs and the final pass (edge_keys.h).
   KeyMemo keys(*master, whole.vertex_capacity());
   uint64_t job_costings = 0, sample_costings = 0;  // (ParallelStats::costings)
+  uint64_t master_sample_costings = 0;             // of those, the master's own (sample_on_master)
   // The edges jobs left deferred (global ids, sorted), kept until a collapse changes an end:
   // the next round's jobs and the final pass queue them deferred (SubsetJob::deferred).
   std::vector<DeferredEdge> deferred;
@@ -593,6 +594,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
     std::vector<SubsetJob> jobs(subsets);
     std::vector<uint64_t> removable(subsets, 0);
     std::vector<SubsetSample> samples(sample ? subsets : 0);
+    // A cheap metric's sample is costed by the master (sample_on_master): the tasks only pick
+    // its edges. A costly one's is costed side by side in the tasks.
+    const bool sample_in_tasks = sample && master->costly();
+    std::vector<SampledEdges> sampled(sample && !sample_in_tasks ? subsets : 0);
     // Per face, the subset whose job owns its three corners: the only state that may list it.
     face_subset.assign(whole.face_capacity(), kNoId);
     std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
@@ -613,7 +618,10 @@ ProgressiveMesh build_progressive_mesh_parallel(
       if (carry_keys) jobs[i].keys = keys_of_job(keys, jobs[i], free);
       if (sample) {
         const double sample_start = thread_cpu_seconds();
-        samples[i] = sample_subset(jobs[i], free, carry_keys, jobs[i].keys);
+        if (sample_in_tasks)
+          samples[i] = sample_subset(jobs[i], free, carry_keys, jobs[i].keys);
+        else
+          sampled[i] = sampled_edges(jobs[i], free);
         sample_cpu[i] = thread_cpu_seconds() - sample_start;
       }
       if (carry_deferred) jobs[i].deferred = deferred_of_job(deferred, jobs[i], free, jobs[i].keys);
@@ -623,6 +631,13 @@ ProgressiveMesh build_progressive_mesh_parallel(
     RoundCosts round_costs;
     if (sample) {
       const auto ts = std::chrono::steady_clock::now();
+      if (!sample_in_tasks) {
+        const double sample_start = thread_cpu_seconds();
+        for (size_t i = 0; i < jobs.size(); ++i)
+          samples[i] = sample_on_master(jobs[i], sampled[i], whole, *master);
+        rs.share_seconds += thread_cpu_seconds() - sample_start;
+        for (const SubsetSample& s : samples) master_sample_costings += s.costings;
+      }
       round_costs =
           round_costs_of(samples, rs.faces_before - rs.goal_faces, parallel.water_level_factor);
       if (!parallel.cost_shares) round_costs.cheap_fraction.clear();
@@ -917,7 +932,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   st.seconds = seconds_since(start);
   st.cpu_seconds = subsets_cpu + (thread_cpu_seconds() - master_cpu_start);
   // The master's: band passes and final pass.
-  const uint64_t master_costings = master->costings();
+  const uint64_t master_costings = master->costings() - master_sample_costings;
   st.costings = job_costings + sample_costings + master_costings;
   pm.info.seconds = st.seconds;
   spdlog::debug(

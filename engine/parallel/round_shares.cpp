@@ -11,14 +11,11 @@
 
 namespace parapm {
 
-SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
-                           std::vector<EdgeKey>& keys) {
-  if (job.state.empty()) throw_internal("sample_subset: a job without the master's state");
-  SubsetSample out;
-  const Mesh& mesh = job.mesh;
+SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& free) {
+  SampledEdges out;
   auto inner = [&](VertexId a, VertexId b) { return a < b && job.owned[a] && job.owned[b]; };
   uint64_t free_edges = 0;
-  for (const Triangle& t : mesh.faces)
+  for (const Triangle& t : job.mesh.faces)
     for (int k = 0; k < 3; ++k) {
       const VertexId a = t[k], b = t[(k + 1) % 3];
       out.inner_edges += inner(a, b) ? 1 : 0;
@@ -26,7 +23,24 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
     }
   if (free_edges == 0) return out;
   const uint64_t stride = std::max<uint64_t>(1, free_edges / kSampledEdgesPerSubset);
-  CollapseMesh local(mesh);
+  out.edges.reserve(free_edges / stride + 1);
+  uint64_t index = 0;
+  for (const Triangle& t : job.mesh.faces)
+    for (int k = 0; k < 3; ++k) {
+      const VertexId a = t[k], b = t[(k + 1) % 3];
+      if (inner(a, b) && free[a] && free[b] && index++ % stride == 0) out.edges.push_back({a, b});
+    }
+  return out;
+}
+
+SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
+                           std::vector<EdgeKey>& keys) {
+  if (job.state.empty()) throw_internal("sample_subset: a job without the master's state");
+  const SampledEdges sampled = sampled_edges(job, free);
+  SubsetSample out;
+  out.inner_edges = sampled.inner_edges;
+  if (sampled.edges.empty()) return out;
+  CollapseMesh local(job.mesh);
   std::unique_ptr<PriorityModule> module = job_module(job, local);
   std::optional<KeyMemo> memo;
   if (carry_keys) {
@@ -34,21 +48,33 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
     memo->reset(keys);
   }
   const PriorityModule& costing = memo ? static_cast<const PriorityModule&>(*memo) : *module;
-  uint64_t index = 0;
   const size_t carried = keys.size();
-  for (const Triangle& t : mesh.faces)
-    for (int k = 0; k < 3; ++k) {
-      const VertexId a = t[k], b = t[(k + 1) % 3];
-      if (!inner(a, b) || !free[a] || !free[b] || index++ % stride != 0) continue;
-      CollapseCandidate c;
-      const bool placed = costing.evaluate(local, a, b, c, Costing::kQueue);
-      out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
-      if (carry_keys)
-        keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
-    }
+  for (const auto& [a, b] : sampled.edges) {
+    CollapseCandidate c;
+    const bool placed = costing.evaluate(local, a, b, c, Costing::kQueue);
+    out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
+    if (carry_keys)
+      keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
+  }
   out.costings = module->costings();
   // Carried keys answered the edges they cover: those came back the same.
   if (keys.size() > carried) sort_unique_edges(keys);
+  return out;
+}
+
+SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
+                              const CollapseMesh& whole, const PriorityModule& master) {
+  SubsetSample out;
+  out.inner_edges = edges.inner_edges;
+  const uint64_t costings_before = master.costings();
+  out.costs.reserve(edges.edges.size());
+  for (const auto& [a, b] : edges.edges) {
+    CollapseCandidate c;
+    const bool placed =
+        master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], c, Costing::kQueue);
+    out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
+  }
+  out.costings = master.costings() - costings_before;
   return out;
 }
 

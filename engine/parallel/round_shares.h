@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "parallel/edge_keys.h"
@@ -50,6 +51,15 @@ struct SubsetSample {
   std::vector<double> costs;  // infinite: the module could not place the edge
 };
 
+// The edges a subset's sample costs: every stride-th of its inner edges with two free ends
+// (local ids, a < b, in the job's face order), about kSampledEdgesPerSubset of them, and the
+// count of its inner edges.
+struct SampledEdges {
+  uint64_t inner_edges = 0;
+  std::vector<std::pair<VertexId, VertexId>> edges;
+};
+SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& free);
+
 // The sample of a job's subset (a job with the master's state: Error(kInternal) otherwise),
 // costed by the job's own module, imported from the job's state as simplify_subset imports
 // it, so that the subsets' samples are costed side by side (in the extraction's tasks).
@@ -60,6 +70,16 @@ struct SubsetSample {
 // job does not cost them again (its module costs them alike: same state).
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
                            std::vector<EdgeKey>& keys);
+
+// The same sample costed by the master's module on the whole mesh (`edges` from
+// sampled_edges(job, ...), translated to global ids): the costs the job's own module would
+// give (its state is the master's, job_state.h), without building the job's mesh and module a
+// second time. For a cheap metric (PriorityModule::costly() false: the quadric, whose sampled
+// costs never travel as keys): its sample, costed in the extraction's tasks, spent more on
+// those copies (3 ms of a 45 ms build on the rocker arm) than on its costings. Not
+// thread-safe (the master's module); out.costings counts the master's costings of it.
+SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
+                              const CollapseMesh& whole, const PriorityModule& master);
 
 // The round's costs from its subsets' samples (one per job, in order), each sampled edge
 // standing for its subset's inner edges over its sampled ones; `remove`: the faces the round

@@ -83,6 +83,33 @@ TEST(RoundShares, WithoutCarriedKeysTheKeysStayEmpty) {
   }
 }
 
+// The master costs a cheap metric's sample on the whole mesh (sample_on_master): the same
+// edges, and the same costs bit for bit, as the job's own module costs on the job's mesh, for
+// either metric (the master's state is the job's).
+TEST(RoundShares, TheMasterCostsTheSampleAsTheJobsModuleDoes) {
+  for (const char* metric : {"quadric", "energy"})
+    for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
+      SimplifyOptions options;
+      options.metric = metric;
+      testing::RoundZero round(name, options, 3);
+      for (SubsetJob& job : round.jobs) {
+        const std::string what =
+            std::string(metric) + " " + name + " subset " + std::to_string(job.subset);
+        const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+        std::vector<EdgeKey> no_keys;
+        const SubsetSample own = sample_subset(job, free, false, no_keys);
+        const SubsetSample master =
+            sample_on_master(job, sampled_edges(job, free), round.whole, *round.master);
+        EXPECT_EQ(master.inner_edges, own.inner_edges) << what;
+        ASSERT_FALSE(own.costs.empty()) << what;
+        ASSERT_EQ(master.costs.size(), own.costs.size()) << what;
+        for (size_t i = 0; i < own.costs.size(); ++i)
+          ASSERT_EQ(master.costs[i], own.costs[i]) << what << " edge " << i;
+        EXPECT_EQ(master.costings, master.costs.size()) << what;
+      }
+    }
+}
+
 // Two subsets: 900 inner edges sampled by 9 costs (1 ... 9, each standing for 100 edges) and
 // 100 edges by 10 costs (10 ... 19, each for 10). A round removing 400 faces takes about 200
 // collapses of 1000 edges: the water level is at the 20% quantile of the edges, 3 (counting
