@@ -93,6 +93,11 @@ Coordinator::Coordinator(CoordinatorConfig config)
 }
 
 Coordinator::~Coordinator() {
+  stop();
+  for (std::thread& t : schedulers_) t.join();
+}
+
+void Coordinator::stop() {
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
@@ -100,7 +105,6 @@ Coordinator::~Coordinator() {
   }
   queue_changed_.notify_all();
   events_changed_.notify_all();
-  for (std::thread& t : schedulers_) t.join();
 }
 
 Upload Coordinator::begin_upload(const std::string& file_name) const {

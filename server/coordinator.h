@@ -66,8 +66,12 @@ struct UploadResult {
 class Coordinator {
  public:
   explicit Coordinator(CoordinatorConfig config);
-  ~Coordinator();  // stops the scheduler; running jobs are cancelled and stay "running" in
-                   // the database, to be re-run by the next start
+  ~Coordinator();  // stop(), then waits for the schedulers
+  // Starts no job any more and cancels the running ones, which stay "running" in the
+  // database, to be re-run by the next start. Called on SIGTERM before the server drains its
+  // calls: a job still computing while the server waits (up to 2 s) for open event streams
+  // would finish instead of being left to the next start. Idempotent.
+  void stop();
   Coordinator(const Coordinator&) = delete;
   Coordinator& operator=(const Coordinator&) = delete;
 

@@ -68,8 +68,9 @@ int run(const CoordinatorArgs& args) {
   }
   const std::string signal = rpc::wait_for_shutdown_signal();
   spdlog::info("{}: stopping (running jobs re-run at the next start)", signal);
+  coordinator.stop();  // before the calls drain, so that running jobs stop now
   server.server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
-  return 0;  // ~Coordinator stops the schedulers
+  return 0;  // ~Coordinator waits for the schedulers
 }
 
 }  // namespace
