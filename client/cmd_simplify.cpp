@@ -38,6 +38,7 @@ struct SimplifyArgs {
   int64_t min_subset_faces = -1;  // -1: by the metric (subset_faces_by_metric)
   bool no_carry_keys = false;
   bool no_carry_deferred = false;
+  bool no_band_pass = false;
   bool no_deferred_recosting = false;
   bool json = false;
 };
@@ -127,6 +128,7 @@ int run_simplify(const SimplifyArgs& args) {
     if (args.min_subset_faces >= 0) parallel.min_subset_faces = args.min_subset_faces;
     parallel.carry_keys = !args.no_carry_keys;
     parallel.carry_deferred = !args.no_carry_deferred;
+    parallel.band_pass = !args.no_band_pass;
     pm = build_progressive_mesh_parallel(loaded.repaired, options, parallel, &parallel_stats,
                                          bar.callback(), nullptr);
     stats.collapses = parallel_stats.collapses;
@@ -325,6 +327,10 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                 "With --parallel: every round's jobs cost all their edges again instead of "
                 "starting from the queue keys (and deferred edges) the round before left (for "
                 "measuring the work they save; the PM differs a little, docs/BENCHMARKS.md)");
+  cmd->add_flag("--no-band-pass", args->no_band_pass,
+                "With --parallel: no sequential pass over what two rounds' borders both kept "
+                "after each round; the next round's jobs and the final pass take it (for "
+                "measuring; the PM differs, docs/BENCHMARKS.md)");
   cmd->add_flag("--no-carry-deferred", args->no_carry_deferred,
                 "With --parallel: the edges a round's jobs left deferred are costed afresh by "
                 "the next round's jobs, not queued deferred again (for measuring the work it "
