@@ -518,6 +518,25 @@ TEST(ParallelBuild, RoundsBoundedByTheirBorderBand) {
   }
 }
 
+// Builds with `parallel` and checks that every round kept `floor` faces a subset: round 0 cut
+// in (faces / floor) subsets, every round in 2 or more and at most (its faces / floor); and the
+// PM lossless.
+ParallelStats build_with_floor(const RepairedMesh& repaired, const SimplifyOptions& options,
+                               const ParallelOptions& parallel, uint64_t floor) {
+  ParallelStats stats;
+  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, parallel, &stats);
+  if (stats.round_stats.empty()) return stats;
+  EXPECT_EQ(stats.round_stats[0].subsets.size(), repaired.mesh.face_count() / floor);
+  for (const RoundStats& r : stats.round_stats) {
+    EXPECT_GE(r.subsets.size(), 2u) << "round " << r.round;
+    EXPECT_LE(r.subsets.size(), r.faces_before / floor) << "round " << r.round;
+  }
+  const MeshDifference diff =
+      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
+  EXPECT_TRUE(diff.equal) << diff.first_difference;
+  return stats;
+}
+
 // A round cuts the mesh into at most (its faces / min_subset_faces) subsets: the 20k-face
 // vessel at p = 16 gets 5 subsets in its first round (the energy's floor, 4000 faces a
 // subset) and fewer as it shrinks (never below 2), and it takes fewer rounds (each of fixed
@@ -530,18 +549,10 @@ TEST(ParallelBuild, SmallMeshesTakeFewerSubsets) {
   capped.subsets = 16;
   ASSERT_EQ(capped.min_subset_faces, kByMetric);
   const uint64_t floor = subset_faces_by_metric(true);
-  ParallelStats stats, uncapped_stats;
-  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, capped, &stats);
+  const ParallelStats stats = build_with_floor(repaired, options, capped, floor);
   ASSERT_FALSE(stats.round_stats.empty());
-  EXPECT_EQ(stats.round_stats[0].subsets.size(), repaired.mesh.face_count() / floor);
-  for (const RoundStats& r : stats.round_stats) {
-    EXPECT_GE(r.subsets.size(), 2u) << "round " << r.round;
-    EXPECT_LE(r.subsets.size(), r.faces_before / floor) << "round " << r.round;
-  }
-  const MeshDifference diff =
-      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
-  EXPECT_TRUE(diff.equal) << diff.first_difference;
 
+  ParallelStats uncapped_stats;
   ParallelOptions uncapped = capped;
   uncapped.min_subset_faces = 0;
   build_progressive_mesh_parallel(repaired, options, uncapped, &uncapped_stats);
@@ -563,18 +574,10 @@ TEST(ParallelBuild, TheQuadricsSubsetsHoldMoreFaces) {
   ASSERT_EQ(floor, 2 * subset_faces_by_metric(true));
   ParallelOptions by_metric;  // the defaults
   by_metric.subsets = 16;
-  ParallelStats stats, energy_floor_stats;
-  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, by_metric, &stats);
+  const ParallelStats stats = build_with_floor(repaired, options, by_metric, floor);
   ASSERT_FALSE(stats.round_stats.empty());
-  EXPECT_EQ(stats.round_stats[0].subsets.size(), repaired.mesh.face_count() / floor);
-  for (const RoundStats& r : stats.round_stats) {
-    EXPECT_GE(r.subsets.size(), 2u) << "round " << r.round;
-    EXPECT_LE(r.subsets.size(), r.faces_before / floor) << "round " << r.round;
-  }
-  const MeshDifference diff =
-      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
-  EXPECT_TRUE(diff.equal) << diff.first_difference;
 
+  ParallelStats energy_floor_stats;
   ParallelOptions energy_floor = by_metric;
   energy_floor.min_subset_faces = subset_faces_by_metric(true);
   build_progressive_mesh_parallel(repaired, options, energy_floor, &energy_floor_stats);
