@@ -175,9 +175,8 @@ void add_submit_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
   cmd->add_option("--min-subset-faces", args->min_subset_faces,
                   "every round cuts the mesh into at most (its faces / this) subsets (default "
-                  "by the metric: 2000 for the energy, 8000 for the quadric; 0: P subsets in every "
-                  "scheduled "
-                  "round)")
+                  "by the metric: 4000 for the energy, 8000 for the quadric; 0: P subsets in "
+                  "every scheduled round)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
   cmd->add_option("--seed", args->seed, "seed of the randomised steps")->capture_default_str();
   cmd->add_option("--samples-per-face", args->samples_per_face, "energy: extra sample points")
