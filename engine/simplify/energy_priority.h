@@ -135,6 +135,7 @@ class EnergyPriority : public PriorityModule {
         star_terms_on_(options.star_planes_weight > 0 || options.volume_weight > 0) {}
   std::string name() const override { return "energy"; }
   bool costly() const override { return true; }
+  double rank_penalty() const override { return topology_penalty_; }
   void initialize(const CollapseMesh& mesh) override;
   // The sharp curves, and the rest (the sample points, the per-face lists, E_scalar).
   std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) override;
