@@ -11,6 +11,10 @@ namespace parapm {
 
 void sort_keys(std::vector<EdgeKey>& keys) { std::sort(keys.begin(), keys.end(), ByEdge{}); }
 
+bool has_key(const std::vector<EdgeKey>& keys, VertexId a, VertexId b) {
+  return std::binary_search(keys.begin(), keys.end(), EdgeKey{a, b, 0}, ByEdge{});
+}
+
 void check_deferred_edges(const std::vector<DeferredEdge>& edges, size_t vertex_capacity) {
   for (const DeferredEdge& d : edges)
     if (d.a >= d.b || d.b >= vertex_capacity)

@@ -33,6 +33,8 @@ struct EdgeKey {
 
 // By (a, b).
 void sort_keys(std::vector<EdgeKey>& keys);
+// Whether `keys` (sorted by (a, b)) holds a key of edge (a, b).
+bool has_key(const std::vector<EdgeKey>& keys, VertexId a, VertexId b);
 
 // Throws Error(kInvalidInput) for a deferred edge that is not (a, b) with a < b below
 // `vertex_capacity`: a job's deferred edges may come from a worker, and the master indexes its

@@ -230,9 +230,6 @@ std::vector<DeferredEdge> deferred_of_job(const std::vector<DeferredEdge>& defer
   const std::vector<VertexId>& global = job.global_vertex;
   std::vector<DeferredEdge> out;
   if (deferred.empty()) return out;
-  auto keyed = [&](VertexId a, VertexId b) {
-    return std::binary_search(keys.begin(), keys.end(), EdgeKey{a, b, 0}, ByEdge{});
-  };
   for (VertexId a = 0; a < global.size(); ++a) {
     if (!free[a]) continue;
     auto d = std::lower_bound(deferred.begin(), deferred.end(), global[a],
@@ -241,7 +238,7 @@ std::vector<DeferredEdge> deferred_of_job(const std::vector<DeferredEdge>& defer
       const auto it = std::lower_bound(global.begin() + a + 1, global.end(), d->b);
       if (it == global.end() || *it != d->b) continue;
       const auto b = VertexId(it - global.begin());
-      if (free[b] && !keyed(a, b)) out.push_back({a, b, d->key});
+      if (free[b] && !has_key(keys, a, b)) out.push_back({a, b, d->key});
     }
   }
   return out;  // sorted: by a, then by b (global order is local order)
@@ -882,9 +879,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
   limits.target_faces = target;
   if (options.defer_recosting) limits.defer_above_faces = defer_line;
   // The jobs' deferred edges that no key answers (sorted: a subsequence of a sorted list).
-  std::erase_if(deferred, [&](const DeferredEdge& d) {
-    return std::binary_search(carried.begin(), carried.end(), EdgeKey{d.a, d.b, 0}, ByEdge{});
-  });
+  std::erase_if(deferred, [&](const DeferredEdge& d) { return has_key(carried, d.a, d.b); });
   limits.first_deferred = &deferred;
   const uint64_t done_before = input_faces - whole.live_faces();
   const double final_setup_seconds = seconds_since(t);

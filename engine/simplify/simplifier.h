@@ -164,10 +164,10 @@ class Simplifier {
     const uint32_t tx = x.stamp & kPenalised, ty = y.stamp & kPenalised;
     return tx != ty ? tx < ty : x.cost < y.cost;
   }
-  struct Before {  // cheapest first, ties broken by the edge's ids for determinism
+  struct Before {  // key_below, ties broken by the edge's ids for determinism
     bool operator()(const Entry& x, const Entry& y) const {
-      if (key_below(x, y)) return true;
-      if (key_below(y, x)) return false;
+      if ((x.stamp ^ y.stamp) & kPenalised) return (x.stamp & kPenalised) < (y.stamp & kPenalised);
+      if (x.cost != y.cost) return x.cost < y.cost;
       if (x.a != y.a) return x.a < y.a;
       return x.b < y.b;
     }
