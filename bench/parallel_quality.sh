@@ -6,9 +6,10 @@
 # and reused by later runs with the same LABEL-free name), then the parallel PM for every p of
 # PS (default "2 4 8 16") with the extra options PAR_ARGS (e.g. "--border-excess 0"), and
 # prints one TSV row per mesh and p: metro's RMS and Hausdorff of the parallel level over the
-# sequential level of the same face count at 50%, 10% and 2% of the input faces (1.000: as
-# good), the rounds performed, the parallel build's seconds and its work (CPU over the sequential
-# build's CPU: the median over WORK_REPEATS pairs, default 3, of a parallel build and a
+# sequential level of the same face count at 50%, 10% and 2% of the input faces and at the
+# base (at the larger of the two base meshes' face counts: the base of one, a level of the
+# other) (1.000: as good), the rounds performed, the parallel build's seconds and its work (CPU
+# over the sequential build's CPU: the median over WORK_REPEATS pairs, default 3, of a parallel build and a
 # sequential build timed one after the other, so that both see the machine of the same minute;
 # a sequential time kept from another run made the small meshes' work swing by 30%, their
 # builds lasting a fifth of a second), and its costings (the edges all its modules costed over
@@ -92,8 +93,17 @@ one_mesh() {
       "$(median <<< "$ratios")" \
       "$(jq -n --argjson a "$(jq .parallel.costings <<< "$pj")" --argjson b "$seq_costings" \
         '$a / $b')")"
-    for level in 50 10 2; do
-      n=$(( in_faces * level / 100 ))
+    # The base: both PMs at the larger base (a parallel build may stop a few faces apart).
+    local seq_base par_base
+    seq_base="$(jq -r .base_faces "$seq_json")"
+    par_base="$(jq -r .base_faces <<< "$pj")"
+    local base_n=$(( seq_base > par_base ? seq_base : par_base ))
+    local base_cache="$OUT/$name.$METRIC.seq.base$base_n.err"
+    [[ -s "$base_cache" ]] ||
+      level_error "$seq_pm" "$base_n" "$OUT/$name.$METRIC.seq.base$base_n.ply" > "$base_cache"
+    seq_err[base]="$(cat "$base_cache")"
+    for level in 50 10 2 base; do
+      if [[ "$level" == base ]]; then n=$base_n; else n=$(( in_faces * level / 100 )); fi
       local prms phd srms shd
       read -r prms phd <<< "$(level_error "$par_pm" "$n" "$OUT/$name.$METRIC.$LABEL.p$p.$level.ply")"
       read -r srms shd <<< "${seq_err[$level]}"
@@ -107,7 +117,7 @@ one_mesh() {
 export -f one_mesh
 
 tsv="$OUT/$LABEL.tsv"
-printf 'mesh\tlabel\tp\trounds\tseconds\twork\tcostings\trms_50\thd_50\trms_10\thd_10\trms_2\thd_2\n' |
+printf 'mesh\tlabel\tp\trounds\tseconds\twork\tcostings\trms_50\thd_50\trms_10\thd_10\trms_2\thd_2\trms_base\thd_base\n' |
   tee "$tsv"
 printf '%s\n' "$@" | xargs -P "${JOBS:-2}" -I{} bash -c 'one_mesh "$1"' _ {} | tee -a "$tsv"
 
@@ -115,7 +125,7 @@ printf '%s\n' "$@" | xargs -P "${JOBS:-2}" -I{} bash -c 'one_mesh "$1"' _ {} | t
 awk -F'\t' 'NR > 1 {
     p = $3; n[p]++; lw[p] += log($6); lc[p] += log($7); sr[p] += $4
     if ($7 > 1.15) cc[p]++
-    for (k = 0; k < 3; k++) {
+    for (k = 0; k < 4; k++) {
       r = $(8 + 2 * k); h = $(9 + 2 * k)
       lr[p, k] += log(r); lh[p, k] += log(h)
       if (r > 1.05) cr[p, k]++
@@ -124,12 +134,12 @@ awk -F'\t' 'NR > 1 {
     }
   }
   END {
-    split("50 10 2", lv, " ")
+    split("50% 10% 2% base", lv, " ")
     for (p in n) {
       line = sprintf("p = %s (%d meshes): rounds %.1f, work %.2f, costings %.3f (%d above 1.15);",
         p, n[p], sr[p] / n[p], exp(lw[p] / n[p]), exp(lc[p] / n[p]), cc[p])
-      for (k = 0; k < 3; k++)
-        line = line sprintf("  %s%% RMS %.3f (%d above 1.05, worst %.3f %s), Hausdorff %.3f (%d above 1.1)",
+      for (k = 0; k < 4; k++)
+        line = line sprintf("  %s RMS %.3f (%d above 1.05, worst %.3f %s), Hausdorff %.3f (%d above 1.1)",
           lv[k + 1], exp(lr[p, k] / n[p]), cr[p, k], wr[p, k], wm[p, k], exp(lh[p, k] / n[p]), ch[p, k])
       print line
     }

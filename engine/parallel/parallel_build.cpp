@@ -442,6 +442,14 @@ ProgressiveMesh build_progressive_mesh_parallel(
     plan.subsets = round_subsets(parallel, faces);
     if (plan.subsets < std::min(2u, parallel.subsets)) return plan;
     if (vertices < 4 * size_t(plan.subsets)) return plan;
+    // A round whose jobs removed less than a tenth of what they were asked ends the rounds:
+    // the mesh is stuck (locked copies of non-manifold vertices, or collapses only the final
+    // pass takes: penalised, or above every ceiling), and rounds on new partitions would
+    // extract, cost and merge it again for nothing (chair-dupfaces-13k, whose every vertex is
+    // locked: three rounds of no collapse took 6-9x the sequential build's CPU).
+    if (last && last->asked_faces > 0 &&
+        double(last->faces_before - last->faces_after) < 0.1 * double(last->asked_faces))
+      return plan;
     plan.scheduled = scheduled_rounds_left > 0;
     if (plan.scheduled) {
       if (faces <= handover) return plan;

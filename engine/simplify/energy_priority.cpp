@@ -121,14 +121,18 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
       out.point_values.insert(out.point_values.end(), scalar_.point_values(id),
                               scalar_.point_values(id) + floats);
   };
-  for (FaceId f : faces) {
-    const FaceId written = to_face(f);
+  // (Each id translated near its own position in the list: exact when the list is the map
+  // itself, a job's export_local.)
+  for (size_t i = 0; i < faces.size(); ++i) {
+    const FaceId f = faces[i];
+    const FaceId written = to_face.near(f, i);
     out.faces.push_back(written);
     for (const FacePoint& p : face_points_[f])
       add_point(p, written, kNoId, bounded_distance_sq(f, p));
   }
-  for (VertexId v : vertices) {
-    const VertexId written = to_vertex(v);
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const VertexId v = vertices[i];
+    const VertexId written = to_vertex.near(v, i);
     out.vertices.push_back(written);
     if (parked_point_[v] != kNoPoint) add_point(parked(parked_point_[v]), kNoId, written, 0.0);
   }

@@ -188,8 +188,9 @@ void ScalarAttributes::export_wedges(const std::vector<WedgeId>& wedges, const I
                                      EnergyState& out) const {
   if (floats_ == 0) return;
   std::unordered_map<WedgeId, WedgeId> first;  // class root -> first written wedge of it
-  for (WedgeId w : wedges) {
-    const WedgeId written = to(w);
+  for (size_t i = 0; i < wedges.size(); ++i) {
+    const WedgeId w = wedges[i];
+    const WedgeId written = to.near(w, i);  // (exact when `wedges` is the map, a job's)
     out.wedges.push_back(written);
     out.wedge_values.insert(out.wedge_values.end(), value(w), value(w) + floats_);
     out.wedge_class.push_back(first.try_emplace(root(w), written).first->second);

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include "mesh/repaired_input.h"
 #include "parallel/border_band.h"
@@ -588,6 +589,26 @@ TEST(ParallelBuild, TheQuadricsSubsetsHoldMoreFaces) {
       "floor\n",
       stats.round_stats.size(), energy_floor_stats.round_stats.size());
   EXPECT_LT(stats.round_stats.size(), energy_floor_stats.round_stats.size());
+}
+
+// A round whose jobs removed less than a tenth of their share ends the rounds (plan_round):
+// on chair-dupfaces-13k every vertex is a locked copy of a non-manifold one, no collapse is
+// legal, and rounds on new partitions would only extract and cost the mesh again (three did,
+// at 6-9x the sequential build's CPU). One round, then the final pass, and the sequential
+// build's PM.
+TEST(ParallelBuild, AStuckMeshEndsTheRounds) {
+  const std::filesystem::path path = testing::shared_meshes_dir() / "chair-dupfaces-13k.obj";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/meshes is not present";
+  const RepairedMesh repaired = repair_mesh(read_mesh(path.string()));
+  const SimplifyOptions options = metric_options("energy", 0.01);
+  ParallelOptions parallel;  // the defaults: 3 scheduled rounds at p = 4
+  parallel.subsets = 4;
+  ParallelStats stats;
+  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, parallel, &stats);
+  ASSERT_EQ(stats.round_stats.size(), 1u);
+  EXPECT_GE(stats.round_stats[0].subsets.size(), 2u);
+  EXPECT_EQ(stats.round_stats[0].faces_after, stats.round_stats[0].faces_before);
+  EXPECT_EQ(testing::pm_bytes(pm), testing::pm_bytes(build_progressive_mesh(repaired, options)));
 }
 
 // Rounds 0 (the default) schedules them by p: two at p = 2, three above (default_rounds).
