@@ -315,14 +315,14 @@ void SharpCurves::import_local(const CollapseMesh& mesh, const EnergyState& stat
     samples_.push_back({s.position, s.distance_sq, s.u, s.w});
     sample_id_.push_back(s.id);
   }
+  // Each list sized once (a job of a mesh of open sheets has lists at most of its vertices),
+  // by counts that a state cannot inflate beyond its own lists (they are checked below).
+  auto count = [](const std::vector<uint32_t>& begin, size_t k, size_t total) {
+    return begin[k + 1] > begin[k] ? std::min<size_t>(begin[k + 1] - begin[k], total) : 0;
+  };
   size_t ends = 0;
   for (size_t i = 0; i < n; ++i) {
     const VertexId v = state.vertices[i];
-    // Each list sized once (a job of a mesh of open sheets has lists at most of its vertices),
-    // by counts that a state cannot inflate beyond its own lists (they are checked below).
-    auto count = [](const std::vector<uint32_t>& begin, size_t i, size_t total) {
-      return begin[i + 1] > begin[i] ? std::min<size_t>(begin[i + 1] - begin[i], total) : 0;
-    };
     neighbors_[v].reserve(neighbors_[v].size() +
                           count(state.sharp_begin, i, state.sharp_neighbors.size()));
     listed_at_[v].reserve(listed_at_[v].size() + count(state.listed_begin, i, state.listed.size()));
