@@ -14,7 +14,12 @@
 # one-thread run), the implied speed-up (sequential CPU / critical path), and for the levels at 50%,
 # 10%, 2% of the input faces and the base mesh, metro's RMS and Hausdorff distances of the
 # parallel level relative to the sequential level of the same face count (1.00: as good).
-# Environment: METRICS, PS, RATIO, ROUNDS, HANDOVER, THREADS (default 0), BENCH_OUT (default
+# With REPEATS=N (default 1) every p is timed N times, each time right after a sequential build
+# of its own (the sequential time of the same minute: on a shared VM a build's time moves by
+# 10-25% from one minute to the next), and the row gives the medians of the N pairs, plus the
+# smallest and largest implied speed-ups (implied_min, implied_max); the metro columns come
+# from the one PM (the same bytes every time).
+# Environment: METRICS, PS, RATIO, ROUNDS, HANDOVER, THREADS (default 0), REPEATS, BENCH_OUT (default
 # ./bench-out-parallel), PARAPM_BUILD_DIR (default build/), METRO (default the one bench/run.sh
 # builds: $PEERS_BUILD/metro, PEERS_BUILD defaulting to ./.peers-build).
 set -euo pipefail
@@ -23,6 +28,8 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 metrics="${METRICS:-energy quadric}"
 ps="${PS:-2 4}"
 ratio="${RATIO:-0.01}"
+repeats="${REPEATS:-1}"
+[[ "$repeats" =~ ^[1-9][0-9]*$ ]] || { echo "$0: REPEATS must be a positive integer" >&2; exit 2; }
 out="${BENCH_OUT:-$PWD/bench-out-parallel}"
 bin="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
 metro="${METRO:-${PEERS_BUILD:-$PWD/.peers-build}/metro}"
@@ -41,8 +48,9 @@ level_error() {
   echo "$(jget "$m" .rms_rel) $(jget "$m" .hausdorff_rel)"
 }
 ratio_of() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.3f", a / b; else print "nan" }'; }
+median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { printf "%.3f", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
-printf 'mesh\tmetric\tp\trounds\tseq_wall\tseq_cpu\tpar_wall\tpar_cpu\tcpu_ratio\tcritical_path\timplied_speedup'
+printf 'mesh\tmetric\tp\trounds\tseq_wall\tseq_cpu\tpar_wall\tpar_cpu\tcpu_ratio\tcritical_path\timplied_speedup\timplied_min\timplied_max'
 for level in 50 10 2 base; do printf '\trms_%s\thausdorff_%s' "$level" "$level"; done
 printf '\n'
 for mesh in "$@"; do
@@ -62,18 +70,31 @@ for mesh in "$@"; do
     for p in $ps; do
       par_pm="$out/$name.$metric.p$p.pm"
       echo "[parallel] $name $metric p=$p" >&2
-      wj="$("$bin" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$metric" --ratio "$ratio" \
-        --parallel "$p" "${par_opts[@]}" --threads "${THREADS:-0}" --json)"
-      par_wall="$(jget "$wj" .seconds)"
-      pj="$("$bin" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$metric" --ratio "$ratio" \
-        --parallel "$p" "${par_opts[@]}" --threads 1 --json)"
+      seqs=() walls=() cpus=() crits=() implied=()
+      for ((i = 0; i < repeats; i++)); do
+        s="$seq_secs"
+        if ((i > 0)); then
+          s="$(jget "$("$bin" --log-level warn simplify "$mesh" -o "$seq_pm" --metric "$metric" \
+            --ratio "$ratio" --json)" .seconds)"
+        fi
+        wj="$("$bin" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$metric" --ratio "$ratio" \
+          --parallel "$p" "${par_opts[@]}" --threads "${THREADS:-0}" --json)"
+        pj="$("$bin" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$metric" --ratio "$ratio" \
+          --parallel "$p" "${par_opts[@]}" --threads 1 --json)"
+        seqs+=("$s") walls+=("$(jget "$wj" .seconds)") cpus+=("$(jget "$pj" .parallel.cpu_seconds)")
+        crits+=("$(jget "$pj" .parallel.critical_path_seconds)")
+        implied+=("$(ratio_of "$s" "${crits[-1]}")")
+      done
       par_base="$(jget "$pj" .base_faces)"
-      par_cpu="$(jget "$pj" .parallel.cpu_seconds)"
-      crit="$(jget "$pj" .parallel.critical_path_seconds)"
       rounds="$(jget "$pj" .parallel.rounds)"
-      printf '%s\t%s\t%s\t%s\t%.3f\t%.3f\t%.3f\t%.3f\t%s\t%.3f\t%s' "$name" "$metric" "$p" "$rounds" \
-        "$seq_secs" "$seq_secs" "$par_wall" "$par_cpu" "$(ratio_of "$par_cpu" "$seq_secs")" \
-        "$crit" "$(ratio_of "$seq_secs" "$crit")"
+      seq_med="$(median "${seqs[@]}")"
+      cpu_ratios=()
+      for ((i = 0; i < repeats; i++)); do cpu_ratios+=("$(ratio_of "${cpus[i]}" "${seqs[i]}")"); done
+      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s' "$name" "$metric" "$p" "$rounds" \
+        "$seq_med" "$seq_med" "$(median "${walls[@]}")" "$(median "${cpus[@]}")" \
+        "$(median "${cpu_ratios[@]}")" "$(median "${crits[@]}")" "$(median "${implied[@]}")" \
+        "$(printf '%s\n' "${implied[@]}" | sort -g | head -1)" \
+        "$(printf '%s\n' "${implied[@]}" | sort -g | tail -1)"
       for level in 50 10 2 base; do
         n=$([[ $level == base ]] && echo "$par_base" || echo $(( in_faces * level / 100 )))
         read -r prms phd <<< "$(level_error "$mesh" "$par_pm" "$n" "$out/$name.$metric.p$p.$level.ply")"

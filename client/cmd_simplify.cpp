@@ -310,10 +310,10 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
   cmd->add_option("--extra-round-faces", args->extra_round_faces,
-                  "With --parallel: past the handover, more rounds at the same ratio while the "
-                  "next would leave each subset at least this many faces and the last one removed "
-                  "at least 90% of what it was asked (or at least half, with 2.5x as many faces "
-                  "per subset) (0: none)")
+                  "With --parallel: past the handover, more rounds in even steps to the target "
+                  "(none removing less than 15% of its faces) while the next would leave each "
+                  "subset at least this many faces and the last one removed at least 90% of what "
+                  "it was asked (or at least half, with 2.5x as many faces per subset) (0: none)")
       ->capture_default_str();
   cmd->add_option("--min-subset-faces", args->min_subset_faces,
                   "With --parallel: every round cuts the mesh into at most (its faces / this) "

@@ -46,14 +46,15 @@ struct ParallelOptions {
   // on the whole mesh, collapses what the last round's borders kept and goes on to the
   // target. The defaults are measured in docs/ARCHITECTURE.md, "Parallel construction".
   double handover_ratio = 0.1;
-  // Past the handover, further rounds at the same ratio per round, while the last round
-  // removed at least 90% of the faces its jobs were asked to, each with as many subsets (up to p,
-  // at least 2) as leave each subset at least this many faces (0: none); after a round that
-  // removed only half of it (stopped at its cost ceiling), 2.5 times this many. A large mesh gets
-  // its final pass shorter (the 871k dragon at p = 16: 7 rounds, the last ones on 11, 6 and 3
-  // subsets; the 203k dragon: one more round on 2 subsets at any p); a small one does not
-  // (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra rounds", "Extra
-  // rounds after a short round").
+  // Past the handover, further rounds in even geometric steps to the target (as many as it is
+  // steps of the scheduled ratio away, rounded; none removing less than 15% of its faces),
+  // while the last round removed at least 90% of the faces its jobs were asked to, each with as
+  // many subsets (up to p, at least 2) as leave each subset at least this many faces (0: none);
+  // after a round that removed only half of it (stopped at its cost ceiling), 2.5 times this
+  // many. A large mesh gets its final pass shorter (the 871k dragon at p = 16: 8 rounds, the
+  // last ones on 16, 9 and 4 subsets; the 203k dragon: one more round, on 2-4 subsets); a
+  // small one does not (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra
+  // rounds", "Extra rounds after a short round", "Extra rounds in even steps").
   uint64_t extra_round_subset_faces = 2000;
   // Every round cuts the mesh into at most (its faces / this) subsets (at least 2, else the
   // rounds end and the final pass does the rest): a subset of few faces is mostly border, which

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -609,6 +610,37 @@ TEST(ParallelBuild, AStuckMeshEndsTheRounds) {
   EXPECT_GE(stats.round_stats[0].subsets.size(), 2u);
   EXPECT_EQ(stats.round_stats[0].faces_after, stats.round_stats[0].faces_before);
   EXPECT_EQ(testing::pm_bytes(pm), testing::pm_bytes(build_progressive_mesh(repaired, options)));
+}
+
+// Past the handover, the extra rounds step evenly to the target, each aiming to remove at least
+// 15% of its faces, and the last one aims at the target: stepping by the scheduled ratio and
+// stopping at the target used to end on slivers. The vessel at p = 2 with a floor of 200 faces
+// a subset and a target of 2%: after a round from 517 to 406 faces (the borders kept 23), rounds
+// from 429 and 408 faces to 406, each a round of fixed work for a few faces.
+TEST(ParallelBuild, ExtraRoundsStepEvenlyToTheTarget) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
+  const SimplifyOptions options = metric_options("quadric", 0.02);
+  ParallelOptions parallel = with_p(2, 0, /*rounds=*/0);
+  parallel.extra_round_subset_faces = 200;
+  ParallelStats stats;
+  const ProgressiveMesh pm = build_progressive_mesh_parallel(repaired, options, parallel, &stats);
+  const uint64_t input = repaired.mesh.face_count();
+  const uint64_t handover = uint64_t(std::llround(parallel.handover_ratio * double(input)));
+  const uint64_t target = uint64_t(std::llround(0.02 * double(input)));
+  const RoundStats* last_extra = nullptr;
+  for (const RoundStats& round : stats.round_stats) {
+    if (round.faces_before > handover) continue;  // a scheduled round
+    last_extra = &round;
+    EXPECT_LE(double(round.goal_faces), 0.85 * double(round.faces_before))
+        << "round " << round.round << " aims at " << round.goal_faces << " of "
+        << round.faces_before << " faces";
+  }
+  ASSERT_NE(last_extra, nullptr) << "no extra round: a weak test";
+  EXPECT_EQ(last_extra->goal_faces, target);
+  EXPECT_EQ(pm.base.face_count(), target);
+  const MeshDifference diff =
+      compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
+  EXPECT_TRUE(diff.equal) << diff.first_difference;
 }
 
 // Rounds 0 (the default) schedules them by p: two at p = 2, three above (default_rounds).
