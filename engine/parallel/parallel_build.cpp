@@ -472,9 +472,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
       const uint64_t floor = done >= 0.9 * asked ? parallel.extra_round_subset_faces
                                                  : parallel.extra_round_subset_faces * 5 / 2;
       // Even geometric steps to the target, as many as the target is steps away, rounded:
-      // stepping by `step` and stopping at the target left a last round of a sliver (the 871k
-      // dragon at p = 8: 11.6k -> 8.7k faces on 2 subsets, slower than the final pass doing it)
-      // and then one for the few faces the last round's border kept.
+      // stepping by `step` and stopping at the target ended on slivers (the 871k dragon at
+      // p = 8: 11.6k -> 8.7k faces on 2 subsets, then a round asked for the 111 faces the last
+      // one's border kept).
       if (step >= 1) return plan;
       const double to_target = std::max(1.0, double(target)) / double(faces);
       const double steps = std::max(1.0, std::round(std::log(to_target) / std::log(step)));
