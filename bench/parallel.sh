@@ -24,6 +24,8 @@
 # builds: $PEERS_BUILD/metro, PEERS_BUILD defaulting to ./.peers-build).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+# shellcheck source=bench/common.sh
+source "$root/bench/common.sh"
 [[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
 metrics="${METRICS:-energy quadric}"
 ps="${PS:-2 4}"
@@ -48,7 +50,6 @@ level_error() {
   echo "$(jget "$m" .rms_rel) $(jget "$m" .hausdorff_rel)"
 }
 ratio_of() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.3f", a / b; else print "nan" }'; }
-median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { printf "%.3f", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 printf 'mesh\tmetric\tp\trounds\tseq_wall\tseq_cpu\tpar_wall\tpar_cpu\tcpu_ratio\tcritical_path\timplied_speedup\timplied_min\timplied_max'
 for level in 50 10 2 base; do printf '\trms_%s\thausdorff_%s' "$level" "$level"; done
@@ -70,7 +71,7 @@ for mesh in "$@"; do
     for p in $ps; do
       par_pm="$out/$name.$metric.p$p.pm"
       echo "[parallel] $name $metric p=$p" >&2
-      seqs=() walls=() cpus=() crits=() implied=()
+      seqs=() walls=() cpus=() cpu_ratios=() crits=() implied=()
       for ((i = 0; i < repeats; i++)); do
         s="$seq_secs"
         if ((i > 0)); then
@@ -82,18 +83,17 @@ for mesh in "$@"; do
         pj="$("$bin" --log-level warn simplify "$mesh" -o "$par_pm" --metric "$metric" --ratio "$ratio" \
           --parallel "$p" "${par_opts[@]}" --threads 1 --json)"
         seqs+=("$s") walls+=("$(jget "$wj" .seconds)") cpus+=("$(jget "$pj" .parallel.cpu_seconds)")
+        cpu_ratios+=("$(ratio_of "${cpus[-1]}" "$s")")
         crits+=("$(jget "$pj" .parallel.critical_path_seconds)")
         implied+=("$(ratio_of "$s" "${crits[-1]}")")
       done
       par_base="$(jget "$pj" .base_faces)"
       rounds="$(jget "$pj" .parallel.rounds)"
-      seq_med="$(median "${seqs[@]}")"
-      cpu_ratios=()
-      for ((i = 0; i < repeats; i++)); do cpu_ratios+=("$(ratio_of "${cpus[i]}" "${seqs[i]}")"); done
+      seq_med="$(median <<< "${seqs[*]}")"
       printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s' "$name" "$metric" "$p" "$rounds" \
-        "$seq_med" "$seq_med" "$(median "${walls[@]}")" "$(median "${cpus[@]}")" \
-        "$(median "${cpu_ratios[@]}")" "$(median "${crits[@]}")" "$(median "${implied[@]}")" \
-        "$(printf '%s\n' "${implied[@]}" | sort -g | head -1)" \
+        "$seq_med" "$seq_med" "$(median <<< "${walls[*]}")" "$(median <<< "${cpus[*]}")" \
+        "$(median <<< "${cpu_ratios[*]}")" "$(median <<< "${crits[*]}")" \
+        "$(median <<< "${implied[*]}")" "$(printf '%s\n' "${implied[@]}" | sort -g | head -1)" \
         "$(printf '%s\n' "${implied[@]}" | sort -g | tail -1)"
       for level in 50 10 2 base; do
         n=$([[ $level == base ]] && echo "$par_base" || echo $(( in_faces * level / 100 )))

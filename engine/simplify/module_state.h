@@ -91,8 +91,7 @@ struct IdTranslation {
   // cache misses made a job's state export take as long as its simplification on a mesh
   // whose every edge is on a curve (openfoam-motorbike-332k).
   uint32_t near(uint32_t id, size_t hint) const {
-    if (id == kNoId) return kNoId;
-    if (!to_local) return (*map)[id];
+    if (id == kNoId || !to_local) return (*this)(id);
     const std::vector<uint32_t>& m = *map;
     if (m.empty()) return kNoId;
     hint = std::min(hint, m.size() - 1);
