@@ -396,11 +396,6 @@ ProgressiveMesh build_progressive_mesh_parallel(
   st.critical_path_seconds = st.setup_seconds;
 
   SubsetOptions subset_options = subset_options_of(options, mesh);
-  // Jobs leave the energy's penalised collapses (changing the curves' topology) to the final
-  // pass, which takes them last, as the sequential build does.
-  if (options.metric == "energy")
-    subset_options.max_cost = 0.1 * EnergyPriority::kTopologyPenalty *
-                              subset_options.reference_diagonal * subset_options.reference_diagonal;
 
   std::vector<CollapseRecord> records;
   // At most one collapse per vertex: no round's records move the earlier ones (growing by
@@ -444,7 +439,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
     if (vertices < 4 * size_t(plan.subsets)) return plan;
     // A round whose jobs removed less than a tenth of what they were asked ends the rounds:
     // the mesh is stuck (locked copies of non-manifold vertices, or collapses only the final
-    // pass takes: penalised, or above every ceiling), and rounds on new partitions would
+    // pass takes, above every ceiling), and rounds on new partitions would
     // extract, cost and merge it again for nothing (chair-dupfaces-13k, whose every vertex is
     // locked: three rounds of no collapse took 6-9x the sequential build's CPU).
     if (last && last->asked_faces > 0 &&

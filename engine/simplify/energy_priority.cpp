@@ -19,13 +19,6 @@
 namespace parapm {
 namespace {
 
-// Half the squared lengths of a face's edges: summed over faces, an interior edge counts
-// once (it has two faces) and a boundary edge half, which is all the spring term needs.
-double half_edges_sq(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = sub(b, a), bc = sub(c, b), ca = sub(a, c);
-  return 0.5 * (dot(ab, ab) + dot(bc, bc) + dot(ca, ca));
-}
-
 // Whether triangle (q0, q1, q2), of normal n (|n|^2 = n_sq), is wide enough to have a plane:
 // a thinner one is measured exactly, point by point.
 bool has_plane(double n_sq, const Vec3& q0, const Vec3& q1, const Vec3& q2) {
@@ -40,6 +33,13 @@ Vec3 rounded(Vec3 v, bool to_float) {
 }
 
 }  // namespace
+
+// The price per point of a change of the curves' topology: the same in every subset of a
+// mesh, which passes the whole mesh's diagonal.
+static double topology_price(double diagonal) {
+  const double moved = EnergyPriority::kTopologyPrice * diagonal;
+  return moved * moved;
+}
 
 double spring_constant(double points_per_face) {
   if (points_per_face < 4) return 1e-2;
@@ -68,9 +68,7 @@ void EnergyPriority::initialize_points(const CollapseMesh& mesh) {
   const std::vector<SurfaceSample> samples =
       sample_surface(mesh, options_.samples_per_face, options_.seed);
   const double diagonal = diagonal_of(mesh);
-  // Large against any ordinary change of energy (each point costs at most diagonal^2), and the
-  // same for every subset of a mesh, so that penalised costs still compare across subsets.
-  topology_penalty_ = diagonal * diagonal * kTopologyPenalty;
+  topology_price_ = topology_price(diagonal);
 
   const bool scalar = mesh.has_wedges() && attributes_.layout.any();
   scalar_.initialize(scalar ? attributes_.layout : AttributeLayout{}, attributes_.values,
@@ -176,7 +174,7 @@ EnergyState EnergyPriority::export_global(const CollapseMesh& mesh, const IdMaps
 
 void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& state) {
   const double diagonal = diagonal_of(mesh);
-  topology_penalty_ = diagonal * diagonal * kTopologyPenalty;
+  topology_price_ = topology_price(diagonal);
   const bool scalar = mesh.has_wedges() && attributes_.layout.any();
   scalar_.import_local(scalar ? attributes_.layout : AttributeLayout{},
                        options_.attribute_weight * diagonal, state);
@@ -593,16 +591,6 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
   return fit;
 }
 
-double EnergyPriority::spring_energy_after(const Vec3& v) const {
-  double sum = 0;
-  for (const StarFace& f : star_) {
-    // half_edges_sq(v, p1, p2), with the rim edge's term kept from the star's assembly.
-    const Vec3 to_p1 = sub(f.p1, v), from_p2 = sub(v, f.p2);
-    sum += 0.5 * (dot(to_p1, to_p1) + f.rim_sq + dot(from_p2, from_p2));
-  }
-  return sum;
-}
-
 bool EnergyPriority::folds(const Vec3& v) const {
   for (const StarFace& f : star_)
     if (face_folds(f.before, f.p1, f.p2, v, f.p1, f.p2)) return true;
@@ -653,7 +641,6 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   int edge_faces = 0;
   edge_faces_ = {kNoId, kNoId};
   joined_count_ = 0;
-  double spring_before = 0;
   // The star's planes before the collapse (area weighted), the sum of its faces' normals and
   // of normal.corner (the tetrahedra between v and the faces have signed volumes summing to
   // (normals.v - offsets) / 6), and twice its area; about a's position, so that the quadric's
@@ -673,7 +660,6 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       const Vec3& p0 = mesh.position(end);
       const Vec3& p1 = mesh.position(t[(k + 1) % 3]);
       const Vec3& p2 = mesh.position(t[(k + 2) % 3]);
-      spring_before += half_edges_sq(p0, p1, p2);
       if (star_terms_on_) {
         const Vec3 n = triangle_normal(p0, p1, p2);
         const double n_length = length(n);
@@ -698,8 +684,6 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       } else {
         star_.push_back({p1, p2, p0, t[(k + 1) % 3], t[(k + 2) % 3]});
         star_.back().source = f;
-        const Vec3 rim = sub(p2, p1);
-        star_.back().rim_sq = dot(rim, rim);
         if (scalar_.enabled()) {
           const auto& w = mesh.corner_wedges(f);
           star_.back().wedges = {w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
@@ -838,7 +822,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                                : nullptr);
     }
     curve_fit = curves_.gathered() ? curves_.project(v) : SharpCurves::Fit{};
-    double energy = fit.distance_sq + curve_fit.distance_sq + kappa * spring_energy_after(v);
+    double energy = fit.distance_sq + curve_fit.distance_sq;
     if (star_terms_on_) energy += star_terms_.evaluate(sub(v, star_origin_));
     if (placed < placements.size()) {
       placements[placed] = {v, energy, std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
@@ -898,7 +882,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
           // model is the reweighted planes'. The collapse is measured when it is performed.
           if (placed < placements.size()) {
             const double distance = by_moments ? plane_model.at(v) : fit.model_at(v);
-            double energy = distance + curve_fit.model_at(v) + kappa * spring_energy_after(v);
+            double energy = distance + curve_fit.model_at(v);
             if (star_terms_on_) energy += star_terms_.evaluate(sub(v, star_origin_));
             placements[placed++] = {v, energy, 0, kNotProjected};
           }
@@ -920,7 +904,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       break;
     }
   out.position = chosen->v;
-  out.cost = chosen->energy - distance_before - curve_before - kappa * spring_before;
+  out.cost = chosen->energy - distance_before - curve_before;
   out.error = std::sqrt(chosen->max_distance_sq);
   if (by_moments) out.cost += moment_rim_change(mesh, chosen->v);
   // E_scalar wants every point's projection at the chosen placement.
@@ -934,8 +918,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   // outweigh the attributes that much more than before (the airplane's colour RMS at 10%
   // doubled: 0.0119 -> 0.0232; with it 0.0110, docs/BENCHMARKS.md).
   if (scalar_.enabled()) out.cost += (1 + options_.star_planes_weight) * scalar_change();
-  // Penalised, not forbidden (Hoppe 96): such collapses come after every ordinary one.
-  if (topology) out.cost += topology_penalty_;
+  // Penalised, not forbidden (Hoppe 96), at a price per point of the star.
+  if (topology) out.cost += topology_price_ * std::max(1.0, points_around);
   return std::isfinite(out.cost);
 }
 

@@ -8,13 +8,16 @@
 //   points accumulate: Hoppe's schedule, scaled by EnergyOptions::spring_scale), and E_disc the
 //   same distance for points sampled on the sharp curves (boundaries, creases, seams), measured
 //   against the curves (sharp_curves.h), and E_scalar the attributes' error at the same points
-//   (scalar_attributes.h). A collapse that changes the curves' topology is penalised.
+//   (scalar_attributes.h). A collapse that changes the curves' topology pays a finite price.
 //
-// The cost of collapsing {a, b} is the change of E restricted to the star of the edge and the
-// points on it, with the surviving vertex placed by the best of three starts (a, b, the
-// midpoint), each refined by alternating projection of the points onto the new star and a
-// least-squares solve for the position (one moving vertex: the normal equations are a scalar
-// times the identity, solved in closed form). As in Hoppe 96, the attributes do not move the
+// The cost of collapsing {a, b} is the change of E, less E_spring, restricted to the star of
+// the edge and the points on it, with the surviving vertex placed by the best of three starts
+// (a, b, the midpoint), each refined by alternating projection of the points onto the new
+// star and a least-squares solve for the position (one moving vertex: the normal equations
+// are a scalar times the identity, solved in closed form). The springs shape that solve (a
+// regulariser) but neither choose among the placements nor price the collapse: priced, their
+// change (the star's squared edge lengths) let collapses that moved a curved surface go first
+// where they shortened long edges, and held back exact ones that lengthened them. As in Hoppe 96, the attributes do not move the
 // vertex: with the position chosen, the wedges' values are solved for and their change of
 // E_scalar is added to the cost.
 //
@@ -122,10 +125,11 @@ double spring_constant(double points_per_face);
 
 class EnergyPriority : public PriorityModule {
  public:
-  // A collapse that changes the curves' topology costs this times the squared reference
-  // diagonal more (each point costs at most one squared diagonal: any ordinary change of
-  // energy is far smaller).
-  static constexpr double kTopologyPenalty = 1e9;
+  // A collapse that changes the curves' topology pays, for each point of its star, the
+  // energy of a point moved by this fraction of the reference diagonal: a finite price (Hoppe
+  // 96's E_disc is one), so that an ordinary collapse moving the star's points farther than
+  // that on average waits behind it.
+  static constexpr double kTopologyPrice = 0.003;
 
   EnergyPriority(std::vector<uint8_t> locked, EnergyOptions options,
                  WedgeAttributes attributes = {})
@@ -135,7 +139,6 @@ class EnergyPriority : public PriorityModule {
         star_terms_on_(options.star_planes_weight > 0 || options.volume_weight > 0) {}
   std::string name() const override { return "energy"; }
   bool costly() const override { return true; }
-  double rank_penalty() const override { return topology_penalty_; }
   void initialize(const CollapseMesh& mesh) override;
   // The sharp curves, and the rest (the sample points, the per-face lists, E_scalar).
   std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) override;
@@ -221,7 +224,6 @@ class EnergyPriority : public PriorityModule {
     int next = -1, previous = -1;
     std::array<WedgeId, 3> wedges{};  // of the corners v, p1, p2 (with E_scalar)
     int group = 0;                    // E_scalar's group of the corner at v
-    double rim_sq = 0;                // |p2 - p1|^2: the spring term's part that v leaves alone
   };
   // Where one point projected: a star face and barycentric coordinates on (v, p1, p2).
   struct Projected {
@@ -292,7 +294,6 @@ class EnergyPriority : public PriorityModule {
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
                     EnergyState& out) const;
-  double spring_energy_after(const Vec3& v) const;
   bool folds(const Vec3& v) const;
 
   std::vector<uint8_t> locked_;
@@ -304,7 +305,7 @@ class EnergyPriority : public PriorityModule {
   WedgeAttributes attributes_;  // the input's; initialize copies them into scalar_
   mutable uint64_t costings_ = 0;
   mutable ScalarAttributes scalar_;  // its star scratch is used by the const evaluate
-  double topology_penalty_ = 0;      // added to a collapse that changes the curves' topology
+  double topology_price_ = 0;  // per point of the star, for a change of the curves' topology
   std::vector<uint32_t> point_id_;   // a job's: per point, the master's id (empty: identity)
 
   // Scratch of one evaluation (evaluate is const but, like CollapseMesh, not thread-safe).

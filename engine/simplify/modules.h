@@ -71,10 +71,6 @@ class PriorityModule {
   // build's modules it is the build's work in costings, the figure the parallel build's work
   // is compared with the sequential one's by, free of the machine's timing noise.
   virtual uint64_t costings() const { return 0; }
-  // A cost this module adds to rank a collapse after every one that has none (the energy's
-  // for a change of its curves' topology; 0: none). The simplifier keys such a collapse by the
-  // rest of its cost, after all others: added to a float key, the penalty swallowed the rest.
-  virtual double rank_penalty() const { return 0; }
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every
@@ -86,7 +82,6 @@ class PriorityWrapper : public PriorityModule {
   std::string name() const override { return inner_.name(); }
   bool costly() const override { return inner_.costly(); }
   uint64_t costings() const override { return inner_.costings(); }
-  double rank_penalty() const override { return inner_.rank_penalty(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) const override {

@@ -47,22 +47,11 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
     if (defer_) remember_key(a, b, std::numeric_limits<float>::infinity());
     return false;
   }
-  entry = entry_for(candidate.cost, a, b, version_[a] + version_[b]);
+  entry = {static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]};
   if (defer_) remember_key(a, b, static_cast<float>(candidate.cost));
   return true;
 }
 
-Simplifier::Entry Simplifier::entry_for(double cost, VertexId a, VertexId b,
-                                        uint32_t versions) const {
-  // (Half the penalty: a penalised change of energy may be negative; no other cost comes near.)
-  if (rank_penalty_ > 0 && cost >= 0.5 * rank_penalty_)
-    return {static_cast<float>(cost - rank_penalty_), a, b, versions | kPenalised};
-  return {static_cast<float>(cost), a, b, versions};
-}
-
-double Simplifier::cost_of(const Entry& entry) const {
-  return double(entry.cost) + ((entry.stamp & kPenalised) ? rank_penalty_ : 0.0);
-}
 
 std::array<float*, 2> Simplifier::key_slots(VertexId a, VertexId b) {
   const EdgeFaces edge = mesh_.edge_faces(a, b);
@@ -148,7 +137,7 @@ bool Simplifier::topologically_legal(VertexId a, VertexId b) const {
 
 bool Simplifier::is_stale(const Entry& entry) const {
   return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
-         version_[entry.a] + version_[entry.b] != (entry.stamp & ~(kDeferred | kPenalised));
+         version_[entry.a] + version_[entry.b] != (entry.stamp & ~kDeferred);
 }
 
 void Simplifier::compact_heap() {
@@ -229,7 +218,6 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
                                             const CancelToken* cancel) {
   stats_ = {};
   priority_.initialize(mesh_);
-  rank_penalty_ = priority_.rank_penalty();
   for (const auto& module : constraints_) module->initialize(mesh_);
   version_.assign(mesh_.vertex_capacity(), 0);
   star_changed_at_.assign(mesh_.vertex_capacity(), 0);
@@ -316,7 +304,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.stale;
       continue;
     }
-    if (cost_of(entry) > limits.max_cost) {  // and so does every entry after it
+    if (entry.cost > limits.max_cost) {  // and so does every entry after it
       heap_.push(entry);                     // (deferred_edges() lists what the queue holds)
       stats_.stop_reason = "cost ceiling reached";
       break;
@@ -369,8 +357,8 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       heap_.pop();
       ++stats_.stale;
     }
-    const Entry now = entry_for(candidate.cost, entry.a, entry.b, entry.stamp & ~kPenalised);
-    if (!heap_.empty() && key_below(heap_.top(), now)) {
+    const Entry now{static_cast<float>(candidate.cost), entry.a, entry.b, entry.stamp};
+    if (!heap_.empty() && heap_.top().cost < now.cost) {
       heap_.push(now);
       ++stats_.requeued;
       requeued_[edge_key(entry.a, entry.b)] = {collapses_, std::move(candidate)};

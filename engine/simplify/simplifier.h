@@ -149,38 +149,20 @@ class Simplifier {
   // 16 bytes, so that more of the heap stays in cache. The stamp is the sum of the two
   // vertices' versions when the entry was pushed: versions only grow, so the sum is unchanged
   // exactly when neither end has changed since. Its top bit marks a deferred entry, whose
-  // edge is to be costed when it comes out; the next one a penalised entry (a cost of at
-  // least half the module's rank_penalty()), whose key is its cost less the penalty and which
-  // comes after every entry that is not (versions count collapses, far below 2^30).
+  // edge is to be costed when it comes out (versions count collapses, far below 2^31).
   static constexpr uint32_t kDeferred = 0x80000000u;
-  static constexpr uint32_t kPenalised = 0x40000000u;
   struct Entry {
-    float cost;  // the key: the cost, less the penalty of a penalised entry
+    float cost;  // the key
     VertexId a, b;
     uint32_t stamp;
   };
-  // Keys in order: unpenalised first, each tier by cost.
-  static bool key_below(const Entry& x, const Entry& y) {
-    const uint32_t tx = x.stamp & kPenalised, ty = y.stamp & kPenalised;
-    return tx != ty ? tx < ty : x.cost < y.cost;
-  }
-  struct Before {  // key_below, ties broken by the edge's ids for determinism
+  struct Before {  // by key, ties broken by the edge's ids for determinism
     bool operator()(const Entry& x, const Entry& y) const {
-      if ((x.stamp ^ y.stamp) & kPenalised) return (x.stamp & kPenalised) < (y.stamp & kPenalised);
       if (x.cost != y.cost) return x.cost < y.cost;
       if (x.a != y.a) return x.a < y.a;
       return x.b < y.b;
     }
   };
-  // The current entry of edge {a, b} (a < b) costing `cost`, pushed when the ends' versions
-  // summed to `versions`. A float key cannot carry a penalty and the costs below it: the
-  // energy adds 1e9 diagonal^2 to a collapse that changes its curves' topology, where a
-  // float's steps are 64 diagonal^2, so every penalised collapse had the same key and they
-  // were taken in the order of their ids (a textured bunny's 2% level, where most collapses
-  // left change a seam: 12x the quadric's distance; docs/BENCHMARKS.md).
-  Entry entry_for(double cost, VertexId a, VertexId b, uint32_t versions) const;
-  // The cost an entry stands for (its key, plus the penalty of a penalised one).
-  double cost_of(const Entry& entry) const;
 
   void push_edge(VertexId a, VertexId b);
   // The first queue from the edges around `vertices` only (SimplifierLimits::first_queue_around).
@@ -226,7 +208,6 @@ class Simplifier {
   bool take_requeued(const Entry& entry, CollapseCandidate& out);
   std::unordered_map<uint64_t, std::pair<uint32_t, CollapseCandidate>> requeued_;
   std::vector<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
-  double rank_penalty_ = 0;                // priority_.rank_penalty(), read when a run starts
   bool defer_ = false;                     // costly() and a limit below SIZE_MAX
   // 3 per face: the key of the edge from corner k; NaN: none yet, infinite: refused
   std::vector<float> face_keys_;

@@ -375,7 +375,7 @@ TEST(ParallelBuild, OneSubsetGivesTheSequentialPm) {
         build_progressive_mesh_parallel(repaired, energy, with_p(1), &stats);
     const ProgressiveMesh sequential = build_progressive_mesh(repaired, energy);
     const size_t before_handover = stats.round_stats.at(0).subsets.at(0).collapses;
-    ASSERT_GT(before_handover, parallel.splits.size() / 2);
+    ASSERT_GT(before_handover, parallel.splits.size() / 3);  // a large part of the build
     ASSERT_GE(sequential.splits.size(), before_handover);
     // Collapse i is split n - 1 - i.
     for (size_t i = 0; i < before_handover; ++i) {

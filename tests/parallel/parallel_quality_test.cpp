@@ -161,7 +161,11 @@ TEST(ParallelQuality, EnergyLevelsMatchTheSequentialOnes) {
 // the one the bound does not help: docs/BENCHMARKS.md, "Rounds bounded by their border band").
 // Since the greedy partitioner counts settled faces (2026-11-25), 8 subsets of fandisk are cut
 // elsewhere: 1.18-1.19 by cheap edges, 1.27-1.36 equal shares, in the input's numbering and in
-// the repair's spatial order alike.
+// the repair's spatial order alike. Since the energy's springs left its cost (2026-11-26,
+// docs/DECISIONS.md) the sequential 50% level is near exact (metro RMS 5.9e-7 against 8.3e-6
+// before, 2.1x CGAL Lindstrom-Turk's): 1.65 by cheap edges, 2.12 equal shares, the parallel
+// level about 10x closer to the input than before; the bound follows (issue 37's target,
+// within 5% of the sequential level, is not met here).
 TEST(ParallelQuality, SharesByCheapEdgesFollowTheSequentialOrder) {
   const std::filesystem::path path = shared_meshes_dir() / "fandisk-13k.obj";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/meshes is not present";
@@ -185,7 +189,7 @@ TEST(ParallelQuality, SharesByCheapEdgesFollowTheSequentialOrder) {
       rms_at_half(build_progressive_mesh_parallel(repaired, options, parallel)) / sequential;
   std::printf("fandisk-13k energy p=8 50%%: rms by cheap edges %.3f, equal shares %.3f\n",
               by_cheap_edges, equal);
-  EXPECT_LE(by_cheap_edges, 1.25);
+  EXPECT_LE(by_cheap_edges, 1.8);
   EXPECT_LT(by_cheap_edges, equal);
 }
 

@@ -290,49 +290,6 @@ TEST(Simplifier, TwinFacesAreTheEdgesFacesOfEveryCorner) {
   expect_twins("after collapses");
 }
 
-// A module's rank penalty (the energy's for a change of its curves' topology) puts a collapse
-// after every unpenalised one, and among penalised ones the rest of the cost still orders
-// them: with every edge penalised, the run is the unpenalised run, collapse for collapse.
-// (When the penalty was added to a float key, 2^50 left steps of 2^26 between keys, every
-// cost below them tied, and the collapses went in the order of their ids.) Costs are whole
-// numbers, so that the penalty comes off exactly.
-TEST(Simplifier, PenalisedCollapsesKeepTheOrderOfTheRestOfTheirCost) {
-  class Penalised : public PriorityWrapper {
-   public:
-    Penalised(PriorityModule& inner, double penalty) : PriorityWrapper(inner), penalty_(penalty) {}
-    bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                  Costing costing) const override {
-      if (!inner_.evaluate(mesh, a, b, out, costing)) return false;
-      out.cost = penalty_ + std::round(out.cost * 1e12);
-      return true;
-    }
-    double rank_penalty() const override { return penalty_; }
-
-   private:
-    double penalty_;
-  };
-  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("stratocaster-9k.ply")));
-  auto run = [&](double penalty) {
-    CollapseMesh cm(repaired.mesh);
-    QuadricPriority quadric(locked_vertices(repaired), QuadricOptions{});
-    Penalised priority(quadric, penalty);
-    Simplifier simplifier(cm, priority, standard_constraints(locked_vertices(repaired)));
-    SimplifierLimits limits;
-    limits.target_faces = cm.live_faces() / 10;
-    return simplifier.run(limits, {}, nullptr);
-  };
-  const double penalty = std::ldexp(1.0, 50);
-  const std::vector<CollapseRecord> plain = run(0), penalised = run(penalty);
-  ASSERT_GT(plain.size(), 1000u);
-  ASSERT_EQ(penalised.size(), plain.size());
-  for (size_t i = 0; i < plain.size(); ++i) {
-    const CollapseRecord &x = plain[i], &y = penalised[i];
-    ASSERT_TRUE(x.vs == y.vs && x.vt == y.vt && x.position == y.position &&
-                y.cost == x.cost + penalty)
-        << "collapse " << i << " differs";
-  }
-}
-
 // A module that costs only the edges with an end in a band (as the parallel build's band pass
 // does) gives the same run whether the first queue holds every edge of the mesh or only the
 // band's (SimplifierLimits::first_queue_around), and costs far fewer edges.

@@ -1,7 +1,12 @@
 // Small meshes drawn in code for unit tests (real meshes come from test_support.h).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <map>
+#include <utility>
+#include <vector>
 
 #include "mesh/mesh.h"
 
@@ -32,6 +37,78 @@ inline Mesh uv_sphere(int rings, int segments, double ripple = 0) {
     }
   for (int s = 0; s < segments; ++s)
     m.faces.push_back({south, ring(rings - 1, s + 1), ring(rings - 1, s)});
+  return m;
+}
+
+
+// An open ground square (two triangles, side 100, z = 0, boundary all round) carrying `boxes`
+// closed boxes of 12 triangles, each a separate component 0.2-1 wide and 0.2-2 tall, placed by
+// a seeded generator: a scene of many small parts on one large open one.
+inline Mesh ground_with_boxes(int boxes, uint64_t seed = 1) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {100, 0, 0}, {100, 100, 0}, {0, 100, 0}};
+  m.faces = {{0, 1, 2}, {0, 2, 3}};
+  auto uniform = [&seed](double lo, double hi) {  // splitmix64
+    uint64_t z = (seed += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return lo + (hi - lo) * double(z ^ (z >> 31)) / 18446744073709551616.0;
+  };
+  for (int k = 0; k < boxes; ++k) {
+    const double x = uniform(1, 98), y = uniform(1, 98), side = uniform(0.2, 1);
+    const double height = uniform(0.2, 2);
+    const auto o = VertexId(m.positions.size());
+    for (double z : {0.0, height})
+      for (const auto& [dx, dy] : {std::pair{0.0, 0.0}, {side, 0.0}, {side, side}, {0.0, side}})
+        m.positions.push_back({x + dx, y + dy, z});
+    const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                             {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    for (const auto& q : quads) {
+      m.faces.push_back({o + q[0], o + q[1], o + q[2]});
+      m.faces.push_back({o + q[0], o + q[2], o + q[3]});
+    }
+  }
+  return m;
+}
+
+// A unit sphere (`rings` x `segments`, a multiple of `chart`) whose texture coordinates come
+// in charts of chart x chart quads, each with wedges of its own: UV seams everywhere, as a
+// texture atlas has them. Closed, genus 0.
+inline Mesh sphere_with_uv_charts(int rings, int segments, int chart) {
+  Mesh m = uv_sphere(rings, segments);
+  m.layout.texcoords = true;
+  // A wedge per (vertex, chart): the chart of a face is that of its quad.
+  std::vector<std::array<WedgeId, 3>> corners;
+  std::map<std::pair<VertexId, int>, WedgeId> wedges;
+  auto wedge = [&](VertexId v, int chart_id, double u, double w) {
+    const auto [it, added] = wedges.try_emplace({v, chart_id}, WedgeId(m.wedge_vertex.size()));
+    if (added) {
+      m.wedge_vertex.push_back(v);
+      m.wedge_values.push_back(float(u));
+      m.wedge_values.push_back(float(w));
+    }
+    return it->second;
+  };
+  for (const Triangle& t : m.faces) {
+    // The face's quad: its ring band and segment, from its vertices' spherical angles.
+    Vec3 c{0, 0, 0};
+    for (VertexId v : t)
+      for (int k = 0; k < 3; ++k) c[k] += m.positions[v][k] / 3;
+    const double radius = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    const double theta = std::acos(std::clamp(c[2] / radius, -1.0, 1.0));
+    double phi = std::atan2(c[1], c[0]);
+    if (phi < 0) phi += 2 * M_PI;
+    const int band = std::min(rings - 1, int(theta / M_PI * rings));
+    const int segment = std::min(segments - 1, int(phi / (2 * M_PI) * segments));
+    const int chart_id = (band / chart) * segments + segment / chart;
+    std::array<WedgeId, 3> w{};
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& p = m.positions[t[k]];
+      w[k] = wedge(t[k], chart_id, 0.5 + 0.5 * p[0], 0.5 + 0.5 * p[1]);
+    }
+    corners.push_back(w);
+  }
+  m.face_wedges = std::move(corners);
   return m;
 }
 
