@@ -38,7 +38,7 @@ one_mesh() {
   set -euo pipefail
   local mesh="$1" name ratio metric smallest
   name="$(basename "$mesh")"; name="${name%.[gG][zZ]}"; name="${name%.*}"
-  local rows="$OUT/rows/$name.tsv.tmp" work="$OUT/work/$name"
+  local rows="$OUT/rows/$name.tsv.tmp" work="$OUT/levels/$name"
   mkdir -p "$work"; : > "$rows"
   declare -A lt_faces
   metro_row() {  # ratio tool faces level-file
