@@ -17,9 +17,9 @@
 // are a scalar times the identity, solved in closed form). The springs shape that solve (a
 // regulariser) but neither choose among the placements nor price the collapse: priced, their
 // change (the star's squared edge lengths) let collapses that moved a curved surface go first
-// where they shortened long edges, and held back exact ones that lengthened them. As in Hoppe 96, the attributes do not move the
-// vertex: with the position chosen, the wedges' values are solved for and their change of
-// E_scalar is added to the cost.
+// where they shortened long edges, and held back exact ones that lengthened them. As in Hoppe 96,
+// the attributes do not move the vertex: with the position chosen, the wedges' values are solved
+// for and their change of E_scalar is added to the cost.
 //
 // Bounded cost, the fix for the 1999 implementation's quadratic behaviour: late collapses
 // cover hundreds of points. A star holding more than max_points_per_evaluation points is
@@ -305,7 +305,7 @@ class EnergyPriority : public PriorityModule {
   WedgeAttributes attributes_;  // the input's; initialize copies them into scalar_
   mutable uint64_t costings_ = 0;
   mutable ScalarAttributes scalar_;  // its star scratch is used by the const evaluate
-  double topology_price_ = 0;  // per point of the star, for a change of the curves' topology
+  double topology_price_ = 0;        // per point of the star, for a change of the curves' topology
   std::vector<uint32_t> point_id_;   // a job's: per point, the master's id (empty: identity)
 
   // Scratch of one evaluation (evaluate is const but, like CollapseMesh, not thread-safe).

@@ -52,7 +52,6 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   return true;
 }
 
-
 std::array<float*, 2> Simplifier::key_slots(VertexId a, VertexId b) {
   const EdgeFaces edge = mesh_.edge_faces(a, b);
   auto slot = [&](FaceId f, VertexId from) {
@@ -305,7 +304,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       continue;
     }
     if (entry.cost > limits.max_cost) {  // and so does every entry after it
-      heap_.push(entry);                     // (deferred_edges() lists what the queue holds)
+      heap_.push(entry);                 // (deferred_edges() lists what the queue holds)
       stats_.stop_reason = "cost ceiling reached";
       break;
     }

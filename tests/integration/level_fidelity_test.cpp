@@ -58,7 +58,8 @@ TEST(LevelFidelity, GroundSquareKeepsItsCornersAmongSmallBoxes) {
       const SurfaceDistance d = surface_distance(input, level, kSamples);
       std::printf("ground and boxes %-8s %zu faces: rms %.3g hausdorff %.3g\n", metric,
                   level.face_count(), d.rms, d.hausdorff);
-      for (const Vec3& corner : {Vec3{0, 0, 0}, Vec3{100, 0, 0}, Vec3{100, 100, 0}, Vec3{0, 100, 0}})
+      for (const Vec3& corner :
+           {Vec3{0, 0, 0}, Vec3{100, 0, 0}, Vec3{100, 100, 0}, Vec3{0, 100, 0}})
         EXPECT_TRUE(has_vertex_at(level, corner))
             << metric << " at " << level.face_count() << " faces lost the corner " << corner[0]
             << ", " << corner[1];
@@ -72,7 +73,8 @@ TEST(LevelFidelity, GroundSquareKeepsItsCornersAmongSmallBoxes) {
 // every ordinary collapse, such collapses waited while the seams were simplified along
 // themselves whatever that cost: 2.4x and 3.5x the quadric's RMS.
 TEST(LevelFidelity, TexturedSurfaceWithSeamsEverywhereFollowsItsShape) {
-  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("pymeshlab-bunny-textured-10k.obj")));
+  const RepairedMesh repaired =
+      repair_mesh(read_mesh(testing::test_data("pymeshlab-bunny-textured-10k.obj")));
   const Mesh input = repaired_input(repaired);
   const ProgressiveMesh quadric = build(repaired, "quadric", 0.02);
   const ProgressiveMesh energy = build(repaired, "energy", 0.02);

@@ -40,7 +40,6 @@ inline Mesh uv_sphere(int rings, int segments, double ripple = 0) {
   return m;
 }
 
-
 // An open ground square (two triangles, side 100, z = 0, boundary all round) carrying `boxes`
 // closed boxes of 12 triangles, each a separate component 0.2-1 wide and 0.2-2 tall, placed by
 // a seeded generator: a scene of many small parts on one large open one.
