@@ -15,6 +15,11 @@ RMS_LIMIT, RMS_FLOOR = 1.5, 1e-5
 HAUSDORFF_LIMIT, HAUSDORFF_FLOOR = 2.0, 1e-4
 
 
+def times(value, reference):
+    """value / reference as text ("2.14x"; "LT exact" when the reference is 0)."""
+    return f"{value / reference:.2f}x" if reference > 0 else "LT exact, not"
+
+
 def floored_ratio(value, reference, floor):
     """value / reference, each floored: below the floor no one can see an error."""
     return max(value, floor) / max(reference, floor)
@@ -62,12 +67,16 @@ def main(paths):
             lr, lh = logs.setdefault((ratio, m), ([], []))
             lr.append(math.log(rr))
             lh.append(math.log(hr))
-            rms_over = rms > RMS_LIMIT * lt_rms and rms >= RMS_FLOOR
-            h_over = h > HAUSDORFF_LIMIT * lt_h and h >= HAUSDORFF_FLOOR
-            if rms_over or h_over:
-                severity = max(rr / RMS_LIMIT if rms_over else 0, hr / HAUSDORFF_LIMIT if h_over else 0)
+            # Over when above both the multiple of LT's error and the floor; how far over is
+            # the error against the larger of the two (what the target allows).
+            rms_allowed = max(RMS_LIMIT * lt_rms, RMS_FLOOR)
+            h_allowed = max(HAUSDORFF_LIMIT * lt_h, HAUSDORFF_FLOOR)
+            if rms > rms_allowed or h > h_allowed:
+                severity = max(rms / rms_allowed, h / h_allowed)
                 over.append((severity, f"{mesh}\t{ratio}\t{m}\tfaces {faces} (LT {lt_faces})"
-                                       f"\tRMS {rr:.2f}x LT\tHausdorff {hr:.2f}x LT"))
+                                       f"\tRMS {rms:.3g} ({times(rms, lt_rms)} LT's)"
+                                       f"\tHausdorff {h:.3g} ({times(h, lt_h)} LT's)"
+                                       f"\t{severity:.2f}x the target"))
         print("\t".join(row))
     print()
     print("geometric mean over the meshes (RMS / LT, Hausdorff / LT; errors floored at"
@@ -81,7 +90,8 @@ def main(paths):
                       f"\t{math.exp(sum(lh) / len(lh)):.3f}")
     print()
     print(f"cells over the targets (RMS > {RMS_LIMIT}x LT and > {RMS_FLOOR:g}, or Hausdorff >"
-          f" {HAUSDORFF_LIMIT}x LT and > {HAUSDORFF_FLOOR:g}): {len(over)}, worst last")
+          f" {HAUSDORFF_LIMIT}x LT and > {HAUSDORFF_FLOOR:g}; the last column: the larger error"
+          f" over what the target allows): {len(over)}, worst last")
     for _, text in sorted(over):
         print(text)
     for path in missing:

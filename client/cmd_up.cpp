@@ -1,7 +1,8 @@
 // parapm up [--workers N] [--data DIR]: the whole service on this machine in the foreground,
 // a coordinator and N workers on loopback, as child processes (the same daemons one starts on
-// many machines). Ctrl-C (or SIGTERM) stops them all cleanly; if one dies, the rest are
-// stopped and the exit status is 1.
+// many machines). Ctrl-C (or SIGTERM) stops them all cleanly. A worker that exits is started
+// again, after a pause that doubles with each exit in a row (0.5 s up to 30 s; a worker that
+// lived a minute starts the count again); the coordinator exiting stops the rest, exit status 1.
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -89,6 +90,74 @@ void stop_all(std::vector<pid_t>& children, std::chrono::seconds grace) {
   }
 }
 
+// A worker `parapm up` keeps running: started again when it exits, with a growing pause.
+struct WorkerProcess {
+  std::string name;
+  std::vector<std::string> args;
+  pid_t pid = -1;  // -1 while waiting to be started again
+  std::chrono::steady_clock::time_point started, restart_at;
+  unsigned exits_in_a_row = 0;
+};
+
+constexpr auto kFirstRestartPause = std::chrono::milliseconds(500);
+constexpr auto kLongestRestartPause = std::chrono::seconds(30);
+constexpr auto kHealthyLifetime = std::chrono::seconds(60);  // resets the pause
+
+void start_worker(WorkerProcess& worker) {
+  worker.pid = spawn(sibling_program("parapm-worker"), worker.args);
+  worker.started = std::chrono::steady_clock::now();
+  std::fprintf(stderr, "parapm up: %s is process %d\n", worker.name.c_str(), int(worker.pid));
+}
+
+std::string exit_text(int status) {
+  return WIFEXITED(status) ? "status " + std::to_string(WEXITSTATUS(status))
+                           : "signal " + std::to_string(WTERMSIG(status));
+}
+
+// Waits for Ctrl-C / SIGTERM or the coordinator's exit, restarting workers that exit; returns
+// the exit status of `parapm up` (0: stopped by a signal; 1: the coordinator exited).
+int supervise(pid_t coordinator, std::vector<WorkerProcess>& workers, const sigset_t& signals) {
+  using Clock = std::chrono::steady_clock;
+  while (true) {
+    // Sleep until a signal, or the next restart that is due.
+    auto wait = std::chrono::milliseconds(1000);
+    for (const WorkerProcess& w : workers)
+      if (w.pid < 0)
+        wait = std::min(wait, std::max(std::chrono::milliseconds(0),
+                                       std::chrono::duration_cast<std::chrono::milliseconds>(
+                                           w.restart_at - Clock::now())));
+    timespec timeout{time_t(wait.count() / 1000), long(wait.count() % 1000) * 1000000};
+    const int signal = sigtimedwait(&signals, nullptr, &timeout);
+    if (signal == SIGINT || signal == SIGTERM) {
+      std::fprintf(stderr, "parapm up: stopping\n");
+      return 0;
+    }
+    int status = 0;
+    for (pid_t pid; (pid = waitpid(-1, &status, WNOHANG)) > 0;) {
+      if (pid == coordinator) {
+        std::fprintf(stderr, "parapm up: the coordinator exited (%s); stopping the workers\n",
+                     exit_text(status).c_str());
+        return 1;
+      }
+      for (WorkerProcess& w : workers) {
+        if (w.pid != pid) continue;
+        w.pid = -1;
+        if (Clock::now() - w.started > kHealthyLifetime) w.exits_in_a_row = 0;
+        const auto pause = std::min<std::chrono::milliseconds>(
+            kLongestRestartPause, kFirstRestartPause * (1u << std::min(w.exits_in_a_row, 6u)));
+        ++w.exits_in_a_row;
+        w.restart_at = Clock::now() + pause;
+        std::fprintf(stderr,
+                     "parapm up: %s (process %d) exited (%s); starting it again in %.1f s\n",
+                     w.name.c_str(), int(pid), exit_text(status).c_str(),
+                     std::chrono::duration<double>(pause).count());
+      }
+    }
+    for (WorkerProcess& w : workers)
+      if (w.pid < 0 && Clock::now() >= w.restart_at) start_worker(w);
+  }
+}
+
 int run_up(const UpArgs& args) {
   sigset_t signals;
   sigemptyset(&signals);
@@ -142,40 +211,26 @@ int run_up(const UpArgs& args) {
   const std::string address =
       (host == "0.0.0.0" || host.empty() ? std::string("127.0.0.1") : host) + ":" +
       std::to_string(port);
+  std::vector<WorkerProcess> workers(args.workers);
   for (unsigned i = 0; i < args.workers; ++i) {
-    std::vector<std::string> worker_args = {"--coordinator", address,
-                                            "--listen",      "127.0.0.1:0",
-                                            "--threads",     std::to_string(threads),
-                                            "--name",        "worker-" + std::to_string(i + 1),
-                                            "--log-level",   args.log_level};
+    WorkerProcess& worker = workers[i];
+    worker.name = "worker-" + std::to_string(i + 1);
+    worker.args = {"--coordinator",         address,  "--listen",  "127.0.0.1:0", "--threads",
+                   std::to_string(threads), "--name", worker.name, "--log-level", args.log_level};
     if (!args.token_file.empty()) {
-      worker_args.push_back("--token-file");
-      worker_args.push_back(args.token_file);
+      worker.args.push_back("--token-file");
+      worker.args.push_back(args.token_file);
     }
-    children.push_back(spawn(sibling_program("parapm-worker"), worker_args));
+    start_worker(worker);
   }
   std::fprintf(stderr,
                "ParaPM is up: coordinator at %s (data in %s), %u workers of %u threads. "
                "Ctrl-C stops them all.\n",
                address.c_str(), args.data.c_str(), args.workers, threads);
 
-  int exit_code = 0;
-  while (true) {
-    int signal = 0;
-    sigwait(&signals, &signal);
-    if (signal != SIGCHLD) {
-      std::fprintf(stderr, "parapm up: stopping\n");
-      break;
-    }
-    int status = 0;
-    const pid_t pid = waitpid(-1, &status, WNOHANG);
-    if (pid <= 0) continue;
-    std::erase(children, pid);
-    std::fprintf(stderr, "parapm up: process %d exited (status %d); stopping the others\n", pid,
-                 WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status));
-    exit_code = 1;
-    break;
-  }
+  const int exit_code = supervise(children[0], workers, signals);
+  for (const WorkerProcess& worker : workers)
+    if (worker.pid > 0) children.push_back(worker.pid);
   stop_all(children, std::chrono::seconds(10));
   return exit_code;
 }

@@ -88,7 +88,8 @@ parapm::v1::UploadReply ServiceClient::upload(
 parapm::v1::Job ServiceClient::watch(
     const std::string& job_id, const std::function<void(const parapm::v1::JobEvent&)>& on_event) {
   uint64_t after = 0;
-  // A watch that breaks (the coordinator restarted) resumes after the last event seen.
+  // A watch that breaks (the coordinator restarted, closed a watch open for its longest time,
+  // or had no room for another stream) resumes after the last event seen.
   for (int attempt = 0;; ++attempt) {
     auto context = this->context(0);
     parapm::v1::WatchRequest request;
@@ -103,8 +104,11 @@ parapm::v1::Job ServiceClient::watch(
     }
     const grpc::Status status = reader->Finish();
     if (status.ok()) break;
-    if (status.error_code() != grpc::StatusCode::UNAVAILABLE || attempt >= 60)
-      check_status(status, "watch " + job_id, server_);
+    const grpc::StatusCode code = status.error_code();
+    const bool resumable = code == grpc::StatusCode::UNAVAILABLE ||
+                           code == grpc::StatusCode::DEADLINE_EXCEEDED ||
+                           code == grpc::StatusCode::RESOURCE_EXHAUSTED;
+    if (!resumable || attempt >= 60) check_status(status, "watch " + job_id, server_);
     std::this_thread::sleep_for(std::chrono::seconds(1));
   }
   auto context = this->context();

@@ -1,5 +1,9 @@
 #include "rpc_security.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <strings.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -37,14 +41,26 @@ std::string load_token(const std::string& token_file) {
 
 bool is_loopback_address(const std::string& address) {
   std::string host = address;
-  if (host.rfind("ipv4:", 0) == 0) host = host.substr(5);
-  if (host.rfind("ipv6:", 0) == 0) host = host.substr(5);
+  if (host.rfind("ipv4:", 0) == 0 || host.rfind("ipv6:", 0) == 0) host = host.substr(5);
   if (!host.empty() && host[0] == '[') {
     const auto close = host.find(']');
-    return close != std::string::npos && host.substr(1, close - 1) == "::1";
+    if (close == std::string::npos) return false;
+    host = host.substr(1, close - 1);
+  } else {
+    host = host.substr(0, host.rfind(':'));
   }
-  host = host.substr(0, host.rfind(':'));
-  return host == "localhost" || host.rfind("127.", 0) == 0;
+  // Addresses are decided by their value, never by their text: "127.evil.example" is a name.
+  in_addr v4{};
+  if (::inet_pton(AF_INET, host.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  in6_addr v6{};
+  if (::inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
+    if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
+    // ::ffff:127.x.y.z, IPv4-mapped loopback.
+    return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;
+  }
+  // The one name that means this machine by definition (RFC 6761); any other may resolve
+  // anywhere.
+  return strcasecmp(host.c_str(), "localhost") == 0;
 }
 
 std::shared_ptr<grpc::ServerCredentials> server_credentials(const TlsFiles& tls) {

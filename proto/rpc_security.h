@@ -15,8 +15,9 @@ namespace parapm::rpc {
 // for a missing or empty file.
 std::string load_token(const std::string& token_file);
 
-// True for 127.0.0.0/8, [::1] and localhost addresses ("host:port"): nothing beyond this
-// machine can connect there.
+// True for "host:port" addresses whose host is an IPv4 address in 127.0.0.0/8, ::1 (also
+// IPv4-mapped loopback), or the name "localhost": nothing beyond this machine can connect
+// there. Any other name is not loopback, whatever its text ("127.x.example" is a name).
 bool is_loopback_address(const std::string& address);
 
 struct TlsFiles {

@@ -22,6 +22,8 @@ grpc::StatusCode status_code_of(ErrorCode code) {
       return grpc::StatusCode::FAILED_PRECONDITION;
     case ErrorCode::kInternal:
       return grpc::StatusCode::INTERNAL;
+    case ErrorCode::kDataLoss:
+      return grpc::StatusCode::DATA_LOSS;
   }
   return grpc::StatusCode::INTERNAL;
 }
@@ -86,6 +88,8 @@ ErrorCode error_code_of(grpc::StatusCode code) {
     case grpc::StatusCode::UNAVAILABLE:
     case grpc::StatusCode::ABORTED:
       return ErrorCode::kIo;
+    case grpc::StatusCode::DATA_LOSS:
+      return ErrorCode::kDataLoss;
     default:
       return ErrorCode::kInternal;
   }

@@ -107,6 +107,12 @@ void Coordinator::stop() {
   events_changed_.notify_all();
 }
 
+ReadLimits Coordinator::read_limits() const {
+  ReadLimits limits;
+  limits.max_bytes = config_.max_mesh_bytes;
+  return limits;
+}
+
 Upload Coordinator::begin_upload(const std::string& file_name) const {
   if (file_name.empty() || file_name.size() > 255)
     throw_invalid(
@@ -119,9 +125,13 @@ UploadResult Coordinator::finish_upload(Upload upload) {
   const std::string sha = sha256_hex(upload.bytes_);
   UploadResult result;
   // Validate whatever the bytes (a repeated upload of a bad file is as bad).
-  ReadReport report;
-  const Mesh mesh = read_mesh_from_memory(upload.bytes_, upload.file_name_, &report);
-  const RepairedMesh repaired = repair_mesh(mesh);
+  parse_slots_.acquire();
+  struct Release {
+    std::counting_semaphore<>& slots;
+    ~Release() { slots.release(); }
+  } release{parse_slots_};
+  const RepairedMesh repaired =
+      repair_mesh(read_mesh_from_memory(upload.bytes_, upload.file_name_, nullptr, read_limits()));
   if (repaired.mesh.face_count() == 0)
     throw_invalid(upload.file_name_ + ": no faces left after repair");
   result.repairs = repairs_text(repaired.report);
@@ -150,14 +160,22 @@ parapm::v1::Job Coordinator::submit(const std::string& mesh_id,
                                     const parapm::v1::JobOptions& options) {
   const std::optional<MeshRecord> mesh = store_.find_mesh(mesh_id);
   if (!mesh) throw Error(ErrorCode::kNotFound, "no mesh '" + mesh_id + "' (upload it first)");
-  const JobSpec spec = job_spec_of(options, config_.default_parallelism);
-  if (spec.parallel.subsets > mesh->vertices)
+  // p is pinned at submission (the PM depends on it): the coordinator's default, or as many
+  // as the mesh can use when that is fewer.
+  const uint32_t most_p = most_useful_parallelism(mesh->faces);
+  parapm::v1::JobOptions pinned = options;
+  if (pinned.parallelism() == 0)
+    pinned.set_parallelism(std::min(config_.default_parallelism, most_p));
+  const JobSpec spec = job_spec_of(pinned, config_.default_parallelism);
+  if (spec.parallel.subsets > most_p)
     throw_invalid("job options: parallelism " + std::to_string(spec.parallel.subsets) +
-                  " exceeds the mesh's " + std::to_string(mesh->vertices) + " vertices");
+                  " on a mesh of " + std::to_string(mesh->faces) +
+                  " faces makes subsets of fewer than " + std::to_string(kLeastSubsetFaces) +
+                  " faces, mostly border; this mesh can use at most " + std::to_string(most_p));
   JobRecord record;
   record.job_id = new_id("job-");
   record.mesh_id = mesh_id;
-  record.options = options.SerializeAsString();
+  record.options = pinned.SerializeAsString();
   record.status = JobStatus::kQueued;
   record.input_faces = mesh->faces;
   record.created_unix_ms = record.updated_unix_ms = unix_ms_now();
@@ -283,13 +301,22 @@ JobRecord Coordinator::done_job(const std::string& job_id) {
   return record;
 }
 
-std::filesystem::path Coordinator::pm_path(const std::string& job_id) {
-  return blobs_.path_of(done_job(job_id).pm_sha256);
-}
-
 std::shared_ptr<const LoadedPm> Coordinator::pm(const std::string& job_id) {
-  const JobRecord record = done_job(job_id);
-  return library_.get(record.pm_sha256, blobs_.path_of(record.pm_sha256));
+  JobRecord record = done_job(job_id);
+  try {
+    return library_.get(record.pm_sha256, blobs_);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kDataLoss) throw;
+    // Never served again: the job shows why, and the same mesh submitted again rebuilds it.
+    record.status = JobStatus::kFailed;
+    record.failure_reason = std::string(e.what()) + "; submit the mesh again to rebuild it";
+    record.updated_unix_ms = unix_ms_now();
+    parapm::v1::JobEvent event;
+    event.mutable_failed()->set_reason(record.failure_reason);
+    end_job(record, event);
+    spdlog::error("job {}: marked failed: {}", job_id, record.failure_reason);
+    throw;
+  }
 }
 
 void Coordinator::scheduler_loop() {
@@ -388,8 +415,8 @@ void Coordinator::execute(JobRecord& record, Running& running,
   const std::optional<MeshRecord> mesh_record = store_.find_mesh(record.mesh_id);
   if (!mesh_record) throw Error(ErrorCode::kNotFound, "mesh " + record.mesh_id + " is gone");
   auto t = std::chrono::steady_clock::now();
-  const RepairedMesh repaired =
-      repair_mesh(read_mesh_from_memory(blobs_.read(mesh_record->sha256), mesh_record->file_name));
+  const RepairedMesh repaired = repair_mesh(read_mesh_from_memory(
+      blobs_.read(mesh_record->sha256), mesh_record->file_name, nullptr, read_limits()));
   transport.set_read_seconds(seconds_since(t));
   record.input_faces = repaired.mesh.face_count();
   {

@@ -16,10 +16,12 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <semaphore>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "io/mesh_io.h"
 #include "parapm.pb.h"
 #include "pm_library.h"
 #include "remote_runner.h"
@@ -32,7 +34,8 @@ namespace parapm::service {
 
 struct CoordinatorConfig {
   std::filesystem::path data_dir;
-  uint64_t max_upload_bytes = uint64_t(2) << 30;
+  uint64_t max_upload_bytes = uint64_t(2) << 30;  // as sent (compressed, for a .gz)
+  uint64_t max_mesh_bytes = uint64_t(4) << 30;    // a mesh file once inflated
   uint32_t default_parallelism = 4;
   unsigned max_running_jobs = 2;
   // Subsets run in the coordinator when no worker is registered (0: wait for workers).
@@ -95,8 +98,8 @@ class Coordinator {
   std::vector<parapm::v1::JobEvent> events(const std::string& job_id, uint64_t after_seq,
                                            std::chrono::milliseconds wait);
 
-  // A done job's PM (kFailedPrecondition when not done).
-  std::filesystem::path pm_path(const std::string& job_id);
+  // A done job's PM, its bytes checked against their hash (kFailedPrecondition when the job
+  // is not done; kDataLoss when its stored PM is corrupt).
   std::shared_ptr<const LoadedPm> pm(const std::string& job_id);
 
  private:
@@ -113,6 +116,7 @@ class Coordinator {
   void end_job(const JobRecord& record, parapm::v1::JobEvent terminal);
   parapm::v1::Job to_proto(const JobRecord& record);
   JobRecord load_job(const std::string& job_id);  // kNotFound
+  ReadLimits read_limits() const;                 // for uploads and stored meshes
   JobRecord done_job(const std::string& job_id);  // kFailedPrecondition unless done
 
   CoordinatorConfig config_;
@@ -123,6 +127,9 @@ class Coordinator {
   PmLibrary library_;
 
   std::mutex upload_mutex_;  // the sha256 lookup and the insert of a new mesh
+  // Uploads parsed at once: each holds its inflated file and mesh, up to max_mesh_bytes and
+  // more, so this bounds their memory whatever the number of clients.
+  std::counting_semaphore<> parse_slots_{2};
   std::mutex mutex_;
   std::condition_variable queue_changed_;
   std::condition_variable events_changed_;

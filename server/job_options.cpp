@@ -1,9 +1,11 @@
 #include "job_options.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "util/error.h"
+#include "util/number_text.h"
 
 namespace parapm::service {
 namespace {
@@ -13,6 +15,10 @@ void require(bool ok, const std::string& message) {
 }
 
 }  // namespace
+
+uint32_t most_useful_parallelism(uint64_t faces) {
+  return uint32_t(std::clamp<uint64_t>(faces / kLeastSubsetFaces, 1, kMaxParallelism));
+}
 
 JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_parallelism) {
   JobSpec spec;
@@ -25,7 +31,7 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
     case parapm::v1::JobOptions::kTargetRatio:
       require(std::isfinite(options.target_ratio()) && options.target_ratio() > 0 &&
                   options.target_ratio() <= 1,
-              "target_ratio must be in (0, 1], got " + std::to_string(options.target_ratio()));
+              "target_ratio must be in (0, 1], got " + number_text(options.target_ratio()));
       s.target_ratio = options.target_ratio();
       break;
     case parapm::v1::JobOptions::TARGET_NOT_SET:
@@ -72,7 +78,7 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
   check_simplify_options(s);
 
   p.subsets = options.parallelism() ? options.parallelism() : default_parallelism;
-  require(p.subsets >= 1 && p.subsets <= 256,
+  require(p.subsets >= 1 && p.subsets <= kMaxParallelism,
           "parallelism must be in [1, 256], got " + std::to_string(p.subsets));
   p.rounds = options.rounds();  // 0 in both: by p
   require(p.rounds <= 64, "rounds must be in [1, 64] (0: by p), got " + std::to_string(p.rounds));
@@ -83,6 +89,16 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
           "border_excess must be at most 0.5 (0: the default, 0.05; negative: none)");
   if (options.border_excess() < 0) p.border_excess = 0;
   if (options.border_excess() > 0) p.border_excess = options.border_excess();
+  require(options.extra_round_faces() <= 0 ||
+              uint64_t(options.extra_round_faces()) >= kLeastSubsetFaces,
+          "extra_round_faces must be at least " + std::to_string(kLeastSubsetFaces) +
+              " (a smaller subset is mostly border: its rounds only cost calls; 0: the default, "
+              "negative: no extra rounds)");
+  require(
+      options.min_subset_faces() <= 0 || uint64_t(options.min_subset_faces()) >= kLeastSubsetFaces,
+      "min_subset_faces must be at least " + std::to_string(kLeastSubsetFaces) +
+          " (a smaller subset is mostly border: its rounds only cost calls; 0: the metric's "
+          "default, negative: no floor)");
   if (options.extra_round_faces() < 0) p.extra_round_subset_faces = 0;
   if (options.extra_round_faces() > 0)
     p.extra_round_subset_faces = uint64_t(options.extra_round_faces());

@@ -13,6 +13,8 @@
 #include "daemon.h"
 #include "mesh_service.h"
 #include "rpc_server.h"
+#include "storage/blob_store.h"
+#include "stream_admission.h"
 
 namespace {
 
@@ -20,6 +22,7 @@ struct CoordinatorArgs {
   std::string listen = "127.0.0.1:50051";
   std::string data = "parapm-data";
   uint64_t max_upload_mb = 2048;
+  uint64_t max_mesh_mb = 4096;
   uint32_t parallelism = 4;
   unsigned max_running_jobs = 2;
   unsigned local_threads = 0;
@@ -29,15 +32,38 @@ struct CoordinatorArgs {
   bool worker_tls = false;
   std::string port_file;
   std::string log_level = "info";
+  bool verify = false;
+  parapm::rpc::StreamLimits streams;
+  double stream_idle_s = 60, stream_total_s = 3600;
 };
 
-int run(const CoordinatorArgs& args) {
+// Upload chunks carry at most 4 MiB of data (parapm.proto); a message a little larger holds
+// its other fields.
+constexpr int kMaxChunkMessageBytes = (4 << 20) + (64 << 10);
+
+// --verify: every blob hashed again; exit status 0 when all match, 1 otherwise.
+int verify_store(const CoordinatorArgs& args) {
+  using parapm::service::BlobStore;
+  parapm::rpc::set_up_logging("coordinator", args.log_level);
+  const BlobStore::VerifyReport report = BlobStore::verify(args.data);
+  std::printf("%llu blobs, %llu bytes checked in %s: %zu corrupt\n",
+              static_cast<unsigned long long>(report.blobs),
+              static_cast<unsigned long long>(report.bytes), args.data.c_str(),
+              report.corrupt.size());
+  for (const std::string& name : report.corrupt) std::printf("corrupt: %s\n", name.c_str());
+  return report.corrupt.empty() ? 0 : 1;
+}
+
+int run(CoordinatorArgs args) {
   using namespace parapm;
   rpc::set_up_logging("coordinator", args.log_level);
+  args.streams.idle = std::chrono::milliseconds(int64_t(args.stream_idle_s * 1000));
+  args.streams.total = std::chrono::milliseconds(int64_t(args.stream_total_s * 1000));
   const std::string token = rpc::token_for_listening(args.token_file, args.listen);
   service::CoordinatorConfig config;
   config.data_dir = args.data;
   config.max_upload_bytes = args.max_upload_mb << 20;
+  config.max_mesh_bytes = args.max_mesh_mb << 20;
   config.default_parallelism = args.parallelism;
   config.max_running_jobs = args.max_running_jobs;
   config.local_threads = args.local_threads;
@@ -46,12 +72,15 @@ int run(const CoordinatorArgs& args) {
   config.worker_credentials = rpc::channel_credentials(args.worker_tls, args.tls);
   std::filesystem::create_directories(config.data_dir);
   service::Coordinator coordinator(config);
-  service::MeshService mesh_service(coordinator, rpc::TokenCheck(token));
+  rpc::StreamAdmission streams(args.streams);
+  service::MeshService mesh_service(coordinator, rpc::TokenCheck(token), streams);
   service::CoordinationService coordination(coordinator.workers(), rpc::TokenCheck(token));
   rpc::ServerSetup setup;
   setup.listen = args.listen;
   setup.tls = args.tls;
-  setup.max_receive_bytes = 16 << 20;  // clients send chunks of at most 4 MiB
+  setup.max_receive_bytes = kMaxChunkMessageBytes;
+  // A thread for every stream admitted, and as many again for unary calls and the workers.
+  setup.max_threads = int(args.streams.max_streams) * 2 + 32;
   rpc::StartedServer server = rpc::start_server(setup, {&mesh_service, &coordination});
   const std::string address = rpc::reachable_address(args.listen, server.port);
   spdlog::info("listening on {} (data in {}, default p = {}, {} jobs at once{})", address,
@@ -86,7 +115,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--data", args.data, "folder for the database and blobs (created if absent)")
       ->capture_default_str();
-  app.add_option("--max-upload-mb", args.max_upload_mb, "largest upload accepted, MiB")
+  app.add_option("--max-upload-mb", args.max_upload_mb,
+                 "largest upload accepted, MiB, as sent (compressed, for a .gz)")
+      ->check(CLI::Range(uint64_t(1), uint64_t(1) << 20))
+      ->capture_default_str();
+  app.add_option("--max-mesh-mb", args.max_mesh_mb,
+                 "largest mesh file accepted once inflated, MiB (a .gz is inflated in a "
+                 "stream that stops here, and after its first 64 KiB when they are no mesh)")
       ->check(CLI::Range(uint64_t(1), uint64_t(1) << 20))
       ->capture_default_str();
   app.add_option("--parallelism", args.parallelism,
@@ -104,6 +139,24 @@ int main(int argc, char** argv) {
                  "beat interval asked of workers; 3 missed beats and a worker is dead")
       ->check(CLI::Range(100, 60000))
       ->capture_default_str();
+  app.add_option("--max-streams", args.streams.max_streams,
+                 "streaming calls (uploads, watches, downloads, streams) open at once, all "
+                 "clients together; more are refused with RESOURCE_EXHAUSTED")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  app.add_option("--max-streams-per-client", args.streams.max_streams_per_client,
+                 "streaming calls open at once from one client address")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  app.add_option("--stream-idle-s", args.stream_idle_s,
+                 "a stream that moves no message for this long is closed (seconds)")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  app.add_option("--stream-total-s", args.stream_total_s,
+                 "a stream open for longer than this is closed (seconds; a watch is then "
+                 "resumed by the client)")
+      ->check(CLI::Range(1.0, 7.0 * 86400))
+      ->capture_default_str();
   app.add_option("--token-file", args.token_file,
                  "bearer token required on every call and sent to workers (else PARAPM_TOKEN; "
                  "required when listening beyond loopback)");
@@ -116,8 +169,12 @@ int main(int argc, char** argv) {
                  "write the port listened on to this file once serving (for scripts, with port 0)");
   app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
       ->capture_default_str();
+  app.add_flag("--verify", args.verify,
+               "check every stored blob of --data against its hash, print the corrupt ones and "
+               "exit (status 1 when any is corrupt); safe beside a running coordinator");
   CLI11_PARSE(app, argc, argv);
   try {
+    if (args.verify) return verify_store(args);
     return run(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "parapm-coordinator: %s\n", e.what());

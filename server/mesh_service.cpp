@@ -21,14 +21,21 @@ void require_id(const std::string& id, const char* what) {
   if (id.empty() || id.size() > 64) throw_invalid(std::string(what) + " must be given");
 }
 
+// How a stream that stopped ends: the watchdog's reason when it closed it, else the client left.
+grpc::Status stopped(const rpc::StreamAdmission::Ticket& ticket) {
+  return ticket.expired().value_or(kClientGone);
+}
+
 // Sends `bytes` in chunks; false when the client went away.
-bool send_chunks(grpc::ServerWriter<parapm::v1::Chunk>* writer, const std::string& bytes) {
+bool send_chunks(grpc::ServerWriter<parapm::v1::Chunk>* writer, std::string_view bytes,
+                 rpc::StreamAdmission::Ticket& ticket) {
   parapm::v1::Chunk chunk;
   chunk.set_total(bytes.size());
   for (size_t at = 0; at < bytes.size() || at == 0; at += kChunkBytes) {
     chunk.set_offset(at);
-    chunk.set_data(bytes.substr(at, kChunkBytes));
+    chunk.set_data(std::string(bytes.substr(at, kChunkBytes)));
     if (!writer->Write(chunk)) return false;
+    ticket.touch();
     if (bytes.empty()) break;
   }
   return true;
@@ -44,12 +51,20 @@ grpc::Status MeshService::Upload(grpc::ServerContext* context,
                                  grpc::ServerReader<parapm::v1::UploadChunk>* reader,
                                  parapm::v1::UploadReply* reply) {
   return rpc::serve(auth_, context, [&] {
+    grpc::Status refused;
+    const auto ticket = streams_.admit(context, "Upload", &refused);
+    if (!ticket) return refused;
     parapm::v1::UploadChunk chunk;
-    if (!reader->Read(&chunk)) throw_invalid("the upload has no chunk (send the file name first)");
+    if (!reader->Read(&chunk)) {
+      if (auto expired = ticket->expired()) return *expired;
+      throw_invalid("the upload has no chunk (send the file name first)");
+    }
     service::Upload upload = coordinator_.begin_upload(chunk.file_name());
     do {
+      ticket->touch();
       upload.add(chunk.data());
     } while (reader->Read(&chunk));
+    if (auto expired = ticket->expired()) return *expired;
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "upload cut off");
     const UploadResult result = coordinator_.finish_upload(std::move(upload));
     reply->set_mesh_id(result.mesh.mesh_id);
@@ -76,12 +91,21 @@ grpc::Status MeshService::Watch(grpc::ServerContext* context,
                                 grpc::ServerWriter<parapm::v1::JobEvent>* writer) {
   return rpc::serve(auth_, context, [&] {
     require_id(request->job_id(), "job_id");
+    grpc::Status refused;
+    const auto ticket = streams_.admit(context, "Watch", &refused);
+    if (!ticket) return refused;
     uint64_t after = request->after_seq();
     while (!context->IsCancelled()) {
+      if (ticket->past_total())
+        return grpc::Status(
+            grpc::StatusCode::DEADLINE_EXCEEDED,
+            "watch open for its longest time: watch again from after_seq " + std::to_string(after));
       const std::vector<parapm::v1::JobEvent> events =
           coordinator_.events(request->job_id(), after, std::chrono::milliseconds(500));
+      ticket->touch();  // waiting for events is not idling; a blocked Write is
       for (const parapm::v1::JobEvent& event : events) {
-        if (!writer->Write(event)) return kClientGone;
+        if (!writer->Write(event)) return stopped(*ticket);
+        ticket->touch();
         after = event.seq();
         if (terminal(event)) return grpc::Status::OK;
       }
@@ -94,7 +118,7 @@ grpc::Status MeshService::Watch(grpc::ServerContext* context,
           return grpc::Status::OK;
       }
     }
-    return grpc::Status(grpc::StatusCode::CANCELLED, "watch cancelled");
+    return ticket->expired().value_or(grpc::Status(grpc::StatusCode::CANCELLED, "watch cancelled"));
   });
 }
 
@@ -130,22 +154,11 @@ grpc::Status MeshService::Download(grpc::ServerContext* context, const parapm::v
                                    grpc::ServerWriter<parapm::v1::Chunk>* writer) {
   return rpc::serve(auth_, context, [&] {
     require_id(request->job_id(), "job_id");
-    const std::filesystem::path path = coordinator_.pm_path(request->job_id());
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(ErrorCode::kIo, "cannot open the PM of job " + request->job_id());
-    const uint64_t total = std::filesystem::file_size(path);
-    parapm::v1::Chunk chunk;
-    chunk.set_total(total);
-    std::string buffer(kChunkBytes, '\0');
-    for (uint64_t at = 0; at < total;) {
-      in.read(buffer.data(), std::streamsize(std::min<uint64_t>(kChunkBytes, total - at)));
-      const auto got = uint64_t(in.gcount());
-      if (got == 0) throw Error(ErrorCode::kIo, "the PM of job " + request->job_id() + " is short");
-      chunk.set_offset(at);
-      chunk.set_data(buffer.data(), got);
-      if (!writer->Write(chunk)) return kClientGone;
-      at += got;
-    }
+    grpc::Status refused;
+    const auto ticket = streams_.admit(context, "Download", &refused);
+    if (!ticket) return refused;
+    const auto loaded = coordinator_.pm(request->job_id());  // its hash checked
+    if (!send_chunks(writer, loaded->bytes, *ticket)) return stopped(*ticket);
     return grpc::Status::OK;
   });
 }
@@ -155,6 +168,9 @@ grpc::Status MeshService::GetLevel(grpc::ServerContext* context,
                                    grpc::ServerWriter<parapm::v1::Chunk>* writer) {
   return rpc::serve(auth_, context, [&] {
     require_id(request->job_id(), "job_id");
+    grpc::Status refused;
+    const auto ticket = streams_.admit(context, "GetLevel", &refused);
+    if (!ticket) return refused;
     const std::string format = request->format().empty() ? "obj" : request->format();
     if (format != "obj" && format != "ply") throw_invalid("format must be \"obj\" or \"ply\"");
     if (request->cut_case() == parapm::v1::LevelRequest::CUT_NOT_SET)
@@ -180,7 +196,7 @@ grpc::Status MeshService::GetLevel(grpc::ServerContext* context,
       throw;
     }
     std::filesystem::remove(temp);
-    if (!send_chunks(writer, bytes)) return kClientGone;
+    if (!send_chunks(writer, bytes, *ticket)) return stopped(*ticket);
     return grpc::Status::OK;
   });
 }
@@ -190,6 +206,9 @@ grpc::Status MeshService::StreamPM(grpc::ServerContext* context,
                                    grpc::ServerWriter<parapm::v1::PmStreamMessage>* writer) {
   return rpc::serve(auth_, context, [&] {
     require_id(request->job_id(), "job_id");
+    grpc::Status refused;
+    const auto ticket = streams_.admit(context, "StreamPM", &refused);
+    if (!ticket) return refused;
     const auto loaded = coordinator_.pm(request->job_id());
     const uint64_t n = loaded->pm.splits.size();
     uint64_t end = n;
@@ -207,18 +226,20 @@ grpc::Status MeshService::StreamPM(grpc::ServerContext* context,
     parapm::v1::PmStreamMessage message;
     message.set_total_vsplits(n);
     if (request->from_vsplit() == 0) {
-      message.set_header_and_base(read_file_range(loaded->path, 0, loaded->splits_begin));
+      message.set_header_and_base(loaded->bytes.substr(0, loaded->splits_begin));
       message.set_first_vsplit(0);
       message.set_count(0);
-      if (!writer->Write(message)) return kClientGone;
+      if (!writer->Write(message)) return stopped(*ticket);
+      ticket->touch();
     }
     for (uint64_t first = request->from_vsplit(); first < end; first += batch) {
       const uint64_t last = std::min<uint64_t>(end, first + batch);
-      message.set_vsplit_batch(
-          read_file_range(loaded->path, loaded->split_begin[first], loaded->split_begin[last]));
+      message.set_vsplit_batch(loaded->bytes.substr(
+          loaded->split_begin[first], loaded->split_begin[last] - loaded->split_begin[first]));
       message.set_first_vsplit(first);
       message.set_count(uint32_t(last - first));
-      if (!writer->Write(message)) return kClientGone;
+      if (!writer->Write(message)) return stopped(*ticket);
+      ticket->touch();
     }
     return grpc::Status::OK;
   });

@@ -1,17 +1,19 @@
 // MeshService bridge: converts requests, calls the Coordinator, converts results and errors
-// (rpc::serve). Streams stop cleanly when a write fails (the client went away).
+// (rpc::serve). Every streaming call is admitted by `streams` first (bounded in number, idle
+// time and age); streams stop cleanly when a write fails (the client went away).
 #pragma once
 
 #include "coordinator.h"
 #include "parapm.grpc.pb.h"
 #include "rpc_security.h"
+#include "stream_admission.h"
 
 namespace parapm::service {
 
 class MeshService final : public parapm::v1::MeshService::Service {
  public:
-  MeshService(Coordinator& coordinator, rpc::TokenCheck auth)
-      : coordinator_(coordinator), auth_(std::move(auth)) {}
+  MeshService(Coordinator& coordinator, rpc::TokenCheck auth, rpc::StreamAdmission& streams)
+      : coordinator_(coordinator), auth_(std::move(auth)), streams_(streams) {}
 
   grpc::Status Upload(grpc::ServerContext* context,
                       grpc::ServerReader<parapm::v1::UploadChunk>* reader,
@@ -36,6 +38,7 @@ class MeshService final : public parapm::v1::MeshService::Service {
  private:
   Coordinator& coordinator_;
   rpc::TokenCheck auth_;
+  rpc::StreamAdmission& streams_;
 };
 
 }  // namespace parapm::service

@@ -1,34 +1,44 @@
 #include "pm_library.h"
 
-#include <fstream>
+#include <istream>
+
+#include <spdlog/spdlog.h>
 
 #include "pm/pm_file.h"
 #include "util/error.h"
+#include "util/view_buffer.h"
 
 namespace parapm::service {
 namespace {
 
-std::shared_ptr<const LoadedPm> load(const std::filesystem::path& path) {
+std::shared_ptr<const LoadedPm> load(const std::string& sha256, const BlobStore& blobs) {
   auto loaded = std::make_shared<LoadedPm>();
-  loaded->path = path;
-  loaded->pm = read_pm_file(path.string());
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::kIo, "cannot open " + path.string());
-  PmReader reader(in, path.string());
-  reader.read_base();
-  loaded->splits_begin = reader.offset();
-  loaded->split_begin.reserve(reader.header().splits + 1);
-  PmSplitRecord record;
-  loaded->split_begin.push_back(reader.offset());
-  while (reader.next_split(record)) loaded->split_begin.push_back(reader.offset());
-  loaded->file_size = std::filesystem::file_size(path);
+  loaded->bytes = blobs.read(sha256);  // kDataLoss when the bytes changed
+  const std::string name = "stored PM " + sha256;
+  try {
+    ViewBuffer buffer(loaded->bytes);
+    std::istream in(&buffer);
+    loaded->pm = read_pm(in, name);
+    in.clear();
+    in.seekg(0);
+    PmReader reader(in, name);
+    reader.read_base();
+    loaded->splits_begin = reader.offset();
+    loaded->split_begin.reserve(reader.header().splits + 1);
+    PmSplitRecord record;
+    loaded->split_begin.push_back(reader.offset());
+    while (reader.next_split(record)) loaded->split_begin.push_back(reader.offset());
+  } catch (const Error& e) {
+    // Its hash matched, so these bytes were stored so: a PM the coordinator itself wrote wrong.
+    spdlog::critical("{} does not decode: {}", name, e.what());
+    throw Error(ErrorCode::kDataLoss, name + " does not decode: " + e.what());
+  }
   return loaded;
 }
 
 }  // namespace
 
-std::shared_ptr<const LoadedPm> PmLibrary::get(const std::string& sha256,
-                                               const std::filesystem::path& path) {
+std::shared_ptr<const LoadedPm> PmLibrary::get(const std::string& sha256, const BlobStore& blobs) {
   {
     std::lock_guard lock(mutex_);
     for (auto it = recent_.begin(); it != recent_.end(); ++it)
@@ -37,21 +47,18 @@ std::shared_ptr<const LoadedPm> PmLibrary::get(const std::string& sha256,
         return it->second;
       }
   }
-  std::shared_ptr<const LoadedPm> loaded = load(path);
+  std::shared_ptr<const LoadedPm> loaded = load(sha256, blobs);
   std::lock_guard lock(mutex_);
   recent_.emplace_front(sha256, loaded);
-  while (recent_.size() > capacity_) recent_.pop_back();
+  uint64_t kept = 0;
+  for (auto it = recent_.begin(); it != recent_.end();) {
+    kept += it->second->bytes.size();
+    if (it != recent_.begin() && kept > budget_bytes_)
+      it = recent_.erase(it);
+    else
+      ++it;
+  }
   return loaded;
-}
-
-std::string read_file_range(const std::filesystem::path& path, uint64_t begin, uint64_t end) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::kIo, "cannot open " + path.string());
-  std::string bytes(end - begin, '\0');
-  in.seekg(std::streamoff(begin));
-  in.read(bytes.data(), std::streamsize(bytes.size()));
-  if (!in) throw Error(ErrorCode::kIo, "cannot read " + path.string());
-  return bytes;
 }
 
 }  // namespace parapm::service

@@ -1,10 +1,10 @@
 // The finished Progressive Meshes the coordinator serves, read from their blobs on first use
-// and kept (a few, most recently used) for levels and streams: the PM itself (validated) and
-// where each split record starts in the file, so that StreamPM sends byte ranges of the file
-// as they are.
+// and kept (the most recently used, within a byte budget) for downloads, levels and streams:
+// the file's bytes as stored (checked against their hash when read: a corrupt blob is never
+// served), the PM decoded from them (validated), and where each split record starts, so that
+// StreamPM sends byte ranges of the file as they are.
 #pragma once
 
-#include <filesystem>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -12,30 +12,30 @@
 #include <vector>
 
 #include "pm/progressive_mesh.h"
+#include "storage/blob_store.h"
 
 namespace parapm::service {
 
 struct LoadedPm {
-  std::filesystem::path path;
+  std::string bytes;  // the .pm file, its SHA-256 checked
   ProgressiveMesh pm;
-  uint64_t file_size = 0;
   uint64_t splits_begin = 0;          // bytes of header + base mesh (+ its CRC)
   std::vector<uint64_t> split_begin;  // per split, its offset; then the offset after the last
 };
 
 class PmLibrary {
  public:
-  explicit PmLibrary(size_t capacity = 4) : capacity_(capacity) {}
-  // Thread-safe; loads outside the lock, so a slow load does not hold up other PMs.
-  std::shared_ptr<const LoadedPm> get(const std::string& sha256, const std::filesystem::path& path);
+  // Keeps PMs whose files add up to at most `budget_bytes` (always the last one used).
+  explicit PmLibrary(uint64_t budget_bytes = uint64_t(512) << 20) : budget_bytes_(budget_bytes) {}
+  // Thread-safe; loads outside the lock, so a slow load does not hold up other PMs. Throws
+  // Error(kDataLoss) when the blob no longer matches its hash or does not decode (its message
+  // names the blob, not a path), kNotFound when it is missing.
+  std::shared_ptr<const LoadedPm> get(const std::string& sha256, const BlobStore& blobs);
 
  private:
-  size_t capacity_;
+  uint64_t budget_bytes_;
   std::mutex mutex_;
   std::list<std::pair<std::string, std::shared_ptr<const LoadedPm>>> recent_;  // front: newest
 };
-
-// Reads the file at `path` byte range [begin, end).
-std::string read_file_range(const std::filesystem::path& path, uint64_t begin, uint64_t end);
 
 }  // namespace parapm::service

@@ -69,7 +69,18 @@ bool is_gzip(std::string_view bytes) {
          static_cast<unsigned char>(bytes[1]) == 0x8b;
 }
 
-std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes) {
+// The size the gzip trailer declares (ISIZE: the last member's size mod 2^32): a hint for the
+// output buffer once the start has been checked, never trusted beyond `cap`.
+uint64_t declared_size(std::string_view compressed) {
+  if (compressed.size() < 18) return 0;
+  const auto* tail =
+      reinterpret_cast<const unsigned char*>(compressed.data() + compressed.size() - 4);
+  return uint64_t(tail[0]) | uint64_t(tail[1]) << 8 | uint64_t(tail[2]) << 16 |
+         uint64_t(tail[3]) << 24;
+}
+
+std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes,
+                   const StartCheck& check_start) {
   z_stream zs{};
   // 15 + 16: gzip wrapper only (zlib or raw deflate data is not accepted as .gz).
   if (inflateInit2(&zs, 15 + 16) != Z_OK)
@@ -82,8 +93,14 @@ std::string gunzip(std::string_view compressed, const std::string& name, uint64_
   // Capacity may reach max_bytes + 1: one byte beyond the limit proves the limit was passed.
   const uint64_t cap = max_bytes + 1;
   std::string out;
-  out.resize(size_t(std::min<uint64_t>(
-      cap, std::max<uint64_t>(uint64_t(1) << 16, uint64_t(compressed.size()) * 4))));
+  // The first buffer holds just the start to check; it grows only after the check passed.
+  out.resize(size_t(std::min<uint64_t>(cap, kStartCheckBytes)));
+  bool start_checked = !check_start;
+  auto check_once = [&](uint64_t out_pos) {
+    if (start_checked) return;
+    start_checked = true;
+    check_start(std::string_view(out.data(), size_t(out_pos)));
+  };
   uint64_t in_pos = 0, out_pos = 0;
   for (;;) {
     if (zs.avail_in == 0 && in_pos < compressed.size()) {
@@ -92,11 +109,14 @@ std::string gunzip(std::string_view compressed, const std::string& name, uint64_
       in_pos += zs.avail_in;
     }
     if (out_pos == out.size()) {
+      check_once(out_pos);
       if (out.size() >= cap)
         throw Error(ErrorCode::kResourceExhausted, name +
                                                        ": decompresses to more than the limit of " +
                                                        std::to_string(max_bytes) + " bytes");
-      out.resize(size_t(std::min<uint64_t>(cap, uint64_t(out.size()) * 2)));
+      const uint64_t hint = std::max<uint64_t>(declared_size(compressed), out.size() * 2);
+      out.resize(
+          size_t(std::min<uint64_t>(cap, out.size() == kStartCheckBytes ? hint : out.size() * 2)));
     }
     zs.next_out = reinterpret_cast<Bytef*>(out.data() + out_pos);
     zs.avail_out = uInt(std::min<uint64_t>(kZlibSlice, out.size() - out_pos));
@@ -138,6 +158,7 @@ std::string gunzip(std::string_view compressed, const std::string& name, uint64_
                       ": the gzip data is truncated (the stream does not end)");
   }
   out.resize(size_t(out_pos));
+  check_once(out_pos);
   return out;
 }
 

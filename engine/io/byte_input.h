@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -19,6 +20,13 @@ bool is_gzip(std::string_view bytes);
 // output never grows beyond max_bytes + 1 bytes: passing max_bytes is kResourceExhausted as
 // soon as it happens, so a gzip bomb costs at most the limit. Corrupt or truncated data is
 // kInvalidInput naming `name` and the compressed byte offset.
-std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes);
+//
+// `check_start`, when given, is called once with the first kStartCheckBytes inflated bytes
+// (fewer when the data is shorter) before more is inflated, and throws to stop there: a file
+// that is not a mesh costs only that much, however large it would inflate.
+using StartCheck = std::function<void(std::string_view start)>;
+constexpr uint64_t kStartCheckBytes = uint64_t(1) << 16;
+std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes,
+                   const StartCheck& check_start = {});
 
 }  // namespace parapm::io

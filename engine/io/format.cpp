@@ -6,6 +6,7 @@
 
 #include "io/formats.h"
 #include "io/mesh_io.h"
+#include "io/read_context.h"
 #include "io/text_scanner.h"
 
 namespace parapm {
@@ -71,6 +72,32 @@ MeshFormat detect_format(std::string_view bytes) {
        {"v", "vt", "vn", "vp", "f", "l", "p", "g", "o", "s", "usemtl", "mtllib"})
     if (first == keyword) return MeshFormat::kObj;
   return MeshFormat::kUnknown;
+}
+
+void check_mesh_start(const ReadContext& ctx, MeshFormat format, std::string_view start) {
+  switch (format) {
+    case MeshFormat::kPly:
+      if (start.size() >= 4 && (start.substr(0, 4) == "ply\n" || start.substr(0, 4) == "ply\r"))
+        return;
+      fail(ctx, "not a PLY file: the first line is not 'ply'");
+    case MeshFormat::kOff:
+      if (detect_format(start) == MeshFormat::kOff) return;
+      fail(ctx, "not an OFF file: its first keyword is not OFF");
+    case MeshFormat::kObj:
+      // OBJ statements are many and open-ended: refuse only what is not text at all.
+      if (const size_t nul = start.find('\0'); nul != std::string_view::npos)
+        fail_at_byte(ctx, nul, "not an OBJ file: a NUL byte (binary data, not text)");
+      return;
+    case MeshFormat::kStl:
+      if (stl_start_fits(start)) return;
+      fail(ctx,
+           "not an STL file: it does not start with 'solid' and its binary header declares "
+           "fewer triangles than the data that follows");
+    case MeshFormat::kUnknown:
+      if (detect_format(start) != MeshFormat::kUnknown || stl_start_fits(start)) return;
+      fail(ctx,
+           "neither the name nor the content tells the format (expected OBJ, PLY, OFF or STL)");
+  }
 }
 
 }  // namespace io

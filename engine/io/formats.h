@@ -22,6 +22,14 @@ MeshFormat detect_format(std::string_view bytes);
 bool is_off_keyword(std::string_view token);
 // Whether the size is exactly 84 + 50 * (the count at byte 80): a binary STL (stl_reader.cpp).
 bool stl_binary_size_matches(std::string_view bytes);
+// Whether `start`, the first bytes of a file, can begin an STL: ascii ('solid'), or binary
+// whose declared size (84 + 50 * the count at byte 80) is at least what is there (stl_reader.cpp).
+bool stl_start_fits(std::string_view start);
+
+// Throws what the format's reader would (kInvalidInput) when `start`, the first bytes of a
+// file whose length is not known yet, cannot begin a mesh file of `format` (kUnknown: of any
+// format): so that a gzip bomb of zeros stops after its first bytes (format.cpp).
+void check_mesh_start(const ReadContext& ctx, MeshFormat format, std::string_view start);
 
 // Throws kInvalidInput unless faces, wedges and attribute arrays are consistent (mesh_io.cpp).
 void check_writable(const Mesh& mesh);

@@ -28,10 +28,13 @@ Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name, Re
   ctx.limits = limits;
   ctx.report = &r;
   std::string inflated;
+  MeshFormat format = format_from_name(name);
   if (io::is_gzip(bytes)) {
-    inflated = io::gunzip(bytes, name, limits.max_bytes);
-    ctx.bytes = inflated;
     ctx.gzip = r.gzip = true;
+    inflated = io::gunzip(bytes, name, limits.max_bytes, [&](std::string_view start) {
+      if (!start.empty()) io::check_mesh_start(ctx, format, start);
+    });
+    ctx.bytes = inflated;
   } else {
     if (bytes.size() > limits.max_bytes)
       io::fail_limit(ctx, "the input has " + std::to_string(bytes.size()) +
@@ -41,7 +44,6 @@ Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name, Re
   r.input_bytes = ctx.bytes.size();
   if (ctx.bytes.empty()) io::fail(ctx, r.gzip ? "decompresses to nothing" : "the file is empty");
 
-  MeshFormat format = format_from_name(name);
   if (format == MeshFormat::kUnknown) format = io::detect_format(ctx.bytes);
   r.format = format;
   switch (format) {

@@ -190,6 +190,7 @@ class ObjParser {
     }
     if (extras == 2)
       fail_at_line(ctx_, line_no, "a vertex has 5 values (x y z [w] or x y z r g b [a])");
+    check_finite_position(ctx_, p, "vertex " + std::to_string(positions_.size() + 1), line_no);
     positions_.push_back(p);
     if (extras == 1) note_ignored(ctx_, "obj vertex w coordinates");
     if (extras >= 3) {

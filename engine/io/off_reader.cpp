@@ -126,6 +126,7 @@ class OffParser {
       p[0] = number<double>("the x coordinate of a vertex");
       p[1] = number<double>("the y coordinate of a vertex");
       p[2] = number<double>("the z coordinate of a vertex");
+      check_finite_position(ctx_, p, "vertex " + std::to_string(i), s_.line());
       mesh_.positions.push_back(p);
       s_.skip_blanks();
       if (!at_line_end_or_comment()) note_ignored(ctx_, "off extra vertex values");

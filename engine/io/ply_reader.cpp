@@ -439,6 +439,7 @@ class PlyBody {
         }
       }
       mesh_.positions.push_back({v[kX], v[kY], v[kZ]});
+      check_finite_position(ctx_, mesh_.positions.back(), "vertex " + std::to_string(i), 0);
       if (layout.normals)
         for (int c : {kNx, kNy, kNz}) mesh_.wedge_values.push_back(float(v[c]));
       if (layout.texcoords)

@@ -1,7 +1,10 @@
 #include "io/read_context.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <iomanip>
+#include <sstream>
 
 #include "util/error.h"
 
@@ -66,5 +69,19 @@ std::string quote(std::string_view token) {
 }
 
 void finish_mesh(Mesh& mesh) { mesh.positions_are_float = all_positions_are_float(mesh.positions); }
+
+void check_finite_position(const ReadContext& ctx, const Vec3& p, const std::string& what,
+                           uint64_t line) {
+  if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) return;
+  auto text = [](double c) {
+    std::ostringstream out;
+    out << std::setprecision(17) << c;
+    return out.str();
+  };
+  const std::string message = what + " has a non-finite coordinate (" + text(p[0]) + ", " +
+                              text(p[1]) + ", " + text(p[2]) + ")";
+  if (line > 0) fail_at_line(ctx, line, message);
+  fail(ctx, message);
+}
 
 }  // namespace parapm::io

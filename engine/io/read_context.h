@@ -35,6 +35,12 @@ struct ReadContext {
 void check_vertex_limit(const ReadContext& ctx, uint64_t count, const std::string& what);
 void check_face_limit(const ReadContext& ctx, uint64_t count, const std::string& what);
 
+// Refuses (kInvalidInput) a position with a NaN or infinite coordinate, naming it as `what`
+// ("vertex 12", numbered as the format numbers it), at `line` when the format has lines (0:
+// none).
+void check_finite_position(const ReadContext& ctx, const Vec3& p, const std::string& what,
+                           uint64_t line);
+
 // Adds `what` to report->ignored unless it is already there.
 void note_ignored(const ReadContext& ctx, const std::string& what);
 

@@ -143,6 +143,7 @@ Mesh read_binary(const ReadContext& ctx) {
         if constexpr (std::endian::native == std::endian::big) bits[k] = __builtin_bswap32(bits[k]);
         p[k] = double(std::bit_cast<float>(bits[k]));
       }
+      check_finite_position(ctx, p, "triangle " + std::to_string(f) + " (from 0)", 0);
       t[c] = welder.vertex(p);
     }
     mesh.faces.push_back(t);
@@ -222,6 +223,7 @@ class AsciiStlParser {
         p[0] = number("the x coordinate of a vertex");
         p[1] = number("the y coordinate of a vertex");
         p[2] = number("the z coordinate of a vertex");
+        check_finite_position(ctx_, p, "a vertex", s_.line());
         polygon_.push_back(welder_->vertex(p));
       }
       expect("endfacet");
@@ -254,6 +256,12 @@ class AsciiStlParser {
 bool stl_binary_size_matches(std::string_view bytes) {
   return bytes.size() >= kBinaryHeaderBytes &&
          kBinaryHeaderBytes + kBinaryTriangleBytes * uint64_t(binary_count(bytes)) == bytes.size();
+}
+
+bool stl_start_fits(std::string_view start) {
+  if (starts_with_solid(start)) return true;
+  return start.size() < kBinaryHeaderBytes ||
+         kBinaryHeaderBytes + kBinaryTriangleBytes * uint64_t(binary_count(start)) >= start.size();
 }
 
 Mesh read_stl(const ReadContext& ctx) {

@@ -22,11 +22,11 @@
 #include <cstring>
 #include <istream>
 #include <sstream>
-#include <streambuf>
 
 #include "pm/byte_io.h"
 #include "simplify/scalar_attributes.h"
 #include "util/error.h"
+#include "util/view_buffer.h"
 
 namespace parapm {
 namespace {
@@ -60,34 +60,6 @@ constexpr uint64_t kMinSampleBytes = 1 + 24 + 8 + 1 + 1;  // id, position, dista
 constexpr uint64_t kQuadricBytes = 11 * 8;
 
 // ---- Reading from a view ----------------------------------------------------------------
-
-// A read-only stream over bytes the caller owns: nothing is copied, and it is seekable, so
-// that ByteReader knows the size and check_fits can refuse counts before allocating.
-class ViewBuffer : public std::streambuf {
- public:
-  explicit ViewBuffer(std::string_view bytes) {
-    // The get area is declared char*, but a streambuf only reads through it.
-    char* begin = const_cast<char*>(bytes.data());
-    setg(begin, begin, begin + bytes.size());
-  }
-
- protected:
-  pos_type seekoff(off_type off, std::ios_base::seekdir dir,
-                   std::ios_base::openmode which) override {
-    if (which & std::ios_base::out) return pos_type(off_type(-1));
-    const off_type size = egptr() - eback();
-    const off_type base = dir == std::ios_base::beg   ? 0
-                          : dir == std::ios_base::cur ? gptr() - eback()
-                                                      : size;
-    const off_type target = base + off;
-    if (target < 0 || target > size) return pos_type(off_type(-1));
-    setg(eback(), eback() + target, egptr());
-    return pos_type(target);
-  }
-  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
-    return seekoff(off_type(pos), std::ios_base::beg, which);
-  }
-};
 
 struct ViewReader {
   ViewReader(std::string_view bytes, const char* name)

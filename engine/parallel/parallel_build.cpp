@@ -27,6 +27,7 @@
 #include "simplify/surface_samples.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/number_text.h"
 
 namespace parapm {
 namespace {
@@ -160,10 +161,10 @@ void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
                   std::to_string(parallel.rounds));
   if (!(parallel.border_excess >= 0 && parallel.border_excess <= 0.5))
     throw_invalid("the border excess must be in [0, 0.5] (0: geometric rounds only), got " +
-                  std::to_string(parallel.border_excess));
+                  number_text(parallel.border_excess));
   if (!(parallel.handover_ratio > 0 && parallel.handover_ratio <= 1))
     throw_invalid("the handover ratio must be in (0, 1], got " +
-                  std::to_string(parallel.handover_ratio));
+                  number_text(parallel.handover_ratio));
 }
 
 // The partitioner's seed of a round. It picks the start vertex as the (seed mod count)-th

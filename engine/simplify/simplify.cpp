@@ -11,6 +11,7 @@
 #include "simplify/simplifier.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/number_text.h"
 
 namespace parapm {
 
@@ -18,8 +19,7 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
   if (options.target_faces != 0) return options.target_faces;
   if (options.target_ratio != 0) {
     if (!(options.target_ratio > 0 && options.target_ratio <= 1))
-      throw_invalid("the target ratio must be in (0, 1], got " +
-                    std::to_string(options.target_ratio));
+      throw_invalid("the target ratio must be in (0, 1], got " + number_text(options.target_ratio));
     return static_cast<uint64_t>(std::llround(options.target_ratio * double(input_faces)));
   }
   return 0;
@@ -28,7 +28,7 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
 void check_energy_tuning(const EnergyTuning& energy) {
   auto weight = [](double w, const char* what) {
     if (!(w >= 0 && w <= 1000))
-      throw_invalid(std::string("the ") + what + " must be in [0, 1000], got " + std::to_string(w));
+      throw_invalid(std::string("the ") + what + " must be in [0, 1000], got " + number_text(w));
   };
   weight(energy.star_planes_weight, "star planes' weight");
   weight(energy.volume_weight, "volume weight");
@@ -38,7 +38,7 @@ void check_energy_tuning(const EnergyTuning& energy) {
                   std::to_string(energy.min_crease_edges));
   if (!(energy.crease_min_length >= 0 && energy.crease_min_length <= 10))
     throw_invalid("the minimum crease length must be in [0, 10] bounding-box diagonals, got " +
-                  std::to_string(energy.crease_min_length));
+                  number_text(energy.crease_min_length));
 }
 
 void check_simplify_options(const SimplifyOptions& options) {
@@ -46,13 +46,13 @@ void check_simplify_options(const SimplifyOptions& options) {
     throw_invalid("unknown metric '" + options.metric + "' (available: quadric, energy)");
   if (!(options.crease_angle_degrees >= 0 && options.crease_angle_degrees <= 180))
     throw_invalid("the crease angle must be in [0, 180] degrees, got " +
-                  std::to_string(options.crease_angle_degrees));
+                  number_text(options.crease_angle_degrees));
   if (!(options.attribute_weight >= 0 && options.attribute_weight <= 1000))
     throw_invalid("the attribute weight must be in [0, 1000], got " +
-                  std::to_string(options.attribute_weight));
+                  number_text(options.attribute_weight));
   if (!(options.samples_per_face >= 0 && options.samples_per_face <= 1000))
     throw_invalid("samples per face must be in [0, 1000], got " +
-                  std::to_string(options.samples_per_face));
+                  number_text(options.samples_per_face));
   check_energy_tuning(options.energy);
 }
 

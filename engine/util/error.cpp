@@ -20,6 +20,8 @@ const char* error_code_name(ErrorCode code) {
       return "failed precondition";
     case ErrorCode::kInternal:
       return "internal error";
+    case ErrorCode::kDataLoss:
+      return "data loss";
   }
   return "unknown error";
 }

@@ -18,6 +18,7 @@ enum class ErrorCode {
   kIo,                  // the operating system failed to read or write
   kFailedPrecondition,  // the object is not in the state the call needs (a job not done yet)
   kInternal,            // a bug: an invariant of the engine does not hold
+  kDataLoss,            // stored bytes no longer match what was stored (a flipped byte, a cut file)
 };
 
 const char* error_code_name(ErrorCode code);

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -17,7 +18,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-[[noreturn]] void throw_io(const std::string& what, int errno_value) {
+// The path goes to the log, not into the message: messages reach clients.
+[[noreturn]] void throw_io(const std::string& what, const fs::path& path, int errno_value) {
+  spdlog::error("blob store: {} ({}): {}", what, path.string(), std::strerror(errno_value));
   throw Error(ErrorCode::kIo, "blob store: " + what + ": " + std::strerror(errno_value));
 }
 
@@ -30,11 +33,11 @@ void make_dir(const fs::path& dir) {
 // A rename is durable only once the folder holding the new name is on disk too.
 void fsync_dir(const fs::path& dir) {
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) throw_io("opening folder " + dir.string(), errno);
+  if (fd < 0) throw_io("opening a folder", dir, errno);
   const int rc = ::fsync(fd);
   const int saved = errno;
   ::close(fd);
-  if (rc != 0) throw_io("fsync of folder " + dir.string(), saved);
+  if (rc != 0) throw_io("fsync of a folder", dir, saved);
 }
 
 // Temp files are only ever written by a live Writer of this process, so at start-up every
@@ -53,6 +56,39 @@ void remove_stale_temp_files(const fs::path& temp_dir) {
     throw Error(ErrorCode::kIo, "blob store: listing " + temp_dir.string() + ": " + ec.message());
   if (removed > 0)
     spdlog::info("blob store: removed {} stale temp files from {}", removed, temp_dir.string());
+}
+
+// The bytes of blob `sha` at `path`, checked against the hash (see BlobStore::read).
+std::string read_checked(const fs::path& path, const std::string& sha) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    if (errno == ENOENT) throw Error(ErrorCode::kNotFound, "blob store: no blob " + sha);
+    throw_io("opening blob " + sha, path, errno);
+  }
+  std::string bytes;
+  struct stat info {};
+  if (::fstat(fd, &info) == 0 && info.st_size > 0) bytes.reserve(static_cast<size_t>(info.st_size));
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int saved = errno;
+      ::close(fd);
+      throw_io("reading blob " + sha, path, saved);
+    }
+    bytes.append(buffer, static_cast<size_t>(n));
+  }
+  ::close(fd);
+  if (sha256_hex(bytes) != sha) {
+    spdlog::critical("blob store: {} is corrupt: its {} bytes no longer hash to its name",
+                     path.string(), bytes.size());
+    throw Error(ErrorCode::kDataLoss, "stored blob " + sha +
+                                          " is corrupt (its bytes no longer match their hash); "
+                                          "the operator has been told in the log");
+  }
+  return bytes;
 }
 
 }  // namespace
@@ -106,7 +142,7 @@ void BlobStore::Writer::write(std::string_view bytes) {
     const ssize_t n = ::write(fd_, bytes.data(), bytes.size());
     if (n < 0) {
       if (errno == EINTR) continue;
-      throw_io("writing " + temp_path_.string(), errno);
+      throw_io("writing a new blob", temp_path_, errno);
     }
     bytes.remove_prefix(static_cast<size_t>(n));
     size_ += static_cast<uint64_t>(n);
@@ -116,7 +152,7 @@ void BlobStore::Writer::write(std::string_view bytes) {
 std::string BlobStore::Writer::commit() {
   if (fd_ < 0) throw_internal("blob store: commit() on a finished writer");
   // On any failure below the destructor still removes the temp file.
-  if (::fsync(fd_) != 0) throw_io("fsync of " + temp_path_.string(), errno);
+  if (::fsync(fd_) != 0) throw_io("fsync of a new blob", temp_path_, errno);
   const std::string sha = hash_.hex();
   const fs::path target = store_->path_of(sha);
   make_dir(target.parent_path());
@@ -128,7 +164,7 @@ std::string BlobStore::Writer::commit() {
   // rename() replaces atomically, so two writers committing the same bytes at once both
   // succeed and leave one complete file.
   if (::rename(temp_path_.c_str(), target.c_str()) != 0)
-    throw_io("renaming " + temp_path_.string() + " to " + target.string(), errno);
+    throw_io("renaming a new blob to " + sha, target, errno);
   ::close(fd_);
   fd_ = -1;
   fsync_dir(target.parent_path());
@@ -140,7 +176,7 @@ std::string BlobStore::Writer::commit() {
 BlobStore::Writer BlobStore::begin() {
   const fs::path temp_path = temp_dir_ / new_id("put-");
   const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) throw_io("creating " + temp_path.string(), errno);
+  if (fd < 0) throw_io("creating a new blob", temp_path, errno);
   return Writer(*this, temp_path, fd);
 }
 
@@ -169,34 +205,39 @@ uint64_t BlobStore::size_of(const std::string& sha) const {
   const uint64_t size = fs::file_size(path, ec);
   if (ec == std::errc::no_such_file_or_directory)
     throw Error(ErrorCode::kNotFound, "blob store: no blob " + sha);
-  if (ec) throw Error(ErrorCode::kIo, "blob store: size of " + path.string() + ": " + ec.message());
+  if (ec) {
+    spdlog::error("blob store: size of {}: {}", path.string(), ec.message());
+    throw Error(ErrorCode::kIo, "blob store: size of blob " + sha + ": " + ec.message());
+  }
   return size;
 }
 
 std::string BlobStore::read(const std::string& sha) const {
-  const fs::path path = path_of(sha);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    if (errno == ENOENT) throw Error(ErrorCode::kNotFound, "blob store: no blob " + sha);
-    throw_io("opening " + path.string(), errno);
+  return read_checked(path_of(sha), sha);
+}
+
+BlobStore::VerifyReport BlobStore::verify(const fs::path& data_dir) {
+  const fs::path blobs_dir = data_dir / "blobs", temp_dir = blobs_dir / "tmp";
+  VerifyReport report;
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& shard : fs::directory_iterator(blobs_dir, ec)) {
+    if (!shard.is_directory() || shard.path() == temp_dir) continue;
+    for (const auto& entry : fs::directory_iterator(shard.path(), ec))
+      names.push_back(entry.path().filename().string());
   }
-  std::string bytes;
-  struct stat info {};
-  if (::fstat(fd, &info) == 0 && info.st_size > 0) bytes.reserve(static_cast<size_t>(info.st_size));
-  char buffer[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
-    if (n == 0) break;
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int saved = errno;
-      ::close(fd);
-      throw_io("reading " + path.string(), saved);
+  if (ec) throw_io("listing the blobs", blobs_dir, ec.value());
+  std::sort(names.begin(), names.end());
+  for (const std::string& name : names) {
+    ++report.blobs;
+    try {
+      if (!is_sha256_hex(name)) throw_invalid("not a blob name");
+      report.bytes += read_checked(blobs_dir / name.substr(0, 2) / name, name).size();
+    } catch (const Error&) {
+      report.corrupt.push_back(name);  // read() logged why
     }
-    bytes.append(buffer, static_cast<size_t>(n));
   }
-  ::close(fd);
-  return bytes;
+  return report;
 }
 
 }  // namespace parapm::service

@@ -8,6 +8,11 @@
 // they write a database row that refers to it: after a crash a row never points at a missing
 // blob (at worst a blob has no row, which costs only disk space).
 //
+// Reading checks: read() hashes what it read and throws Error(kDataLoss) when the bytes no
+// longer hash to the blob's name (a flipped byte, a cut file), so nothing corrupt is used or
+// served. Messages thrown name blobs by hash, never by path (they reach clients); the paths go
+// to the log.
+//
 // Thread safety: the const members and begin() may be called from many threads; each Writer
 // belongs to one thread. One BlobStore per data folder per process: the constructor removes
 // every temp file, which would break another live store's writers.
@@ -17,6 +22,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "storage/sha256.h"
 
@@ -62,9 +68,19 @@ class BlobStore {
   bool contains(const std::string& sha) const;
   // Where the blob is or would be. Throws kInvalidInput on a malformed hash.
   std::filesystem::path path_of(const std::string& sha) const;
-  // Throw kInvalidInput on a malformed hash, kNotFound when the blob is absent, kIo otherwise.
+  // Throw kInvalidInput on a malformed hash, kNotFound when the blob is absent, kIo otherwise;
+  // read() also kDataLoss when the bytes do not hash to `sha`.
   uint64_t size_of(const std::string& sha) const;
   std::string read(const std::string& sha) const;
+
+  // Every blob stored under DATA_DIR hashed again: the names of those whose bytes no longer
+  // match (or cannot be read), in name order. Reads the whole store; touches nothing, so it
+  // may run beside a live coordinator.
+  struct VerifyReport {
+    uint64_t blobs = 0, bytes = 0;
+    std::vector<std::string> corrupt;
+  };
+  static VerifyReport verify(const std::filesystem::path& data_dir);
 
   const std::filesystem::path& blobs_dir() const { return blobs_dir_; }
   const std::filesystem::path& temp_dir() const { return temp_dir_; }

@@ -65,12 +65,37 @@ TEST(Gzip, BombStopsAtTheLimit) {
   ASSERT_LT(bomb.size(), 1u << 20);
   expect_error([&] { io::gunzip(bomb, "bomb.gz", 1 << 20); }, ErrorCode::kResourceExhausted,
                {"bomb.gz", "limit of 1048576 bytes"});
+  // A bomb whose start looks like a mesh stops at the reader's limit.
+  const std::string ply_bomb = io::gzip_compress("ply\n" + std::string(64u << 20, ' '));
   ReadLimits limits;
   limits.max_bytes = 4096;
-  expect_error([&] { read_text(bomb, "bomb.ply.gz", nullptr, limits); },
+  expect_error([&] { read_text(ply_bomb, "bomb.ply.gz", nullptr, limits); },
                ErrorCode::kResourceExhausted, {"bomb.ply.gz", "limit of 4096"});
   // Exactly at the limit is fine.
   EXPECT_EQ(io::gunzip(io::gzip_compress(std::string(4096, 'a')), "edge.gz", 4096).size(), 4096u);
+}
+
+// A bomb that is no mesh stops after its first 64 KiB, far below the limit, with the reader's
+// own message: what it costs does not depend on how large it would inflate.
+TEST(Gzip, BombThatIsNoMeshStopsAfterItsStart) {
+  const std::string zeros = io::gzip_compress(std::string(64u << 20, '\0'));
+  uint64_t seen = 0;
+  expect_error(
+      [&] {
+        io::gunzip(zeros, "zeros.gz", uint64_t(8) << 30, [&](std::string_view start) {
+          seen = start.size();
+          throw Error(ErrorCode::kInvalidInput, "zeros.gz: not a mesh");
+        });
+      },
+      ErrorCode::kInvalidInput, {"not a mesh"});
+  EXPECT_EQ(seen, io::kStartCheckBytes);
+  for (const char* name : {"zeros.ply.gz", "zeros.obj.gz", "zeros.off.gz", "zeros.stl.gz"})
+    expect_error([&] { read_text(zeros, name); }, ErrorCode::kInvalidInput, {name, "not a"});
+  expect_error([&] { read_text(zeros, "zeros.gz"); }, ErrorCode::kInvalidInput,
+               {"zeros.gz", "neither the name nor the content tells the format"});
+  // A short valid file is checked once, whole, and read.
+  EXPECT_EQ(read_text(io::gzip_compress(kObj), "small.obj.gz").face_count(),
+            read_text(kObj, "small.obj").face_count());
 }
 
 TEST(Files, PlainInputLargerThanTheLimitIsRefused) {

@@ -58,11 +58,24 @@ TEST(ObjReader, PositionsKeepDoublePrecision) {
   EXPECT_FALSE(mesh.positions_are_float);
 }
 
-TEST(ObjReader, NanAndInfinityParse) {
-  const Mesh mesh = read_text("v nan inf -inf\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "nan.obj");
-  EXPECT_TRUE(std::isnan(mesh.positions[0][0]));
-  EXPECT_TRUE(std::isinf(mesh.positions[0][1]));
-  EXPECT_TRUE(std::isinf(mesh.positions[0][2]));
+// NaN and infinity parse as numbers, but no mesh can use them: refused where they are, by
+// file, line and the vertex's number as the format counts (from 1 in OBJ, from 0 in OFF/PLY).
+TEST(ObjReader, NonFinitePositionsAreRefusedWhereTheyAre) {
+  expect_error([] { read_text("v 0 0 0\nv 1 0 0\nv nan inf -inf\nf 1 2 3\n", "nan.obj"); },
+               ErrorCode::kInvalidInput,
+               {"nan.obj", "line 3", "vertex 3 has a non-finite coordinate (nan, inf, -inf)"});
+  expect_error([] { read_text("OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n", "inf.off"); },
+               ErrorCode::kInvalidInput,
+               {"inf.off", "line 4", "vertex 1 has a non-finite coordinate"});
+  expect_error(
+      [] {
+        read_text(
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+            "end_header\n0 0 0\n1 0 0\n0 nan 0\n3 0 1 2\n",
+            "nan.ply");
+      },
+      ErrorCode::kInvalidInput, {"nan.ply", "vertex 2 has a non-finite coordinate"});
 }
 
 // Two triangles sharing the edge 0-2; vertex 0 has two texture coordinates (a seam).

@@ -114,6 +114,48 @@ TEST_F(ServiceCli, UpSubmitFetchStreamAndStopWithCtrlC) {
   EXPECT_EQ(after.exit_code, 3) << "the coordinator still answers after Ctrl-C: " << after.output;
 }
 
+size_t count_of(const std::string& text, const std::string& what) {
+  size_t count = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++count;
+  return count;
+}
+
+// A worker killed under `parapm up` used to stop the whole service; now it is started again
+// and the service keeps building.
+TEST_F(ServiceCli, UpStartsACrashedWorkerAgain) {
+  const std::string server = "127.0.0.1:" + std::to_string(free_port());
+  ChildProcess up("up",
+                  {(fs::path(PARAPM_BINARY_DIR) / "parapm").string(), "up", "--workers", "1",
+                   "--data", (dir() / "up-data").string(), "--listen", server},
+                  dir() / "up.log");
+  auto wait_for = [&](const std::string& what, size_t count) {
+    for (int i = 0; i < 400 && count_of(up.log(), what) < count; ++i)
+      std::this_thread::sleep_for(milliseconds(50));
+    return count_of(up.log(), what) >= count;
+  };
+  ASSERT_TRUE(wait_for("registered with coordinator", 1)) << up.log();
+  const std::string log = up.log();
+  const size_t at = log.find("worker-1 is process ");
+  ASSERT_NE(at, std::string::npos) << log;
+  const pid_t worker = pid_t(std::stol(log.substr(at + 20)));
+  ASSERT_EQ(::kill(worker, SIGKILL), 0);
+  ASSERT_TRUE(wait_for("registered with coordinator", 2)) << up.log();
+  EXPECT_NE(up.log().find("exited (signal 9); starting it again in 0.5 s"), std::string::npos)
+      << up.log();
+  ASSERT_TRUE(up.running()) << up.log();
+
+  const fs::path input = mesh("cad-featuretype-3k.stl");
+  const fs::path out = dir() / "after-crash.pm";
+  CliResult submitted = run_parapm(
+      {"submit", input.string(), "--parallel", "2", "-o", out.string(), "--server", server}, dir());
+  ASSERT_EQ(submitted.exit_code, 0) << submitted.output << up.log();
+  EXPECT_EQ(lossless_failure(read_binary(out), input, dir()), "");
+  up.signal(SIGINT);
+  const std::optional<int> status = up.wait(seconds(15));
+  ASSERT_TRUE(status.has_value()) << up.log();
+  EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 0) << up.log();
+}
+
 TEST_F(ServiceCli, TlsWithAVerifiedCertificate) {
   const std::string cert = testing::test_data("tls/cert.pem");
   const std::string key = testing::test_data("tls/key.pem");

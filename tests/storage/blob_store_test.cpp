@@ -2,6 +2,7 @@
 // idempotence, temp files of abandoned writers and of a crash, and refused hash names.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -164,6 +165,37 @@ TEST(BlobStore, MissingBlobIsNotFound) {
   EXPECT_FALSE(store.contains(kAbcSha));
   expect_error([&] { store.read(kAbcSha); }, ErrorCode::kNotFound, {"no blob", kAbcSha});
   expect_error([&] { store.size_of(kAbcSha); }, ErrorCode::kNotFound, {"no blob", kAbcSha});
+}
+
+// A flipped byte or a cut file is DATA_LOSS naming the blob, not where it lies; verify()
+// finds exactly the changed blobs, and leaves the store as it was.
+TEST(BlobStore, ChangedBytesAreDataLossAndVerifyFindsThem) {
+  TempDir dir;
+  BlobStore store(dir.path());
+  const std::string flipped = store.put(some_bytes(5000));
+  const std::string cut = store.put(some_bytes(7000));
+  const std::string intact = store.put(some_bytes(9000));
+  std::string bytes = some_bytes(5000);
+  bytes[1234] ^= 0x10;
+  testing::write_file(store.path_of(flipped), bytes);
+  testing::write_file(store.path_of(cut), some_bytes(6999));
+  for (const std::string& sha : {flipped, cut}) {
+    try {
+      store.read(sha);
+      ADD_FAILURE() << "read of a changed blob succeeded";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kDataLoss);
+      EXPECT_NE(std::string(e.what()).find(sha), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find(dir.path().string()), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(store.read(intact), some_bytes(9000));
+  const BlobStore::VerifyReport report = BlobStore::verify(dir.path());
+  EXPECT_EQ(report.blobs, 3u);
+  std::vector<std::string> expected = {flipped, cut};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(report.corrupt, expected);
+  EXPECT_TRUE(store.contains(flipped));  // verify reports; it removes nothing
 }
 
 TEST(BlobStore, StoresACommittedMeshFileUnderItsSha256sum) {

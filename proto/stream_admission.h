@@ -1,0 +1,94 @@
+// Admission control for streaming calls, which hold a server thread each for as long as they
+// are open (the sync API): a bound on open streams in all and per client, so that idle or
+// greedy clients cannot take the threads that unary calls and the workers' heartbeats need;
+// and a watchdog that cancels a stream that moved no message for `idle` or has been open for
+// `total`, so that a stream a client abandons without closing frees its thread.
+//
+// A refused stream gets RESOURCE_EXHAUSTED saying which bound was hit, with the trailing
+// metadata grpc-retry-pushback-ms (when to retry). Thread-safe.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <grpcpp/grpcpp.h>
+
+namespace parapm::rpc {
+
+struct StreamLimits {
+  unsigned max_streams = 64;             // open streaming calls, all clients together
+  unsigned max_streams_per_client = 16;  // per client address (its IP, without the port)
+  std::chrono::milliseconds idle{std::chrono::seconds(60)};  // no message moved: cancelled
+  std::chrono::milliseconds total{std::chrono::hours(1)};    // open this long: cancelled
+};
+
+class StreamAdmission {
+  struct Entry;
+
+ public:
+  explicit StreamAdmission(StreamLimits limits);  // starts the watchdog thread
+  ~StreamAdmission();
+  StreamAdmission(const StreamAdmission&) = delete;
+  StreamAdmission& operator=(const StreamAdmission&) = delete;
+
+  // An admitted stream; leaving its handler (destroying the ticket) frees its place.
+  class Ticket {
+   public:
+    ~Ticket();
+    Ticket(const Ticket&) = delete;
+    Ticket& operator=(const Ticket&) = delete;
+    void touch();             // a message moved: the idle clock starts again
+    bool past_total() const;  // open for longer than the total limit
+    // The status to end with once the watchdog cancelled the call (idle or past the total),
+    // else nullopt.
+    std::optional<grpc::Status> expired() const;
+
+   private:
+    friend class StreamAdmission;
+    Ticket(StreamAdmission& owner, std::list<Entry>::iterator entry)
+        : owner_(owner), entry_(entry) {}
+    StreamAdmission& owner_;
+    std::list<Entry>::iterator entry_;
+  };
+
+  // Admits the stream `call` of `context`, or returns nullptr and sets *refused.
+  std::unique_ptr<Ticket> admit(grpc::ServerContext* context, const char* call,
+                                grpc::Status* refused);
+
+  const StreamLimits& limits() const { return limits_; }
+  size_t open_streams() const;
+
+ private:
+  struct Entry {
+    grpc::ServerContext* context;
+    std::string call, client;
+    std::chrono::steady_clock::time_point opened, last_moved;
+    const char* expired = nullptr;  // "idle" or "open too long" once cancelled
+  };
+  // Gives back the place of an admitted stream (once: at expiry or at the ticket's end).
+  void release(Entry& entry);
+  void watch_loop();
+
+  StreamLimits limits_;
+  mutable std::mutex mutex_;
+  std::condition_variable stop_changed_;
+  bool stopping_ = false;
+  std::list<Entry> open_;  // admitted streams whose handlers are still running
+  size_t admitted_ = 0;    // those of open_ not expired: an expired one is on its way out
+  std::map<std::string, unsigned> per_client_;  // admitted, per client
+  std::thread watchdog_;
+};
+
+// The client part of a peer string: "ipv4:127.0.0.1:5000" -> "127.0.0.1",
+// "ipv6:[::1]:5000" -> "::1".
+std::string peer_client(const std::string& peer);
+
+}  // namespace parapm::rpc
