@@ -1,5 +1,5 @@
-// parapm jobs / watch JOB / cancel JOB: the coordinator's job list, one job's events as they
-// happen, and cancellation.
+// parapm jobs / watch JOB / cancel JOB / delete JOB | --mesh MESH: the coordinator's job list,
+// one job's events as they happen, cancellation, and deletion.
 #include <ctime>
 
 #include <spdlog/spdlog.h>
@@ -16,6 +16,7 @@ struct JobsArgs {
   ConnectionArgs connection;
   uint32_t limit = 20;
   std::string job_id;
+  std::string mesh_id;  // delete --mesh
   bool json = false;
 };
 
@@ -87,6 +88,34 @@ int run_cancel(const JobsArgs& args) {
   return 0;
 }
 
+int run_delete(const JobsArgs& args) {
+  if (args.job_id.empty() == args.mesh_id.empty())
+    throw_invalid("give a job id or --mesh MESH (one of them)");
+  ServiceClient client(args.connection);
+  parapm::v1::DeleteReply reply;
+  auto context = client.context();
+  if (!args.mesh_id.empty()) {
+    parapm::v1::MeshRef ref;
+    ref.set_mesh_id(args.mesh_id);
+    check_status(client.stub().DeleteMesh(context.get(), ref, &reply),
+                 "delete mesh " + args.mesh_id, client.server());
+  } else {
+    parapm::v1::JobRef ref;
+    ref.set_job_id(args.job_id);
+    check_status(client.stub().DeleteJob(context.get(), ref, &reply), "delete " + args.job_id,
+                 client.server());
+  }
+  if (args.json)
+    print_json(message_json(reply));
+  else
+    std::printf("deleted %llu jobs, %llu meshes; %llu blobs (%llu bytes) freed\n",
+                static_cast<unsigned long long>(reply.jobs_deleted()),
+                static_cast<unsigned long long>(reply.meshes_deleted()),
+                static_cast<unsigned long long>(reply.blobs_removed()),
+                static_cast<unsigned long long>(reply.bytes_freed()));
+  return 0;
+}
+
 }  // namespace
 
 void add_jobs_commands(CLI::App& app, int& exit_code) {
@@ -116,6 +145,18 @@ void add_jobs_commands(CLI::App& app, int& exit_code) {
   c->add_flag("--json", cancel->json, "print the job as one JSON object");
   add_connection_options(c, cancel->connection);
   c->callback([cancel, &exit_code] { exit_code = run_cancel(*cancel); });
+
+  auto remove = std::make_shared<JobsArgs>();
+  CLI::App* d = app.add_subcommand(
+      "delete",
+      "delete an ended job (its events and PM), or with --mesh a mesh and all its jobs; the "
+      "stored files no job or mesh names any more are removed (a queued or running job: cancel "
+      "it first)");
+  d->add_option("job", remove->job_id, "job id");
+  d->add_option("--mesh", remove->mesh_id, "delete this mesh and its jobs instead");
+  d->add_flag("--json", remove->json, "print what was deleted as one JSON object");
+  add_connection_options(d, remove->connection);
+  d->callback([remove, &exit_code] { exit_code = run_delete(*remove); });
 }
 
 }  // namespace parapm::cli

@@ -14,7 +14,7 @@ void add_partition_command(CLI::App& app, int& exit_code);
 // The service commands (service_client.h), when built with the service.
 void add_up_command(CLI::App& app, int& exit_code);
 void add_submit_command(CLI::App& app, int& exit_code);
-void add_jobs_commands(CLI::App& app, int& exit_code);   // jobs, watch, cancel
+void add_jobs_commands(CLI::App& app, int& exit_code);   // jobs, watch, cancel, delete
 void add_fetch_commands(CLI::App& app, int& exit_code);  // get, level
 void add_stream_command(CLI::App& app, int& exit_code);
 

@@ -1,5 +1,7 @@
 #include "coordinator.h"
 
+#include <malloc.h>
+
 #include <chrono>
 #include <sstream>
 
@@ -16,6 +18,12 @@
 
 namespace parapm::service {
 namespace {
+
+// A job's and an upload's memory (the mesh, the engine's state, the PM: hundreds of MB on a
+// large mesh) is freed in blocks glibc keeps for reuse in its per-thread arenas; give the
+// free pages back to the system, so that an idle coordinator's memory falls back near where
+// it started.
+void give_back_free_memory() { ::malloc_trim(0); }
 
 parapm::v1::JobState state_of(JobStatus status) {
   switch (status) {
@@ -89,12 +97,15 @@ Coordinator::Coordinator(CoordinatorConfig config)
   }
   for (unsigned i = 0; i < std::max(1u, config_.max_running_jobs); ++i)
     schedulers_.emplace_back([this] { scheduler_loop(); });
+  if (config_.retain_for.count() > 0 || config_.retain_bytes > 0)
+    retention_ = std::thread([this] { retention_loop(); });
   spdlog::info("coordinator data in {}: {} jobs queued", config_.data_dir.string(), queue_.size());
 }
 
 Coordinator::~Coordinator() {
   stop();
   for (std::thread& t : schedulers_) t.join();
+  if (retention_.joinable()) retention_.join();
 }
 
 void Coordinator::stop() {
@@ -105,6 +116,7 @@ void Coordinator::stop() {
   }
   queue_changed_.notify_all();
   events_changed_.notify_all();
+  stop_requested_.notify_all();
 }
 
 ReadLimits Coordinator::read_limits() const {
@@ -130,8 +142,13 @@ UploadResult Coordinator::finish_upload(Upload upload) {
     std::counting_semaphore<>& slots;
     ~Release() { slots.release(); }
   } release{parse_slots_};
-  const RepairedMesh repaired =
-      repair_mesh(read_mesh_from_memory(upload.bytes_, upload.file_name_, nullptr, read_limits()));
+  const RepairedMesh repaired = [&] {
+    struct GiveBack {
+      ~GiveBack() { give_back_free_memory(); }
+    } give_back;  // after the parse, whether it succeeded or not
+    return repair_mesh(
+        read_mesh_from_memory(upload.bytes_, upload.file_name_, nullptr, read_limits()));
+  }();
   if (repaired.mesh.face_count() == 0)
     throw_invalid(upload.file_name_ + ": no faces left after repair");
   result.repairs = repairs_text(repaired.report);
@@ -293,6 +310,104 @@ std::vector<parapm::v1::JobEvent> Coordinator::events(const std::string& job_id,
   return fetch();
 }
 
+DeleteResult Coordinator::collect_garbage() {
+  const BlobStore::Removed removed =
+      blobs_.remove_unreferenced(store_.referenced_blobs(), std::chrono::seconds(60));
+  DeleteResult result;
+  result.blobs = removed.blobs;
+  result.bytes = removed.bytes;
+  return result;
+}
+
+DeleteResult Coordinator::delete_job(const std::string& job_id) {
+  store_.delete_job(job_id);
+  DeleteResult result = collect_garbage();
+  result.jobs = 1;
+  spdlog::info("job {} deleted ({} blobs, {} bytes freed)", job_id, result.blobs, result.bytes);
+  return result;
+}
+
+DeleteResult Coordinator::delete_mesh(const std::string& mesh_id) {
+  std::vector<JobRecord> jobs;
+  {
+    // Not while an upload of the same bytes is answering with this mesh.
+    std::lock_guard lock(upload_mutex_);
+    jobs = store_.delete_mesh(mesh_id);
+  }
+  DeleteResult result = collect_garbage();
+  result.meshes = 1;
+  result.jobs = jobs.size();
+  spdlog::info("mesh {} deleted with {} jobs ({} blobs, {} bytes freed)", mesh_id, jobs.size(),
+               result.blobs, result.bytes);
+  return result;
+}
+
+DeleteResult Coordinator::apply_retention() {
+  DeleteResult result;
+  const int64_t now = unix_ms_now();
+  auto drop_job = [&](const JobRecord& job) {
+    try {
+      store_.delete_job(job.job_id);
+      ++result.jobs;
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::kNotFound && e.code() != ErrorCode::kFailedPrecondition) throw;
+    }
+  };
+  auto drop_mesh_without_jobs = [&](const MeshRecord& mesh) {
+    std::lock_guard lock(upload_mutex_);
+    if (store_.jobs_of_mesh(mesh.mesh_id) > 0) return false;
+    store_.delete_mesh(mesh.mesh_id);
+    ++result.meshes;
+    return true;
+  };
+  if (config_.retain_for.count() > 0) {
+    const int64_t before = now - config_.retain_for.count();
+    for (const JobRecord& job : store_.ended_jobs())
+      if (job.updated_unix_ms < before) drop_job(job);
+    for (const MeshRecord& mesh : store_.list_meshes())
+      if (mesh.created_unix_ms < before) drop_mesh_without_jobs(mesh);
+  }
+  DeleteResult freed = collect_garbage();
+  if (config_.retain_bytes > 0) {
+    // Oldest first, one at a time, until the blobs fit (a blob is freed once no row names it).
+    for (const JobRecord& job : store_.ended_jobs()) {
+      if (blobs_.stored_bytes() <= config_.retain_bytes) break;
+      drop_job(job);
+      const DeleteResult more = collect_garbage();
+      freed.blobs += more.blobs;
+      freed.bytes += more.bytes;
+    }
+    // A mesh uploaded in the last hour is spared: its client may not have submitted yet.
+    const int64_t fresh = now - int64_t(3600) * 1000;
+    for (const MeshRecord& mesh : store_.list_meshes()) {
+      if (blobs_.stored_bytes() <= config_.retain_bytes) break;
+      if (mesh.created_unix_ms > fresh || !drop_mesh_without_jobs(mesh)) continue;
+      const DeleteResult more = collect_garbage();
+      freed.blobs += more.blobs;
+      freed.bytes += more.bytes;
+    }
+  }
+  result.blobs = freed.blobs;
+  result.bytes = freed.bytes;
+  if (result.jobs + result.meshes + result.blobs > 0)
+    spdlog::info("retention: {} jobs, {} meshes and {} blobs ({} bytes) deleted", result.jobs,
+                 result.meshes, result.blobs, result.bytes);
+  return result;
+}
+
+void Coordinator::retention_loop() {
+  std::unique_lock lock(mutex_);
+  do {
+    lock.unlock();
+    try {
+      apply_retention();
+    } catch (const std::exception& e) {
+      spdlog::error("retention: {}", e.what());
+    }
+    lock.lock();
+  } while (!stop_requested_.wait_for(lock, config_.retention_check, [this] { return stopping_; }));
+}
+
 JobRecord Coordinator::done_job(const std::string& job_id) {
   JobRecord record = load_job(job_id);
   if (record.status != JobStatus::kDone)
@@ -402,8 +517,11 @@ void Coordinator::run_job(const std::string& job_id) {
     end_job(record, event);
     spdlog::error("job {} failed: {}", job_id, record.failure_reason);
   }
-  std::lock_guard lock(mutex_);
-  running_.erase(job_id);
+  {
+    std::lock_guard lock(mutex_);
+    running_.erase(job_id);
+  }
+  give_back_free_memory();
 }
 
 void Coordinator::execute(JobRecord& record, Running& running,

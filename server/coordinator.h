@@ -43,6 +43,18 @@ struct CoordinatorConfig {
   std::chrono::milliseconds heartbeat{1000};
   std::string worker_token;  // sent on calls to workers
   std::shared_ptr<grpc::ChannelCredentials> worker_credentials;
+  // Retention, applied at start and every retention_check: jobs that ended longer ago than
+  // retain_for are deleted, and meshes older than that with no job left (0: kept forever);
+  // while the blobs hold more than retain_bytes, the oldest ended jobs, then the oldest
+  // meshes without a job (uploaded more than an hour ago), are deleted (0: no bound).
+  std::chrono::milliseconds retain_for{0};
+  uint64_t retain_bytes = 0;
+  std::chrono::milliseconds retention_check{std::chrono::minutes(10)};
+};
+
+// What a deletion removed: rows, and the blobs no row refers to any more.
+struct DeleteResult {
+  uint64_t jobs = 0, meshes = 0, blobs = 0, bytes = 0;
 };
 
 // An upload in progress: bytes gathered up to the size limit.
@@ -98,6 +110,14 @@ class Coordinator {
   std::vector<parapm::v1::JobEvent> events(const std::string& job_id, uint64_t after_seq,
                                            std::chrono::milliseconds wait);
 
+  // Deletes an ended job (kFailedPrecondition while queued or running, kNotFound) and the
+  // blobs no row refers to any more.
+  DeleteResult delete_job(const std::string& job_id);
+  // Deletes a mesh with its ended jobs (kFailedPrecondition while one is queued or running).
+  DeleteResult delete_mesh(const std::string& mesh_id);
+  // Applies the retention of the config once (the retention thread calls it).
+  DeleteResult apply_retention();
+
   // A done job's PM, its bytes checked against their hash (kFailedPrecondition when the job
   // is not done; kDataLoss when its stored PM is corrupt).
   std::shared_ptr<const LoadedPm> pm(const std::string& job_id);
@@ -109,6 +129,10 @@ class Coordinator {
   };
 
   void scheduler_loop();
+  void retention_loop();
+  // Removes the blobs no row names (committed more than a minute ago: a blob is written
+  // before its row).
+  DeleteResult collect_garbage();
   void run_job(const std::string& job_id);
   void execute(JobRecord& record, Running& running, parapm::v1::JobEvent::Transport& transport);
   void emit(const std::string& job_id, parapm::v1::JobEvent event);
@@ -133,10 +157,12 @@ class Coordinator {
   std::mutex mutex_;
   std::condition_variable queue_changed_;
   std::condition_variable events_changed_;
+  std::condition_variable stop_requested_;  // wakes the retention thread
   std::deque<std::string> queue_;
   std::map<std::string, std::shared_ptr<Running>> running_;
   bool stopping_ = false;
   std::vector<std::thread> schedulers_;
+  std::thread retention_;  // only when a retention is configured
 };
 
 }  // namespace parapm::service

@@ -35,6 +35,7 @@ struct CoordinatorArgs {
   bool verify = false;
   parapm::rpc::StreamLimits streams;
   double stream_idle_s = 60, stream_total_s = 3600;
+  double retain_days = 0, retain_gb = 0, retention_check_s = 600;
 };
 
 // Upload chunks carry at most 4 MiB of data (parapm.proto); a message a little larger holds
@@ -64,6 +65,9 @@ int run(CoordinatorArgs args) {
   config.data_dir = args.data;
   config.max_upload_bytes = args.max_upload_mb << 20;
   config.max_mesh_bytes = args.max_mesh_mb << 20;
+  config.retain_for = std::chrono::milliseconds(int64_t(args.retain_days * 86400e3));
+  config.retain_bytes = uint64_t(args.retain_gb * double(1ull << 30));
+  config.retention_check = std::chrono::milliseconds(int64_t(args.retention_check_s * 1000));
   config.default_parallelism = args.parallelism;
   config.max_running_jobs = args.max_running_jobs;
   config.local_threads = args.local_threads;
@@ -156,6 +160,21 @@ int main(int argc, char** argv) {
                  "a stream open for longer than this is closed (seconds; a watch is then "
                  "resumed by the client)")
       ->check(CLI::Range(1.0, 7.0 * 86400))
+      ->capture_default_str();
+  app.add_option("--retain-days", args.retain_days,
+                 "delete jobs that ended this many days ago, and meshes as old with no job left "
+                 "(0: keep them)")
+      ->check(CLI::Range(0.0, 36500.0))
+      ->capture_default_str();
+  app.add_option("--retain-gb", args.retain_gb,
+                 "while the stored uploads and PMs take more than this (GiB), delete the oldest "
+                 "ended jobs, then the oldest meshes without a job uploaded over an hour ago "
+                 "(0: no bound)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  app.add_option("--retention-check-s", args.retention_check_s,
+                 "how often the retention is applied (seconds; also at start)")
+      ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
   app.add_option("--token-file", args.token_file,
                  "bearer token required on every call and sent to workers (else PARAPM_TOKEN; "

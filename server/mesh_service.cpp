@@ -150,6 +150,36 @@ grpc::Status MeshService::CancelJob(grpc::ServerContext* context, const parapm::
   });
 }
 
+namespace {
+
+void to_reply(const DeleteResult& result, parapm::v1::DeleteReply* reply) {
+  reply->set_jobs_deleted(result.jobs);
+  reply->set_meshes_deleted(result.meshes);
+  reply->set_blobs_removed(result.blobs);
+  reply->set_bytes_freed(result.bytes);
+}
+
+}  // namespace
+
+grpc::Status MeshService::DeleteJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                                    parapm::v1::DeleteReply* reply) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->job_id(), "job_id");
+    to_reply(coordinator_.delete_job(request->job_id()), reply);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status MeshService::DeleteMesh(grpc::ServerContext* context,
+                                     const parapm::v1::MeshRef* request,
+                                     parapm::v1::DeleteReply* reply) {
+  return rpc::serve(auth_, context, [&] {
+    require_id(request->mesh_id(), "mesh_id");
+    to_reply(coordinator_.delete_mesh(request->mesh_id()), reply);
+    return grpc::Status::OK;
+  });
+}
+
 grpc::Status MeshService::Download(grpc::ServerContext* context, const parapm::v1::JobRef* request,
                                    grpc::ServerWriter<parapm::v1::Chunk>* writer) {
   return rpc::serve(auth_, context, [&] {

@@ -28,6 +28,10 @@ class MeshService final : public parapm::v1::MeshService::Service {
                         parapm::v1::ListJobsReply* reply) override;
   grpc::Status CancelJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
                          parapm::v1::Job* reply) override;
+  grpc::Status DeleteJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
+                         parapm::v1::DeleteReply* reply) override;
+  grpc::Status DeleteMesh(grpc::ServerContext* context, const parapm::v1::MeshRef* request,
+                          parapm::v1::DeleteReply* reply) override;
   grpc::Status Download(grpc::ServerContext* context, const parapm::v1::JobRef* request,
                         grpc::ServerWriter<parapm::v1::Chunk>* writer) override;
   grpc::Status GetLevel(grpc::ServerContext* context, const parapm::v1::LevelRequest* request,

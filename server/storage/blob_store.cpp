@@ -58,6 +58,18 @@ void remove_stale_temp_files(const fs::path& temp_dir) {
     spdlog::info("blob store: removed {} stale temp files from {}", removed, temp_dir.string());
 }
 
+// Calls visit(path, name) for every file in the shard folders (not the temp folder).
+template <class Visit>
+void for_each_blob_file(const fs::path& blobs_dir, const fs::path& temp_dir, Visit visit) {
+  std::error_code ec;
+  for (const auto& shard : fs::directory_iterator(blobs_dir, ec)) {
+    if (!shard.is_directory() || shard.path() == temp_dir) continue;
+    for (const auto& entry : fs::directory_iterator(shard.path(), ec))
+      if (entry.is_regular_file()) visit(entry.path(), entry.path().filename().string());
+  }
+  if (ec) throw_io("listing the blobs", blobs_dir, ec.value());
+}
+
 // The bytes of blob `sha` at `path`, checked against the hash (see BlobStore::read).
 std::string read_checked(const fs::path& path, const std::string& sha) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -159,6 +171,9 @@ std::string BlobStore::Writer::commit() {
   std::error_code ec;
   if (fs::exists(target, ec)) {
     discard();  // the same bytes are stored already
+    // Fresh again, so that garbage collection (which spares young blobs) cannot remove it
+    // before the caller's row names it.
+    ::utimensat(AT_FDCWD, target.c_str(), nullptr, 0);
     return sha;
   }
   // rename() replaces atomically, so two writers committing the same bytes at once both
@@ -220,13 +235,8 @@ BlobStore::VerifyReport BlobStore::verify(const fs::path& data_dir) {
   const fs::path blobs_dir = data_dir / "blobs", temp_dir = blobs_dir / "tmp";
   VerifyReport report;
   std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& shard : fs::directory_iterator(blobs_dir, ec)) {
-    if (!shard.is_directory() || shard.path() == temp_dir) continue;
-    for (const auto& entry : fs::directory_iterator(shard.path(), ec))
-      names.push_back(entry.path().filename().string());
-  }
-  if (ec) throw_io("listing the blobs", blobs_dir, ec.value());
+  for_each_blob_file(blobs_dir, temp_dir,
+                     [&](const fs::path&, const std::string& name) { names.push_back(name); });
   std::sort(names.begin(), names.end());
   for (const std::string& name : names) {
     ++report.blobs;
@@ -238,6 +248,33 @@ BlobStore::VerifyReport BlobStore::verify(const fs::path& data_dir) {
     }
   }
   return report;
+}
+
+BlobStore::Removed BlobStore::remove_unreferenced(const std::set<std::string>& keep,
+                                                  std::chrono::seconds min_age) const {
+  Removed removed;
+  const auto now = fs::file_time_type::clock::now();
+  for_each_blob_file(blobs_dir_, temp_dir_, [&](const fs::path& path, const std::string& name) {
+    if (keep.contains(name)) return;
+    std::error_code ec;
+    const auto modified = fs::last_write_time(path, ec);
+    if (ec || now - modified < min_age) return;
+    const uint64_t size = fs::file_size(path, ec);
+    if (ec || !fs::remove(path, ec)) return;
+    ++removed.blobs;
+    removed.bytes += size;
+  });
+  return removed;
+}
+
+uint64_t BlobStore::stored_bytes() const {
+  uint64_t bytes = 0;
+  for_each_blob_file(blobs_dir_, temp_dir_, [&](const fs::path& path, const std::string&) {
+    std::error_code ec;
+    const uint64_t size = fs::file_size(path, ec);
+    if (!ec) bytes += size;
+  });
+  return bytes;
 }
 
 }  // namespace parapm::service

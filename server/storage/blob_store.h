@@ -18,8 +18,10 @@
 // every temp file, which would break another live store's writers.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,8 +47,8 @@ class BlobStore {
     void write(std::string_view bytes);  // throws kIo on a failed write
     uint64_t size() const { return size_; }
     // fsyncs and renames the temp file to its hash name; when that blob exists already the
-    // temp file is dropped instead (same hash, same bytes). Returns the hex hash. The writer
-    // is finished afterwards: write() and commit() throw kInternal.
+    // temp file is dropped instead (same hash, same bytes) and the blob's time set to now. Returns
+    // the hex hash. The writer is finished afterwards: write() and commit() throw kInternal.
     std::string commit();
 
    private:
@@ -81,6 +83,15 @@ class BlobStore {
     std::vector<std::string> corrupt;
   };
   static VerifyReport verify(const std::filesystem::path& data_dir);
+
+  // Removes the blobs not in `keep` that are older than `min_age` (by modification time: a
+  // blob just committed whose row is not written yet is never taken). Returns what it freed.
+  struct Removed {
+    uint64_t blobs = 0, bytes = 0;
+  };
+  Removed remove_unreferenced(const std::set<std::string>& keep,
+                              std::chrono::seconds min_age) const;
+  uint64_t stored_bytes() const;  // of every blob
 
   const std::filesystem::path& blobs_dir() const { return blobs_dir_; }
   const std::filesystem::path& temp_dir() const { return temp_dir_; }

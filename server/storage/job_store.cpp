@@ -281,4 +281,105 @@ std::vector<EventRecord> JobStore::events(const std::string& job_id, uint64_t af
   return events;
 }
 
+// ---- deletion and retention
+
+void JobStore::delete_job_locked(const std::string& job_id) {
+  sqlite::Statement events(*db_, "DELETE FROM events WHERE job_id = ?1",
+                           "deleting the events of job " + job_id);
+  events.bind_text(1, job_id);
+  events.run();
+  sqlite::Statement job(*db_, "DELETE FROM jobs WHERE job_id = ?1", "deleting job " + job_id);
+  job.bind_text(1, job_id);
+  job.run();
+}
+
+namespace {
+
+bool is_live(JobStatus status) {
+  return status == JobStatus::kQueued || status == JobStatus::kRunning;
+}
+
+[[noreturn]] void refuse_live(const JobRecord& job) {
+  throw Error(ErrorCode::kFailedPrecondition,
+              "job " + job.job_id + " is " + to_string(job.status) + ": cancel it first");
+}
+
+}  // namespace
+
+void JobStore::delete_job(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  sqlite::Transaction transaction(*db_, "deleting job " + job_id);
+  sqlite::Statement query(*db_, select_from(kJobColumns, "FROM jobs WHERE job_id = ?1"),
+                          "finding job " + job_id);
+  query.bind_text(1, job_id);
+  if (!query.step()) throw Error(ErrorCode::kNotFound, "no job '" + job_id + "'");
+  const JobRecord job = read_job(query, db_->file());
+  if (is_live(job.status)) refuse_live(job);
+  delete_job_locked(job_id);
+  transaction.commit();
+}
+
+std::vector<JobRecord> JobStore::delete_mesh(const std::string& mesh_id) {
+  std::lock_guard lock(mutex_);
+  sqlite::Transaction transaction(*db_, "deleting mesh " + mesh_id);
+  sqlite::Statement mesh(*db_, "SELECT mesh_id FROM meshes WHERE mesh_id = ?1",
+                         "finding mesh " + mesh_id);
+  mesh.bind_text(1, mesh_id);
+  if (!mesh.step()) throw Error(ErrorCode::kNotFound, "no mesh '" + mesh_id + "'");
+  sqlite::Statement query(*db_, select_from(kJobColumns, "FROM jobs WHERE mesh_id = ?1"),
+                          "listing the jobs of mesh " + mesh_id);
+  query.bind_text(1, mesh_id);
+  std::vector<JobRecord> jobs = read_jobs(query, db_->file());
+  for (const JobRecord& job : jobs)
+    if (is_live(job.status)) refuse_live(job);
+  for (const JobRecord& job : jobs) delete_job_locked(job.job_id);
+  sqlite::Statement remove(*db_, "DELETE FROM meshes WHERE mesh_id = ?1",
+                           "deleting mesh " + mesh_id);
+  remove.bind_text(1, mesh_id);
+  remove.run();
+  transaction.commit();
+  return jobs;
+}
+
+std::vector<MeshRecord> JobStore::list_meshes() const {
+  std::lock_guard lock(mutex_);
+  sqlite::Statement query(
+      *db_, select_from(kMeshColumns, "FROM meshes ORDER BY created_unix_ms, mesh_id"),
+      "listing meshes");
+  std::vector<MeshRecord> meshes;
+  while (query.step()) meshes.push_back(read_mesh(query));
+  return meshes;
+}
+
+std::vector<JobRecord> JobStore::ended_jobs() const {
+  std::lock_guard lock(mutex_);
+  sqlite::Statement query(
+      *db_,
+      select_from(kJobColumns,
+                  "FROM jobs WHERE status IN (?1, ?2, ?3) ORDER BY updated_unix_ms, job_id"),
+      "listing ended jobs");
+  query.bind_text(1, to_string(JobStatus::kDone))
+      .bind_text(2, to_string(JobStatus::kFailed))
+      .bind_text(3, to_string(JobStatus::kCancelled));
+  return read_jobs(query, db_->file());
+}
+
+size_t JobStore::jobs_of_mesh(const std::string& mesh_id) const {
+  std::lock_guard lock(mutex_);
+  sqlite::Statement query(*db_, "SELECT COUNT(*) FROM jobs WHERE mesh_id = ?1",
+                          "counting the jobs of mesh " + mesh_id);
+  query.bind_text(1, mesh_id);
+  return query.step() ? size_t(query.column_uint64(0)) : 0;
+}
+
+std::set<std::string> JobStore::referenced_blobs() const {
+  std::lock_guard lock(mutex_);
+  sqlite::Statement query(
+      *db_, "SELECT sha256 FROM meshes UNION SELECT pm_sha256 FROM jobs WHERE pm_sha256 != ''",
+      "listing the blobs rows refer to");
+  std::set<std::string> shas;
+  while (query.step()) shas.insert(query.column_text(0));
+  return shas;
+}
+
 }  // namespace parapm::service

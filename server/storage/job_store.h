@@ -21,6 +21,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -66,8 +67,23 @@ class JobStore {
   // watcher that finds the job ended must find its last event too). Returns the event's seq.
   uint64_t end_job(const JobRecord& job, int64_t unix_ms, std::string_view terminal_event);
 
+  // Deletion, each in one transaction. A job that is queued or running is never deleted:
+  // kFailedPrecondition (cancel it first), checked in the same transaction.
+  // The job and its events; kNotFound when absent.
+  void delete_job(const std::string& job_id);
+  // The mesh, its jobs and their events; kNotFound when absent. Returns the jobs deleted.
+  std::vector<JobRecord> delete_mesh(const std::string& mesh_id);
+  // Every mesh, oldest first (created_unix_ms, then mesh_id).
+  std::vector<MeshRecord> list_meshes() const;
+  // Jobs that ended (done, failed or cancelled), oldest first by updated_unix_ms.
+  std::vector<JobRecord> ended_jobs() const;
+  size_t jobs_of_mesh(const std::string& mesh_id) const;
+  // The blob hashes the rows name: every mesh's sha256 and every job's pm_sha256.
+  std::set<std::string> referenced_blobs() const;
+
  private:
   void update_job_locked(const JobRecord& job);
+  void delete_job_locked(const std::string& job_id);
   uint64_t append_event_locked(const std::string& job_id, int64_t unix_ms,
                                std::string_view payload);
 
