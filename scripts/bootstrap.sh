@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages ParaPM needs (only those missing; apt-get, as root or through
 # sudo), then configures and builds a Release build into build/ (ccache when present).
+# PARAPM_WITH_FUZZ=1 also installs what the fuzz targets need (scripts/fuzz.sh).
 # Safe to run again: it only does what is missing. JOBS=N limits the compile jobs.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -9,6 +10,8 @@ build="${PARAPM_BUILD_DIR:-$root/build}"
 pkgs=(cmake ninja-build g++ ccache libeigen3-dev libspdlog-dev libfmt-dev libcli11-dev
       nlohmann-json3-dev zlib1g-dev libgrpc++-dev libprotobuf-dev protobuf-compiler
       protobuf-compiler-grpc libsqlite3-dev libssl-dev libgtest-dev libgmock-dev)
+# The fuzz targets (scripts/fuzz.sh) need clang and its libFuzzer runtime.
+if [[ -n "${PARAPM_WITH_FUZZ:-}" ]]; then pkgs+=(clang libclang-rt-14-dev); fi
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
