@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# bench/coordinator_memory.sh [JOBS] : the coordinator's resident memory (VmRSS) idle, after
-# JOBS jobs (default 30) on three test meshes built by one worker, and two seconds later.
+# bench/coordinator_memory.sh [JOBS] : the coordinator's resident memory (VmRSS) idle, and
+# after JOBS jobs (default 30) on three test meshes built by one worker, one after the other
+# (each submitted with --wait), the last one ended.
 # Environment: PARAPM_BUILD_DIR (default build/).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -22,8 +23,6 @@ echo "idle: $(rss)"
 meshes=(pymeshlab-colored-airplane-11k.ply stratocaster-9k.ply cad-cycloidal-43k.ply)
 for ((i = 0; i < jobs; ++i)); do
   "$bin/parapm" submit "$root/tests/data/${meshes[i % 3]}" --server "$server" --parallel 2 \
-    --min-subset-faces 2000 --ratio 0.1 --seed "$((i + 1))" > /dev/null 2>&1
+    --min-subset-faces 2000 --ratio 0.1 --seed "$((i + 1))" --wait > /dev/null 2>&1
 done
 echo "after $jobs jobs: $(rss)"
-sleep 2
-echo "2 s later: $(rss)"

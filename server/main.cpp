@@ -8,13 +8,13 @@
 
 #include <spdlog/spdlog.h>
 
+#include "call_admission.h"
 #include "coordination_service.h"
 #include "coordinator.h"
 #include "daemon.h"
 #include "mesh_service.h"
 #include "rpc_server.h"
 #include "storage/blob_store.h"
-#include "stream_admission.h"
 
 namespace {
 
@@ -33,7 +33,8 @@ struct CoordinatorArgs {
   std::string port_file;
   std::string log_level = "info";
   bool verify = false;
-  parapm::rpc::StreamLimits streams;
+  parapm::rpc::CallLimits streams;
+  parapm::rpc::CallLimits unary{"calls", 32, 8};
   double stream_idle_s = 60, stream_total_s = 3600;
   double retain_days = 0, retain_gb = 0, retention_check_s = 600;
 };
@@ -60,6 +61,8 @@ int run(CoordinatorArgs args) {
   rpc::set_up_logging("coordinator", args.log_level);
   args.streams.idle = std::chrono::milliseconds(int64_t(args.stream_idle_s * 1000));
   args.streams.total = std::chrono::milliseconds(int64_t(args.stream_total_s * 1000));
+  args.unary.idle = args.streams.idle;
+  args.unary.total = args.streams.total;
   const std::string token = rpc::token_for_listening(args.token_file, args.listen);
   service::CoordinatorConfig config;
   config.data_dir = args.data;
@@ -76,15 +79,17 @@ int run(CoordinatorArgs args) {
   config.worker_credentials = rpc::channel_credentials(args.worker_tls, args.tls);
   std::filesystem::create_directories(config.data_dir);
   service::Coordinator coordinator(config);
-  rpc::StreamAdmission streams(args.streams);
-  service::MeshService mesh_service(coordinator, rpc::TokenCheck(token), streams);
+  rpc::CallAdmission streams(args.streams);
+  rpc::CallAdmission unary(args.unary);
+  service::MeshService mesh_service(coordinator, rpc::TokenCheck(token), streams, unary);
   service::CoordinationService coordination(coordinator.workers(), rpc::TokenCheck(token));
   rpc::ServerSetup setup;
   setup.listen = args.listen;
   setup.tls = args.tls;
   setup.max_receive_bytes = kMaxChunkMessageBytes;
-  // A thread for every stream admitted, and as many again for unary calls and the workers.
-  setup.max_threads = int(args.streams.max_streams) * 2 + 32;
+  // A thread for every client call admitted, and 64 more that only the workers' calls (and
+  // health checks) can take: client traffic never starves the workers' heartbeats.
+  setup.max_threads = int(args.streams.max_calls + args.unary.max_calls) + 64;
   rpc::StartedServer server = rpc::start_server(setup, {&mesh_service, &coordination});
   const std::string address = rpc::reachable_address(args.listen, server.port);
   spdlog::info("listening on {} (data in {}, default p = {}, {} jobs at once{})", address,
@@ -143,17 +148,26 @@ int main(int argc, char** argv) {
                  "beat interval asked of workers; 3 missed beats and a worker is dead")
       ->check(CLI::Range(100, 60000))
       ->capture_default_str();
-  app.add_option("--max-streams", args.streams.max_streams,
+  app.add_option("--max-streams", args.streams.max_calls,
                  "streaming calls (uploads, watches, downloads, streams) open at once, all "
                  "clients together; more are refused with RESOURCE_EXHAUSTED")
       ->check(CLI::Range(1, 4096))
       ->capture_default_str();
-  app.add_option("--max-streams-per-client", args.streams.max_streams_per_client,
+  app.add_option("--max-streams-per-client", args.streams.max_per_client,
                  "streaming calls open at once from one client address")
       ->check(CLI::Range(1, 4096))
       ->capture_default_str();
+  app.add_option("--max-calls", args.unary.max_calls,
+                 "unary client calls (submit, job queries, cancel, delete) in progress at once, "
+                 "all clients together; more are refused with RESOURCE_EXHAUSTED")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  app.add_option("--max-calls-per-client", args.unary.max_per_client,
+                 "unary calls in progress at once from one client address")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
   app.add_option("--stream-idle-s", args.stream_idle_s,
-                 "a stream that moves no message for this long is closed (seconds)")
+                 "a call that moves no message for this long is closed (seconds)")
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
   app.add_option("--stream-total-s", args.stream_total_s,

@@ -22,13 +22,13 @@ void require_id(const std::string& id, const char* what) {
 }
 
 // How a stream that stopped ends: the watchdog's reason when it closed it, else the client left.
-grpc::Status stopped(const rpc::StreamAdmission::Ticket& ticket) {
+grpc::Status stopped(const rpc::CallAdmission::Ticket& ticket) {
   return ticket.expired().value_or(kClientGone);
 }
 
 // Sends `bytes` in chunks; false when the client went away.
 bool send_chunks(grpc::ServerWriter<parapm::v1::Chunk>* writer, std::string_view bytes,
-                 rpc::StreamAdmission::Ticket& ticket) {
+                 rpc::CallAdmission::Ticket& ticket) {
   parapm::v1::Chunk chunk;
   chunk.set_total(bytes.size());
   for (size_t at = 0; at < bytes.size() || at == 0; at += kChunkBytes) {
@@ -80,6 +80,9 @@ grpc::Status MeshService::Upload(grpc::ServerContext* context,
 grpc::Status MeshService::Submit(grpc::ServerContext* context,
                                  const parapm::v1::SubmitRequest* request, parapm::v1::Job* reply) {
   return rpc::serve(auth_, context, [&] {
+    grpc::Status refused;
+    const auto ticket = unary_.admit(context, "Submit", &refused);
+    if (!ticket) return refused;
     require_id(request->mesh_id(), "mesh_id");
     *reply = coordinator_.submit(request->mesh_id(), request->options());
     return grpc::Status::OK;
@@ -125,6 +128,9 @@ grpc::Status MeshService::Watch(grpc::ServerContext* context,
 grpc::Status MeshService::GetJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
                                  parapm::v1::Job* reply) {
   return rpc::serve(auth_, context, [&] {
+    grpc::Status refused;
+    const auto ticket = unary_.admit(context, "GetJob", &refused);
+    if (!ticket) return refused;
     require_id(request->job_id(), "job_id");
     *reply = coordinator_.job(request->job_id());
     return grpc::Status::OK;
@@ -135,6 +141,9 @@ grpc::Status MeshService::ListJobs(grpc::ServerContext* context,
                                    const parapm::v1::ListJobsRequest* request,
                                    parapm::v1::ListJobsReply* reply) {
   return rpc::serve(auth_, context, [&] {
+    grpc::Status refused;
+    const auto ticket = unary_.admit(context, "ListJobs", &refused);
+    if (!ticket) return refused;
     const size_t limit = request->limit() ? std::min<uint32_t>(request->limit(), 10000) : 100;
     for (parapm::v1::Job& job : coordinator_.jobs(limit)) *reply->add_jobs() = std::move(job);
     return grpc::Status::OK;
@@ -144,6 +153,9 @@ grpc::Status MeshService::ListJobs(grpc::ServerContext* context,
 grpc::Status MeshService::CancelJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
                                     parapm::v1::Job* reply) {
   return rpc::serve(auth_, context, [&] {
+    grpc::Status refused;
+    const auto ticket = unary_.admit(context, "CancelJob", &refused);
+    if (!ticket) return refused;
     require_id(request->job_id(), "job_id");
     *reply = coordinator_.cancel(request->job_id());
     return grpc::Status::OK;
@@ -164,6 +176,9 @@ void to_reply(const DeleteResult& result, parapm::v1::DeleteReply* reply) {
 grpc::Status MeshService::DeleteJob(grpc::ServerContext* context, const parapm::v1::JobRef* request,
                                     parapm::v1::DeleteReply* reply) {
   return rpc::serve(auth_, context, [&] {
+    grpc::Status refused;
+    const auto ticket = unary_.admit(context, "DeleteJob", &refused);
+    if (!ticket) return refused;
     require_id(request->job_id(), "job_id");
     to_reply(coordinator_.delete_job(request->job_id()), reply);
     return grpc::Status::OK;
@@ -174,6 +189,9 @@ grpc::Status MeshService::DeleteMesh(grpc::ServerContext* context,
                                      const parapm::v1::MeshRef* request,
                                      parapm::v1::DeleteReply* reply) {
   return rpc::serve(auth_, context, [&] {
+    grpc::Status refused;
+    const auto ticket = unary_.admit(context, "DeleteMesh", &refused);
+    if (!ticket) return refused;
     require_id(request->mesh_id(), "mesh_id");
     to_reply(coordinator_.delete_mesh(request->mesh_id()), reply);
     return grpc::Status::OK;

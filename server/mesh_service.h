@@ -1,19 +1,21 @@
 // MeshService bridge: converts requests, calls the Coordinator, converts results and errors
-// (rpc::serve). Every streaming call is admitted by `streams` first (bounded in number, idle
-// time and age); streams stop cleanly when a write fails (the client went away).
+// (rpc::serve). Every call is admitted first, streaming calls by `streams` (bounded in number,
+// idle time and age), unary calls by `unary` (bounded in number); streams stop cleanly when a
+// write fails (the client went away).
 #pragma once
 
+#include "call_admission.h"
 #include "coordinator.h"
 #include "parapm.grpc.pb.h"
 #include "rpc_security.h"
-#include "stream_admission.h"
 
 namespace parapm::service {
 
 class MeshService final : public parapm::v1::MeshService::Service {
  public:
-  MeshService(Coordinator& coordinator, rpc::TokenCheck auth, rpc::StreamAdmission& streams)
-      : coordinator_(coordinator), auth_(std::move(auth)), streams_(streams) {}
+  MeshService(Coordinator& coordinator, rpc::TokenCheck auth, rpc::CallAdmission& streams,
+              rpc::CallAdmission& unary)
+      : coordinator_(coordinator), auth_(std::move(auth)), streams_(streams), unary_(unary) {}
 
   grpc::Status Upload(grpc::ServerContext* context,
                       grpc::ServerReader<parapm::v1::UploadChunk>* reader,
@@ -42,7 +44,8 @@ class MeshService final : public parapm::v1::MeshService::Service {
  private:
   Coordinator& coordinator_;
   rpc::TokenCheck auth_;
-  rpc::StreamAdmission& streams_;
+  rpc::CallAdmission& streams_;
+  rpc::CallAdmission& unary_;
 };
 
 }  // namespace parapm::service

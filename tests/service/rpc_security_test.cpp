@@ -2,8 +2,8 @@
 // and how a peer string names its client: decided by the address's value, never its text.
 #include <gtest/gtest.h>
 
+#include "call_admission.h"
 #include "rpc_security.h"
-#include "stream_admission.h"
 
 namespace parapm::rpc {
 namespace {

@@ -3,7 +3,9 @@
 // behind the coordinator's back. After each the service still builds a good mesh.
 #include <sys/wait.h>
 
+#include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <thread>
 
@@ -96,6 +98,37 @@ TEST_F(ServiceHostile, SilentStreamsAreBoundedAndClosedWhileWorkersKeepBeating) 
   EXPECT_EQ(service().coordinator().log().find("missed"), std::string::npos)
       << "the worker was declared dead";
   EXPECT_NE(service().coordinator().log().find("moved nothing for 2 s"), std::string::npos);
+}
+
+// Unary calls are bounded too (each holds a thread while it runs): eight threads asking at once
+// with a bound of one call per client get answers or RESOURCE_EXHAUSTED, nothing else, and the
+// worker keeps beating.
+TEST_F(ServiceHostile, UnaryCallsAreBoundedPerClient) {
+  start(1, {"--max-calls-per-client", "1", "--heartbeat-ms", "200"});
+  std::atomic<int> answered = 0, refused = 0, other = 0;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 8; ++t)
+    threads.emplace_back([&] {
+      for (int i = 0; i < 200; ++i) {
+        parapm::v1::Job job;
+        const grpc::Status status = service().try_get_job("job-unknown", &job);
+        if (status.error_code() == grpc::StatusCode::NOT_FOUND)
+          ++answered;
+        else if (status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED &&
+                 status.error_message().find("calls open, the limit per client") !=
+                     std::string::npos)
+          ++refused;
+        else
+          ++other;
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(other, 0);
+  EXPECT_GT(answered, 0);
+  EXPECT_GT(refused, 0);
+  std::printf("unary flood: %d answered, %d refused\n", answered.load(), refused.load());
+  expect_serves(3);
+  EXPECT_EQ(service().coordinator().log().find("missed"), std::string::npos);
 }
 
 // 256 MiB of zeros named .ply.gz used to be inflated whole (with buffer doubling) before its

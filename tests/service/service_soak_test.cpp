@@ -1,4 +1,4 @@
-// A bounded soak: many clients at once upload, submit, watch, download and cancel while a
+// A bounded soak: many clients at once upload, submit, watch, download, stream and cancel while a
 // worker is killed and another started, against a coordinator with small stream bounds. It
 // ends with every job done or cancelled, every done PM lossless, every client thread back
 // (no stuck stream), and the coordinator's memory back near where it started. Its figures
@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 
+#include "rpc_security.h"
 #include "service_fixture.h"
 
 namespace parapm::service_test {
@@ -81,13 +82,37 @@ TEST_F(ServiceSoak, ManyClientsAndAWorkerKilledLoseNothing) {
       if (!status.ok()) return fail("download: " + status_text(status));
       if (const std::string bad = lossless_failure(pm, file, dir()); !bad.empty())
         return fail(job.job_id() + " not lossless: " + bad);
+      if (j == 2) {  // a viewer's stream too: every vsplit arrives, the same bytes
+        grpc::ClientContext context;
+        context.set_deadline(std::chrono::system_clock::now() + seconds(60));
+        rpc::attach_token(context, service().token());
+        parapm::v1::StreamRequest request;
+        request.set_job_id(job.job_id());
+        request.set_batch_vsplits(256);
+        ++requests;
+        auto reader = service().stub().StreamPM(&context, request);
+        parapm::v1::PmStreamMessage message;
+        std::string streamed;
+        uint64_t vsplits = 0;
+        while (reader->Read(&message)) {
+          streamed += message.header_and_base() + message.vsplit_batch();
+          vsplits += message.count();
+        }
+        status = reader->Finish();
+        if (!status.ok()) return fail("stream: " + status_text(status));
+        if (vsplits != ended.vsplits() || pm.compare(0, streamed.size(), streamed) != 0)
+          return fail(job.job_id() + ": the stream is not the PM's bytes");
+      }
       ++done;
     }
   };
   std::vector<std::thread> clients;
   for (int c = 0; c < kClients; ++c) clients.emplace_back(client, c);
-  // The fault: a worker killed while jobs run, a new one started a moment later.
-  std::this_thread::sleep_for(milliseconds(300));
+  // The fault: the first worker killed as soon as it holds a subset, a new one started a
+  // moment later.
+  for (int i = 0; i < 400 && service().worker("w1")->log().find(": started, ") == std::string::npos;
+       ++i)
+    std::this_thread::sleep_for(milliseconds(10));
   service().worker("w1")->kill_now();
   std::this_thread::sleep_for(milliseconds(500));
   service().start_worker("w3");
@@ -96,6 +121,8 @@ TEST_F(ServiceSoak, ManyClientsAndAWorkerKilledLoseNothing) {
   for (const std::string& f : failures) ADD_FAILURE() << f;
   EXPECT_EQ(done + cancelled, kClients * kJobsPerClient);
   EXPECT_GE(cancelled, 1);
+  EXPECT_NE(service().coordinator().log().find("failed on worker"), std::string::npos)
+      << "the kill interrupted no subset";
   std::this_thread::sleep_for(milliseconds(500));
   const uint64_t after_bytes = resident_bytes(service().coordinator().pid());
   EXPECT_LT(after_bytes, idle_bytes + (150u << 20))

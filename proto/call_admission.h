@@ -1,10 +1,11 @@
-// Admission control for streaming calls, which hold a server thread each for as long as they
-// are open (the sync API): a bound on open streams in all and per client, so that idle or
-// greedy clients cannot take the threads that unary calls and the workers' heartbeats need;
-// and a watchdog that cancels a stream that moved no message for `idle` or has been open for
-// `total`, so that a stream a client abandons without closing frees its thread.
+// Admission control for the calls of clients, each of which holds a server thread for as long
+// as it runs (the sync API): a bound on calls in progress in all and per client, so that idle
+// or greedy clients cannot take the threads the workers' registrations and heartbeats need;
+// and a watchdog that cancels a call that moved no message for `idle` or has run for `total`,
+// so that a stream a client abandons without closing frees its thread. The coordinator keeps
+// one for streaming calls and one for unary calls (server/main.cpp).
 //
-// A refused stream gets RESOURCE_EXHAUSTED saying which bound was hit, with the trailing
+// A refused call gets RESOURCE_EXHAUSTED saying which bound was hit, with the trailing
 // metadata grpc-retry-pushback-ms (when to retry). Thread-safe.
 #pragma once
 
@@ -23,23 +24,24 @@
 
 namespace parapm::rpc {
 
-struct StreamLimits {
-  unsigned max_streams = 64;             // open streaming calls, all clients together
-  unsigned max_streams_per_client = 16;  // per client address (its IP, without the port)
+struct CallLimits {
+  const char* kind = "streams";  // in messages: "streams", "calls"
+  unsigned max_calls = 64;       // calls in progress, all clients together
+  unsigned max_per_client = 16;  // per client address (its IP, without the port)
   std::chrono::milliseconds idle{std::chrono::seconds(60)};  // no message moved: cancelled
   std::chrono::milliseconds total{std::chrono::hours(1)};    // open this long: cancelled
 };
 
-class StreamAdmission {
+class CallAdmission {
   struct Entry;
 
  public:
-  explicit StreamAdmission(StreamLimits limits);  // starts the watchdog thread
-  ~StreamAdmission();
-  StreamAdmission(const StreamAdmission&) = delete;
-  StreamAdmission& operator=(const StreamAdmission&) = delete;
+  explicit CallAdmission(CallLimits limits);  // starts the watchdog thread
+  ~CallAdmission();
+  CallAdmission(const CallAdmission&) = delete;
+  CallAdmission& operator=(const CallAdmission&) = delete;
 
-  // An admitted stream; leaving its handler (destroying the ticket) frees its place.
+  // An admitted call; leaving its handler (destroying the ticket) frees its place.
   class Ticket {
    public:
     ~Ticket();
@@ -52,18 +54,17 @@ class StreamAdmission {
     std::optional<grpc::Status> expired() const;
 
    private:
-    friend class StreamAdmission;
-    Ticket(StreamAdmission& owner, std::list<Entry>::iterator entry)
-        : owner_(owner), entry_(entry) {}
-    StreamAdmission& owner_;
+    friend class CallAdmission;
+    Ticket(CallAdmission& owner, std::list<Entry>::iterator entry) : owner_(owner), entry_(entry) {}
+    CallAdmission& owner_;
     std::list<Entry>::iterator entry_;
   };
 
-  // Admits the stream `call` of `context`, or returns nullptr and sets *refused.
+  // Admits the call named `call` of `context`, or returns nullptr and sets *refused.
   std::unique_ptr<Ticket> admit(grpc::ServerContext* context, const char* call,
                                 grpc::Status* refused);
 
-  const StreamLimits& limits() const { return limits_; }
+  const CallLimits& limits() const { return limits_; }
   size_t open_streams() const;
 
  private:
@@ -77,7 +78,7 @@ class StreamAdmission {
   void release(Entry& entry);
   void watch_loop();
 
-  StreamLimits limits_;
+  CallLimits limits_;
   mutable std::mutex mutex_;
   std::condition_variable stop_changed_;
   bool stopping_ = false;

@@ -1,4 +1,4 @@
-#include "stream_admission.h"
+#include "call_admission.h"
 
 #include <algorithm>
 
@@ -10,7 +10,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // How often the watchdog looks: a small part of the idle limit.
-std::chrono::milliseconds scan_interval(const StreamLimits& limits) {
+std::chrono::milliseconds scan_interval(const CallLimits& limits) {
   return std::clamp(limits.idle / 4, std::chrono::milliseconds(50),
                     std::chrono::milliseconds(1000));
 }
@@ -33,10 +33,10 @@ std::string peer_client(const std::string& peer) {
   return port == std::string::npos ? address : address.substr(0, port);
 }
 
-StreamAdmission::StreamAdmission(StreamLimits limits)
+CallAdmission::CallAdmission(CallLimits limits)
     : limits_(limits), watchdog_([this] { watch_loop(); }) {}
 
-StreamAdmission::~StreamAdmission() {
+CallAdmission::~CallAdmission() {
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
@@ -45,36 +45,37 @@ StreamAdmission::~StreamAdmission() {
   watchdog_.join();
 }
 
-size_t StreamAdmission::open_streams() const {
+size_t CallAdmission::open_streams() const {
   std::lock_guard lock(mutex_);
   return admitted_;
 }
 
-void StreamAdmission::release(Entry& entry) {
+void CallAdmission::release(Entry& entry) {
   if (entry.expired) return;  // released when it expired
   --admitted_;
   if (const auto it = per_client_.find(entry.client); it != per_client_.end() && --it->second == 0)
     per_client_.erase(it);
 }
 
-std::unique_ptr<StreamAdmission::Ticket> StreamAdmission::admit(grpc::ServerContext* context,
-                                                                const char* call,
-                                                                grpc::Status* refused) {
+std::unique_ptr<CallAdmission::Ticket> CallAdmission::admit(grpc::ServerContext* context,
+                                                            const char* call,
+                                                            grpc::Status* refused) {
   const std::string client = peer_client(context->peer());
   std::lock_guard lock(mutex_);
   unsigned& mine = per_client_[client];
   std::string why;
-  if (admitted_ >= limits_.max_streams)
-    why = "the coordinator has " + std::to_string(admitted_) + " streams open, its limit";
-  else if (mine >= limits_.max_streams_per_client)
-    why = "this client (" + client + ") has " + std::to_string(mine) +
-          " streams open, the limit per client";
+  const std::string kind = limits_.kind;
+  if (admitted_ >= limits_.max_calls)
+    why = "the coordinator has " + std::to_string(admitted_) + " " + kind + " open, its limit";
+  else if (mine >= limits_.max_per_client)
+    why = "this client (" + client + ") has " + std::to_string(mine) + " " + kind +
+          " open, the limit per client";
   if (!why.empty()) {
     if (mine == 0) per_client_.erase(client);
     context->AddTrailingMetadata("grpc-retry-pushback-ms", "1000");
     *refused = grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                             std::string(call) + " refused: " + why +
-                                "; retry in a second, or close streams you no longer read");
+                                "; retry in a second, or close " + kind + " you no longer read");
     spdlog::warn("{} from {} refused: {}", call, client, why);
     return nullptr;
   }
@@ -85,23 +86,23 @@ std::unique_ptr<StreamAdmission::Ticket> StreamAdmission::admit(grpc::ServerCont
   return std::unique_ptr<Ticket>(new Ticket(*this, open_.begin()));
 }
 
-StreamAdmission::Ticket::~Ticket() {
+CallAdmission::Ticket::~Ticket() {
   std::lock_guard lock(owner_.mutex_);
   owner_.release(*entry_);
   owner_.open_.erase(entry_);
 }
 
-void StreamAdmission::Ticket::touch() {
+void CallAdmission::Ticket::touch() {
   std::lock_guard lock(owner_.mutex_);
   entry_->last_moved = Clock::now();
 }
 
-bool StreamAdmission::Ticket::past_total() const {
+bool CallAdmission::Ticket::past_total() const {
   std::lock_guard lock(owner_.mutex_);
   return Clock::now() - entry_->opened > owner_.limits_.total;
 }
 
-std::optional<grpc::Status> StreamAdmission::Ticket::expired() const {
+std::optional<grpc::Status> CallAdmission::Ticket::expired() const {
   std::lock_guard lock(owner_.mutex_);
   if (!entry_->expired) return std::nullopt;
   const bool idle = std::string_view(entry_->expired) == "idle";
@@ -114,7 +115,7 @@ std::optional<grpc::Status> StreamAdmission::Ticket::expired() const {
                       " s: closed (open it again to go on)"));
 }
 
-void StreamAdmission::watch_loop() {
+void CallAdmission::watch_loop() {
   std::unique_lock lock(mutex_);
   while (!stop_changed_.wait_for(lock, scan_interval(limits_), [this] { return stopping_; })) {
     const auto now = Clock::now();
