@@ -1,5 +1,7 @@
 // parapm get JOB -o OUT.pm / parapm level JOB (--faces N | --error E) -o OUT.obj|ply: fetch a
 // finished job's Progressive Mesh, or one level of detail cut from it by the coordinator.
+#include <optional>
+
 #include "cli_common.h"
 #include "commands.h"
 #include "service_client.h"
@@ -13,7 +15,7 @@ struct FetchArgs {
   std::string job_id;
   std::string output;
   uint64_t faces = 0;
-  double error = -1;
+  std::optional<double> error;  // unset: cut by --faces
   bool json = false;
 };
 
@@ -35,8 +37,8 @@ int run_level(const FetchArgs& args) {
   ServiceClient client(args.connection);
   parapm::v1::LevelRequest request;
   request.set_job_id(args.job_id);
-  if (args.error >= 0)
-    request.set_max_error(args.error);
+  if (args.error)
+    request.set_max_error(*args.error);
   else
     request.set_max_faces(args.faces);
   request.set_format(ext.substr(1));

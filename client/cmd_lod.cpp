@@ -1,6 +1,7 @@
 // parapm lod IN.pm (--faces N | --error E) -o OUT.obj|OUT.ply: one level of detail.
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -16,7 +17,7 @@ struct LodArgs {
   std::string input;
   std::string output;
   uint64_t faces = 0;
-  double error = -1;
+  std::optional<double> error;  // unset: cut by --faces
   bool ascii = false;
   bool json = false;
 };
@@ -25,7 +26,7 @@ int run_lod(const LodArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const ProgressiveMesh pm = read_pm_file(args.input);
   const size_t level =
-      args.error >= 0 ? level_for_error(pm, args.error) : level_for_faces(pm, args.faces);
+      args.error ? level_for_error(pm, *args.error) : level_for_faces(pm, args.faces);
   const Mesh mesh = level_of_detail(pm, level);
   WriteOptions options;
   options.ascii = args.ascii;

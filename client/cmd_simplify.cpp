@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <optional>
+
 #include <spdlog/spdlog.h>
 
 #include "cli_common.h"
@@ -35,7 +37,7 @@ struct SimplifyArgs {
   double handover = ParallelOptions{}.handover_ratio;
   double border_excess = ParallelOptions{}.border_excess;
   uint64_t extra_round_faces = ParallelOptions{}.extra_round_subset_faces;
-  int64_t min_subset_faces = -1;  // -1: by the metric (subset_faces_by_metric)
+  std::optional<uint64_t> min_subset_faces;  // unset: by the metric (subset_faces_by_metric)
   bool no_carry_keys = false;
   bool no_carry_deferred = false;
   bool no_band_pass = false;
@@ -125,7 +127,7 @@ int run_simplify(const SimplifyArgs& args) {
     parallel.handover_ratio = args.handover;
     parallel.border_excess = args.border_excess;
     parallel.extra_round_subset_faces = args.extra_round_faces;
-    if (args.min_subset_faces >= 0) parallel.min_subset_faces = args.min_subset_faces;
+    if (args.min_subset_faces) parallel.min_subset_faces = *args.min_subset_faces;
     parallel.carry_keys = !args.no_carry_keys;
     parallel.carry_deferred = !args.no_carry_deferred;
     parallel.band_pass = !args.no_band_pass;

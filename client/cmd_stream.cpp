@@ -3,6 +3,7 @@
 // then a level each time the face count has doubled, then the last level.
 #include <filesystem>
 #include <istream>
+#include <optional>
 #include <streambuf>
 
 #include <spdlog/spdlog.h>
@@ -23,7 +24,7 @@ struct StreamArgs {
   std::string job_id;
   std::string output_dir;
   uint64_t faces = 0;
-  double error = -1;
+  std::optional<double> error;  // unset: to --faces, or the whole PM
   uint32_t batch = 0;
   bool json = false;
 };
@@ -59,8 +60,8 @@ int run_stream(const StreamArgs& args) {
   std::filesystem::create_directories(args.output_dir);
   parapm::v1::StreamRequest request;
   request.set_job_id(args.job_id);
-  if (args.error >= 0)
-    request.set_max_error(args.error);
+  if (args.error)
+    request.set_max_error(*args.error);
   else if (args.faces > 0)
     request.set_max_faces(args.faces);
   request.set_batch_vsplits(args.batch);

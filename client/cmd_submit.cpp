@@ -1,6 +1,8 @@
 // parapm submit IN [options] [--wait] [-o OUT.pm]: uploads a mesh to the coordinator and
 // submits a job; with --wait (implied by -o) follows it with a progress bar to its end and
 // downloads the PM.
+#include <optional>
+
 #include <spdlog/spdlog.h>
 
 #include "cli_common.h"
@@ -11,26 +13,19 @@
 namespace parapm::cli {
 namespace {
 
+// Every option the user did not give stays unset, and the job's options leave it unset: the
+// coordinator's defaults apply (parapm.proto names them).
 struct SubmitArgs {
   ConnectionArgs connection;
   std::string input;
   std::string output;
-  uint64_t faces = 0;
-  double ratio = 0;
+  std::optional<uint64_t> faces;
+  std::optional<double> ratio;
   std::string metric = "quadric";
-  uint32_t parallel = 0;
-  uint32_t rounds = 0;
-  uint64_t seed = 1;
-  double samples_per_face = 0;
-  double crease_angle = 60;
-  double attribute_weight = 0.01;
-  double handover = 0;
-  int64_t extra_round_faces = -1;  // -1: not given (the coordinator's default)
-  int64_t min_subset_faces = -1;   // -1: not given (the coordinator's default)
-  double border_excess = -1;       // negative: not given (the coordinator's default)
-  // The energy's tuning; negative: not given (the coordinator's default).
-  double star_planes_weight = -1, volume_weight = -1, spring_scale = -1, crease_min_length = -1;
-  int64_t crease_min_edges = -1;
+  std::optional<uint32_t> parallel, rounds, crease_min_edges;
+  std::optional<uint64_t> seed, extra_round_faces, min_subset_faces;
+  std::optional<double> samples_per_face, crease_angle, attribute_weight, handover, border_excess;
+  std::optional<double> star_planes_weight, volume_weight, spring_scale, crease_min_length;
   bool keep_order = false;
   bool free_copies = false;
   bool wait = false;
@@ -53,33 +48,25 @@ int run_submit(SubmitArgs& args) {
   parapm::v1::SubmitRequest request;
   request.set_mesh_id(uploaded.mesh_id());
   parapm::v1::JobOptions& o = *request.mutable_options();
-  if (args.faces) o.set_target_faces(args.faces);
-  if (args.ratio > 0) o.set_target_ratio(args.ratio);
+  if (args.faces) o.set_target_faces(*args.faces);
+  if (args.ratio) o.set_target_ratio(*args.ratio);
   o.set_metric(args.metric == "energy" ? parapm::v1::METRIC_ENERGY : parapm::v1::METRIC_QUADRIC);
-  o.set_parallelism(args.parallel);
-  o.set_rounds(args.rounds);
-  o.set_seed(args.seed);
-  o.set_samples_per_face(args.samples_per_face);
-  o.set_crease_angle_degrees(args.crease_angle);
-  o.set_attribute_weight(args.attribute_weight > 0 ? args.attribute_weight : -1);
-  o.set_handover_ratio(args.handover);
-  // The API reads 0 as "the default" and a negative count as "none".
-  if (args.border_excess >= 0)
-    o.set_border_excess(args.border_excess == 0 ? -1 : args.border_excess);
-  if (args.extra_round_faces >= 0)
-    o.set_extra_round_faces(args.extra_round_faces == 0 ? -1 : args.extra_round_faces);
-  if (args.min_subset_faces >= 0)
-    o.set_min_subset_faces(args.min_subset_faces == 0 ? -1 : args.min_subset_faces);
-  // The energy's tuning: 0 is the default to the API, a negative number asks for 0.
+  if (args.parallel) o.set_parallelism(*args.parallel);
+  if (args.rounds) o.set_rounds(*args.rounds);
+  if (args.seed) o.set_seed(*args.seed);
+  if (args.samples_per_face) o.set_samples_per_face(*args.samples_per_face);
+  if (args.crease_angle) o.set_crease_angle_degrees(*args.crease_angle);
+  if (args.attribute_weight) o.set_attribute_weight(*args.attribute_weight);
+  if (args.handover) o.set_handover_ratio(*args.handover);
+  if (args.border_excess) o.set_border_excess(*args.border_excess);
+  if (args.extra_round_faces) o.set_extra_round_faces(*args.extra_round_faces);
+  if (args.min_subset_faces) o.set_min_subset_faces(*args.min_subset_faces);
   parapm::v1::EnergyTuning& e = *o.mutable_energy();
-  auto tuning = [](double given, auto set) {
-    if (given >= 0) set(given == 0 ? -1 : given);
-  };
-  tuning(args.star_planes_weight, [&](double v) { e.set_star_planes_weight(v); });
-  tuning(args.volume_weight, [&](double v) { e.set_volume_weight(v); });
-  tuning(args.spring_scale, [&](double v) { e.set_spring_scale(v); });
-  tuning(args.crease_min_length, [&](double v) { e.set_crease_min_length(v); });
-  if (args.crease_min_edges > 0) e.set_min_crease_edges(uint32_t(args.crease_min_edges));
+  if (args.star_planes_weight) e.set_star_planes_weight(*args.star_planes_weight);
+  if (args.volume_weight) e.set_volume_weight(*args.volume_weight);
+  if (args.spring_scale) e.set_spring_scale(*args.spring_scale);
+  if (args.crease_min_length) e.set_crease_min_length(*args.crease_min_length);
+  if (args.crease_min_edges) e.set_min_crease_edges(*args.crease_min_edges);
   o.set_keep_order(args.keep_order);
   o.set_free_copies(args.free_copies);
   parapm::v1::Job job;
@@ -150,7 +137,7 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("-o,--output", args->output, "write the .pm here when done (implies --wait)");
   auto* faces = cmd->add_option("--faces", args->faces, "target base mesh faces");
   cmd->add_option("--ratio", args->ratio, "target base mesh faces as a ratio of the input")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(CLI::Range(1e-9, 1.0))
       ->excludes(faces);
   cmd->add_option("--metric", args->metric, "quadric or energy")
       ->check(CLI::IsMember({"quadric", "energy"}))
@@ -158,12 +145,11 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--parallel", args->parallel,
                   "subsets p (default: the coordinator's --parallelism)")
       ->check(CLI::Range(1, 256));
-  cmd->add_option("--rounds", args->rounds,
-                  "parallel rounds (0, the default: by p, 2 at p = 2, 3 above)")
-      ->check(CLI::Range(0, 64));
+  cmd->add_option("--rounds", args->rounds, "parallel rounds (default: by p, 2 at p = 2, 3 above)")
+      ->check(CLI::Range(1, 64));
   cmd->add_option("--handover-ratio", args->handover,
                   "the rounds go down to this fraction of the input faces (default 0.1)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(CLI::Range(1e-9, 1.0));
   cmd->add_option("--border-excess", args->border_excess,
                   "a round ends where the faces along its cut hold at most this fraction of the "
                   "faces in excess (default 0.05; 0: none, geometric rounds only)")
@@ -171,26 +157,24 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--extra-round-faces", args->extra_round_faces,
                   "past the handover, more rounds while every subset keeps this many faces and "
                   "the last round did 90% of its share (2.5x as many faces after one that did "
-                  "half) (default 2000; 0: none)")
-      ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
+                  "half) (default 2000; 0: none; else at least 50)")
+      ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
   cmd->add_option("--min-subset-faces", args->min_subset_faces,
                   "every round cuts the mesh into at most (its faces / this) subsets (default "
                   "by the metric: 4000 for the energy, 8000 for the quadric; 0: P subsets in "
-                  "every scheduled round)")
-      ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
-  cmd->add_option("--seed", args->seed, "seed of the randomised steps")->capture_default_str();
-  cmd->add_option("--samples-per-face", args->samples_per_face, "energy: extra sample points")
+                  "every scheduled round; else at least 50)")
+      ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
+  cmd->add_option("--seed", args->seed, "seed of the randomised steps (default 1)");
+  cmd->add_option("--samples-per-face", args->samples_per_face,
+                  "energy: extra sample points (default 0)")
       ->check(CLI::Range(0.0, 64.0));
-  // Above 0: the API reads 0 as "the default" (60).
   cmd->add_option("--crease-angle", args->crease_angle,
-                  "energy: crease angle, degrees, in (0, 180] (creases of fewer than 8 edges and "
-                  "shorter than 5% of the diagonal are noise, not kept)")
-      ->check(CLI::Range(1e-6, 180.0))
-      ->capture_default_str();
+                  "energy: crease angle, degrees, in [0, 180] (default 60; creases of fewer than 8 "
+                  "edges and shorter than 5% of the diagonal are noise, not kept)")
+      ->check(CLI::Range(0.0, 180.0));
   cmd->add_option("--attribute-weight", args->attribute_weight,
-                  "energy: weight of attributes against geometry (0: not optimised)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+                  "energy: weight of attributes against geometry (default 0.01; 0: not optimised)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--crease-min-edges", args->crease_min_edges,
                   "energy: creases of fewer edges (and shorter than --crease-min-length) are "
                   "noise (default 8; 1: every crease kept)")

@@ -181,7 +181,7 @@ parapm::v1::Job Coordinator::submit(const std::string& mesh_id,
   // as the mesh can use when that is fewer.
   const uint32_t most_p = most_useful_parallelism(mesh->faces);
   parapm::v1::JobOptions pinned = options;
-  if (pinned.parallelism() == 0)
+  if (!pinned.has_parallelism())
     pinned.set_parallelism(std::min(config_.default_parallelism, most_p));
   const JobSpec spec = job_spec_of(pinned, config_.default_parallelism);
   if (spec.parallel.subsets > most_p)

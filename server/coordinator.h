@@ -1,7 +1,14 @@
-// The coordinator's core, free of gRPC types (the MeshService and Coordination bridges call
-// it): uploads become validated meshes in the blob store, submissions become jobs in SQLite,
-// a scheduler runs queued jobs (the engine's parallel build, its subsets sent to workers by
-// RemoteRunner), and every step of a job is an event, stored and woken up for watchers.
+// The coordinator's core, which the MeshService and Coordination bridges call: uploads become
+// validated meshes in the blob store, submissions become jobs in SQLite, a scheduler runs
+// queued jobs (the engine's parallel build, its subsets sent to workers by RemoteRunner), and
+// every step of a job is an event, stored and woken up for watchers.
+//
+// Its boundary: the API's protobuf messages (parapm.v1 Job, JobEvent, JobOptions) are its
+// domain types, plain data it stores and returns as they are (an event is stored as its
+// serialized message); it is a gRPC client of the workers (RemoteRunner, WorkerChannels, the
+// credentials in its config). It is no part of the gRPC server: no ServerContext and no
+// grpc::Status here; it throws parapm::Error, and the bridges convert requests, replies and
+// errors (rpc::serve).
 //
 // Durability: a mesh's or PM's blob is written and fsync'd before the row naming it; a job's
 // row changes state before its event is appended. On start, jobs left queued or running by a

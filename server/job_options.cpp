@@ -48,62 +48,60 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
     default:
       require(false, "unknown metric " + std::to_string(int(options.metric())));
   }
-  require(std::isfinite(options.samples_per_face()) && options.samples_per_face() >= 0 &&
-              options.samples_per_face() <= 64,
-          "samples_per_face must be in [0, 64]");
-  s.samples_per_face = options.samples_per_face();
-  require(std::isfinite(options.crease_angle_degrees()) && options.crease_angle_degrees() >= 0 &&
-              options.crease_angle_degrees() <= 180,
-          "crease_angle_degrees must be in [0, 180] (0: 60)");
-  if (options.crease_angle_degrees() > 0) s.crease_angle_degrees = options.crease_angle_degrees();
-  require(std::isfinite(options.attribute_weight()), "attribute_weight must be finite");
-  if (options.attribute_weight() < 0)
-    s.attribute_weight = 0;
-  else if (options.attribute_weight() > 0)
-    s.attribute_weight = options.attribute_weight();
+  if (options.has_samples_per_face()) {
+    require(std::isfinite(options.samples_per_face()) && options.samples_per_face() >= 0 &&
+                options.samples_per_face() <= 64,
+            "samples_per_face must be in [0, 64]");
+    s.samples_per_face = options.samples_per_face();
+  }
+  if (options.has_crease_angle_degrees()) {
+    require(std::isfinite(options.crease_angle_degrees()) && options.crease_angle_degrees() >= 0 &&
+                options.crease_angle_degrees() <= 180,
+            "crease_angle_degrees must be in [0, 180]");
+    s.crease_angle_degrees = options.crease_angle_degrees();
+  }
+  if (options.has_attribute_weight()) s.attribute_weight = options.attribute_weight();
   const parapm::v1::EnergyTuning& e = options.energy();
-  auto tuning = [&](double value, double& out, const char* name) {
-    require(std::isfinite(value), std::string("energy.") + name + " must be finite");
-    if (value < 0) out = 0;
-    if (value > 0) out = value;
-  };
-  tuning(e.star_planes_weight(), s.energy.star_planes_weight, "star_planes_weight");
-  tuning(e.volume_weight(), s.energy.volume_weight, "volume_weight");
-  tuning(e.spring_scale(), s.energy.spring_scale, "spring_scale");
-  tuning(e.crease_min_length(), s.energy.crease_min_length, "crease_min_length");
-  if (e.min_crease_edges() > 0) s.energy.min_crease_edges = e.min_crease_edges();
-  s.seed = options.seed() ? options.seed() : 1;
+  if (e.has_star_planes_weight()) s.energy.star_planes_weight = e.star_planes_weight();
+  if (e.has_volume_weight()) s.energy.volume_weight = e.volume_weight();
+  if (e.has_spring_scale()) s.energy.spring_scale = e.spring_scale();
+  if (e.has_crease_min_length()) s.energy.crease_min_length = e.crease_min_length();
+  if (e.has_min_crease_edges()) s.energy.min_crease_edges = e.min_crease_edges();
+  if (options.has_seed()) s.seed = options.seed();
   s.keep_order = options.keep_order();
   s.free_copies = options.free_copies();
-  check_simplify_options(s);
+  check_simplify_options(s);  // the ranges of the weights and the crease rule
 
-  p.subsets = options.parallelism() ? options.parallelism() : default_parallelism;
+  p.subsets = options.has_parallelism() ? options.parallelism() : default_parallelism;
   require(p.subsets >= 1 && p.subsets <= kMaxParallelism,
           "parallelism must be in [1, 256], got " + std::to_string(p.subsets));
-  p.rounds = options.rounds();  // 0 in both: by p
-  require(p.rounds <= 64, "rounds must be in [1, 64] (0: by p), got " + std::to_string(p.rounds));
-  if (options.handover_ratio() != 0) p.handover_ratio = options.handover_ratio();
-  require(std::isfinite(p.handover_ratio) && p.handover_ratio > 0 && p.handover_ratio <= 1,
-          "handover_ratio must be in (0, 1]");
-  require(std::isfinite(options.border_excess()) && options.border_excess() <= 0.5,
-          "border_excess must be at most 0.5 (0: the default, 0.05; negative: none)");
-  if (options.border_excess() < 0) p.border_excess = 0;
-  if (options.border_excess() > 0) p.border_excess = options.border_excess();
-  require(options.extra_round_faces() <= 0 ||
-              uint64_t(options.extra_round_faces()) >= kLeastSubsetFaces,
-          "extra_round_faces must be at least " + std::to_string(kLeastSubsetFaces) +
-              " (a smaller subset is mostly border: its rounds only cost calls; 0: the default, "
-              "negative: no extra rounds)");
-  require(
-      options.min_subset_faces() <= 0 || uint64_t(options.min_subset_faces()) >= kLeastSubsetFaces,
-      "min_subset_faces must be at least " + std::to_string(kLeastSubsetFaces) +
-          " (a smaller subset is mostly border: its rounds only cost calls; 0: the metric's "
-          "default, negative: no floor)");
-  if (options.extra_round_faces() < 0) p.extra_round_subset_faces = 0;
-  if (options.extra_round_faces() > 0)
-    p.extra_round_subset_faces = uint64_t(options.extra_round_faces());
-  if (options.min_subset_faces() < 0) p.min_subset_faces = 0;
-  if (options.min_subset_faces() > 0) p.min_subset_faces = uint64_t(options.min_subset_faces());
+  if (options.has_rounds()) {
+    require(options.rounds() >= 1 && options.rounds() <= 64,
+            "rounds must be in [1, 64], got " + std::to_string(options.rounds()));
+    p.rounds = options.rounds();
+  }
+  if (options.has_handover_ratio()) {
+    require(std::isfinite(options.handover_ratio()) && options.handover_ratio() > 0 &&
+                options.handover_ratio() <= 1,
+            "handover_ratio must be in (0, 1]");
+    p.handover_ratio = options.handover_ratio();
+  }
+  if (options.has_border_excess()) {
+    require(std::isfinite(options.border_excess()) && options.border_excess() >= 0 &&
+                options.border_excess() <= 0.5,
+            "border_excess must be in [0, 0.5]");
+    p.border_excess = options.border_excess();
+  }
+  auto subset_floor = [](const char* name, uint64_t value) {
+    require(value == 0 || value >= kLeastSubsetFaces,
+            std::string(name) + " must be 0 or at least " + std::to_string(kLeastSubsetFaces) +
+                " (a smaller subset is mostly border: its rounds only cost calls)");
+    return value;
+  };
+  if (options.has_extra_round_faces())
+    p.extra_round_subset_faces = subset_floor("extra_round_faces", options.extra_round_faces());
+  if (options.has_min_subset_faces())
+    p.min_subset_faces = subset_floor("min_subset_faces", options.min_subset_faces());
   return spec;
 }
 

@@ -281,7 +281,7 @@ TEST_F(ServiceFaults, BadUploadsAreRefusedAndTheServerKeepsServing) {
   EXPECT_EQ(tuning_status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_NE(tuning_status.error_message().find("spring scale"), std::string::npos)
       << tuning_status.error_message();
-  for (double excess : {0.7, std::nan("")}) {
+  for (double excess : {0.7, -0.1, std::nan("")}) {
     parapm::v1::JobOptions bad_excess = options(2, parapm::v1::METRIC_QUADRIC, 0.5);
     bad_excess.set_border_excess(excess);
     const grpc::Status status = service().try_submit(mesh_id, bad_excess, &job);

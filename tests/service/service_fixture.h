@@ -38,7 +38,7 @@ class ServiceTest : public ::testing::Test {
   static parapm::v1::JobOptions options(uint32_t parallelism, parapm::v1::Metric metric,
                                         double ratio, uint64_t seed = 1) {
     parapm::v1::JobOptions o;
-    o.set_parallelism(parallelism);
+    if (parallelism > 0) o.set_parallelism(parallelism);  // 0: left to the coordinator
     o.set_metric(metric);
     if (ratio > 0) o.set_target_ratio(ratio);
     o.set_seed(seed);

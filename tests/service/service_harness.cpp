@@ -176,48 +176,36 @@ CliResult run_parapm(const std::vector<std::string>& args, const fs::path& dir,
 
 std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
   std::vector<std::string> args;
-  args.insert(args.end(), {"--parallel", std::to_string(o.parallelism() ? o.parallelism() : 4)});
-  if (o.rounds()) args.insert(args.end(), {"--rounds", std::to_string(o.rounds())});
+  args.insert(args.end(),
+              {"--parallel", std::to_string(o.has_parallelism() ? o.parallelism() : 4)});
+  if (o.has_rounds()) args.insert(args.end(), {"--rounds", std::to_string(o.rounds())});
   args.insert(args.end(),
               {"--metric", o.metric() == parapm::v1::METRIC_ENERGY ? "energy" : "quadric"});
   if (o.has_target_faces()) args.insert(args.end(), {"--faces", std::to_string(o.target_faces())});
-  if (o.has_target_ratio()) {
-    std::ostringstream ratio;
-    ratio.precision(17);
-    ratio << o.target_ratio();
-    args.insert(args.end(), {"--ratio", ratio.str()});
-  }
-  args.insert(args.end(), {"--seed", std::to_string(o.seed() ? o.seed() : 1)});
   auto number = [&](const char* flag, double value) {
     std::ostringstream text;
     text.precision(17);
     text << value;
     args.insert(args.end(), {flag, text.str()});
   };
-  if (o.samples_per_face() > 0) number("--samples-per-face", o.samples_per_face());
-  if (o.crease_angle_degrees() > 0) number("--crease-angle", o.crease_angle_degrees());
-  if (o.attribute_weight() < 0) number("--attribute-weight", 0);
-  if (o.attribute_weight() > 0) number("--attribute-weight", o.attribute_weight());
-  if (o.handover_ratio() > 0) number("--handover-ratio", o.handover_ratio());
-  if (o.border_excess() != 0)
-    number("--border-excess", o.border_excess() < 0 ? 0 : o.border_excess());
-  if (o.extra_round_faces() != 0)
-    args.insert(args.end(),
-                {"--extra-round-faces",
-                 std::to_string(o.extra_round_faces() < 0 ? 0 : o.extra_round_faces())});
-  if (o.min_subset_faces() != 0)
-    args.insert(args.end(), {"--min-subset-faces",
-                             std::to_string(o.min_subset_faces() < 0 ? 0 : o.min_subset_faces())});
-  const parapm::v1::EnergyTuning& e = o.energy();
-  auto tuning = [&](const char* flag, double value) {
-    if (value != 0) number(flag, value < 0 ? 0 : value);
+  auto count = [&](const char* flag, uint64_t value) {
+    args.insert(args.end(), {flag, std::to_string(value)});
   };
-  tuning("--star-planes-weight", e.star_planes_weight());
-  tuning("--volume-weight", e.volume_weight());
-  tuning("--spring-scale", e.spring_scale());
-  tuning("--crease-min-length", e.crease_min_length());
-  if (e.min_crease_edges() > 0)
-    args.insert(args.end(), {"--crease-min-edges", std::to_string(e.min_crease_edges())});
+  if (o.has_target_ratio()) number("--ratio", o.target_ratio());
+  if (o.has_seed()) count("--seed", o.seed());
+  if (o.has_samples_per_face()) number("--samples-per-face", o.samples_per_face());
+  if (o.has_crease_angle_degrees()) number("--crease-angle", o.crease_angle_degrees());
+  if (o.has_attribute_weight()) number("--attribute-weight", o.attribute_weight());
+  if (o.has_handover_ratio()) number("--handover-ratio", o.handover_ratio());
+  if (o.has_border_excess()) number("--border-excess", o.border_excess());
+  if (o.has_extra_round_faces()) count("--extra-round-faces", o.extra_round_faces());
+  if (o.has_min_subset_faces()) count("--min-subset-faces", o.min_subset_faces());
+  const parapm::v1::EnergyTuning& e = o.energy();
+  if (e.has_star_planes_weight()) number("--star-planes-weight", e.star_planes_weight());
+  if (e.has_volume_weight()) number("--volume-weight", e.volume_weight());
+  if (e.has_spring_scale()) number("--spring-scale", e.spring_scale());
+  if (e.has_crease_min_length()) number("--crease-min-length", e.crease_min_length());
+  if (e.has_min_crease_edges()) count("--crease-min-edges", e.min_crease_edges());
   if (o.keep_order()) args.push_back("--keep-order");
   if (o.free_copies()) args.push_back("--free-copies");
   return args;

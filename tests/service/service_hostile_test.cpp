@@ -216,7 +216,7 @@ TEST_F(ServiceHostile, WastefulOptionsAreRefusedAndSmallMeshesGetAUsefulP) {
   const uint64_t most = upload.faces() / 50;
   parapm::v1::Job job;
   parapm::v1::JobOptions greedy = options(256, parapm::v1::METRIC_QUADRIC, 0.1);
-  greedy.set_min_subset_faces(-1);
+  greedy.set_min_subset_faces(0);
   grpc::Status status = service().try_submit(upload.mesh_id(), greedy, &job);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status_text(status);
   EXPECT_NE(status.error_message().find("at most " + std::to_string(most)), std::string::npos)
@@ -225,7 +225,8 @@ TEST_F(ServiceHostile, WastefulOptionsAreRefusedAndSmallMeshesGetAUsefulP) {
   tiny_subsets.set_min_subset_faces(1);
   status = service().try_submit(upload.mesh_id(), tiny_subsets, &job);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status_text(status);
-  EXPECT_NE(status.error_message().find("min_subset_faces must be at least 50"), std::string::npos)
+  EXPECT_NE(status.error_message().find("min_subset_faces must be 0 or at least 50"),
+            std::string::npos)
       << status.error_message();
 
   // A single triangle with the coordinator's default p (4): p = 1, and a lossless PM.
