@@ -2,7 +2,7 @@
 """bench/renumber_ply.py IN.ply OUT.ply [--shuffle SEED] [--rotate SEED]
 
 The same surface under another numbering (and/or a random rotation), to measure what a
-mesh's numbering alone does to the engine's speed and levels (docs/BENCHMARKS.md, "Memory
+mesh's numbering alone does to the engine's speed and levels (docs/decisions/notebook-2026-11.md, "Memory
 order"). IN: a triangle PLY as `parapm lod` writes it (binary little-endian, double x y z,
 uchar/int vertex lists) or ASCII; OUT: ASCII PLY, doubles printed exactly (repr).
 

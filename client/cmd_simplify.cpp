@@ -279,7 +279,8 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                 "Let the copies the repair makes of a non-manifold input vertex (one per sheet "
                 "meeting there) simplify like any vertex: coarser levels reach further and stay "
                 "closer to the input, but the sheets part at coarse levels (cracks, far wider "
-                "than the level's distance error: docs/BENCHMARKS.md). Default: the copies never "
+                "than the level's distance error: docs/decisions/notebook-2026-11.md). Default: "
+                "the copies never "
                 "move, and are most of what remains at coarse levels of a mesh with many of "
                 "them");
   cmd->add_option("--parallel", args->parallel,
@@ -325,22 +326,23 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                       std::to_string(subset_faces_by_metric(false)) +
                       " for the quadric, which does a tenth of the energy's work per face)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 40));
-  cmd->add_flag("--no-carry-keys", args->no_carry_keys,
-                "With --parallel: every round's jobs cost all their edges again instead of "
-                "starting from the queue keys (and deferred edges) the round before left (for "
-                "measuring the work they save; the PM differs a little, docs/BENCHMARKS.md)");
+  cmd->add_flag(
+      "--no-carry-keys", args->no_carry_keys,
+      "With --parallel: every round's jobs cost all their edges again instead of "
+      "starting from the queue keys (and deferred edges) the round before left (for "
+      "measuring the work they save; the PM differs a little, docs/decisions/notebook-2026-11.md)");
   cmd->add_flag("--no-band-pass", args->no_band_pass,
                 "With --parallel: no sequential pass over what two rounds' borders both kept "
                 "after each round; the next round's jobs and the final pass take it (for "
-                "measuring; the PM differs, docs/BENCHMARKS.md)");
+                "measuring; the PM differs, docs/decisions/notebook-2026-11.md)");
   cmd->add_flag("--no-carry-deferred", args->no_carry_deferred,
                 "With --parallel: the edges a round's jobs left deferred are costed afresh by "
                 "the next round's jobs, not queued deferred again (for measuring the work it "
-                "saves; the PM differs a little, docs/BENCHMARKS.md)");
+                "saves; the PM differs a little, docs/decisions/notebook-2026-11.md)");
   cmd->add_flag("--no-deferred-recosting", args->no_deferred_recosting,
                 "Energy: cost the edges around each collapse at once, not when they reach the "
                 "top of the queue (for measuring the costings deferral saves; the PM differs a "
-                "little, docs/BENCHMARKS.md)");
+                "little, docs/decisions/notebook-2026-11.md)");
   cmd->add_flag("--json", args->json,
                 "Print one JSON object on stdout: sizes, seconds, CPU seconds and costings (edges "
                 "the metric costed); with --parallel, under \"parallel\": p, rounds performed, "

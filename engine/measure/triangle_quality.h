@@ -2,7 +2,8 @@
 // detail is from its input, not how well its triangles are shaped, and slivers (triangles with
 // a tiny angle) shade badly, morph badly between levels and make poor meshes for anything
 // downstream. Simplifiers trade one for the other: an order by distance alone leaves slivers
-// where the surface is flat (docs/BENCHMARKS.md, "E_spring: the distance's price of shape").
+// where the surface is flat (docs/decisions/notebook-2026-11.md, "E_spring: the distance's price of
+// shape").
 #pragma once
 
 #include <cstddef>

@@ -1,15 +1,14 @@
-// Queue keys carried from round to round of the parallel construction. Every round's jobs
-// used to cost every edge of their subsets before their first collapse, although most of
-// those edges had a key at the end of the previous round that the sequential build would
-// still hold in its queue: on the 203k dragon at p = 2, a third of the subsets' work
-// (docs/BENCHMARKS.md, "Carried queue keys").
+// Queue keys carried from round to round of the parallel construction, so that a round's jobs
+// do not cost again every edge of their subsets before their first collapse: most of those
+// edges have a key at the end of the previous round that the sequential build would still
+// hold in its queue (decisions/notebook-2026-11.md, "Carried queue keys").
 //
 // The sequential build keeps an edge's key in its queue until a collapse changes one of its
 // ends (vs or vt of the collapse; simplifier.h, the entries' stamps), even when collapses
 // nearby have changed the edge's star: the key is costed again, with Costing::kPerform, when
 // it reaches the top. A key the memo carries obeys the same rule, so a round's jobs start from
 // the queue the sequential build would have, not from one costed afresh. Carrying keys changes
-// the PM a little (a fresh costing sees the changed stars): docs/BENCHMARKS.md measures it.
+// the PM a little (a fresh costing sees the changed stars; measured in the same section).
 //
 // Why a job's key is current on the master after the round: a job costs only edges with two
 // free ends (subset_rule.h), which no other subset can collapse; the master's state is the

@@ -399,13 +399,13 @@ ProgressiveMesh build_progressive_mesh_parallel(
   SubsetOptions subset_options = subset_options_of(options, mesh);
 
   std::vector<CollapseRecord> records;
-  // At most one collapse per vertex: no round's records move the earlier ones (growing by
-  // doubling moved the 871k dragon's first 190k records at round 1's merge, 0.2 s).
+  // At most one collapse per vertex: reserved once, so no round's records move the earlier
+  // ones (growing by doubling would copy them at each merge).
   records.reserve(whole.live_vertices());
   // A round's subsets' lists wait for the next step of the master to go into `records`, k-way
   // merged by cost (the band pass's records follow them). Nothing reads `records` before the PM
-  // is assembled, so the merge by cost (0.07 s for the 871k dragon's first round at p = 16) runs
-  // beside the band pass, the next round's partition, or the final pass.
+  // is assembled, so the merge by cost runs beside the band pass, the next round's partition,
+  // or the final pass, off the critical path.
   std::vector<std::vector<CollapseRecord>> pending_lists;
   auto append_pending = [&] { append_merged_by_cost(pending_lists, records); };
   std::vector<uint8_t> bound_before;  // the previous round's bound vertices (subset_rule.h)
@@ -414,8 +414,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
   double subsets_cpu = 0;
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three rounds'
   // if that is gentler: after two scheduled rounds (a ratio of 0.32 at the default handover),
-  // an extra round would need 3.2 x the floor per subset to start, and the 203k dragon at p = 2
-  // got none (a final pass of 18k collapses instead of 7k).
+  // an extra round would need 3.2 x the floor per subset to start, and mid-sized meshes at
+  // p = 2 would get none (a longer sequential final pass).
   const double handover_ratio = double(handover) / double(input_faces);
   const double step =
       std::max(std::pow(handover_ratio, 1.0 / double(rounds)), std::pow(handover_ratio, 1.0 / 3.0));
@@ -458,8 +458,7 @@ ProgressiveMesh build_progressive_mesh_parallel(
       // parts stop it short gains nothing from more) and the subsets stay large enough that
       // their borders do not decide the order. A round that did only half of it stopped at its
       // cost ceiling: the rest is costlier, its order matters more, so the next round's subsets
-      // must be larger (2.5 x the floor; with the floor itself, such rounds made the 203k
-      // dragon's 10% level 7% worse at p = 4 and 8: docs/BENCHMARKS.md, "Extra rounds after a
+      // must be larger (2.5 x the floor; decisions/notebook-2026-11.md, "Extra rounds after a
       // short round").
       if (parallel.extra_round_subset_faces == 0 || !last) return plan;
       const double done = double(last->faces_before) - double(last->faces_after);
@@ -468,9 +467,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
       const uint64_t floor = done >= 0.9 * asked ? parallel.extra_round_subset_faces
                                                  : parallel.extra_round_subset_faces * 5 / 2;
       // Even geometric steps to the target, as many as the target is steps away, rounded:
-      // stepping by `step` and stopping at the target ended on slivers (the 871k dragon at
-      // p = 8: 11.6k -> 8.7k faces on 2 subsets, then a round asked for the 111 faces the last
-      // one's border kept).
+      // stepping by `step` and stopping at the target can end on a sliver of a round (asked
+      // only for what the last round's border kept).
       if (step >= 1) return plan;
       const double to_target = std::max(1.0, double(target)) / double(faces);
       const double steps = std::max(1.0, std::round(std::log(to_target) / std::log(step)));
@@ -682,10 +680,9 @@ ProgressiveMesh build_progressive_mesh_parallel(
 
     // Round 1's partition, drawn beside round 0's jobs on the mesh as round 0 found it (the
     // master only waits for them, and `whole` changes only at their merge): round 0 has no
-    // band pass to draw it beside, and drawn after the merge it was all on the critical path
-    // (0.12-0.13 s on the 871k dragon at p = 8 and 16). Its subsets, balanced for round 0's
-    // faces, hold round 1's unevenly (round 0's jobs stop at its water level): on the 871k,
-    // the largest 4% / 7% / 9% above the mean at p = 4 / 8 / 16.
+    // band pass to draw it beside, and drawn after the merge it would be all on the critical
+    // path. The price: its subsets, balanced for round 0's faces, hold round 1's a little
+    // unevenly (round 0's jobs stop at its water level).
     std::vector<SubsetResult> results;
     auto draw_round_one = [&] {
       PartitionOptions next_options;

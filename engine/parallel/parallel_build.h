@@ -23,64 +23,44 @@ namespace parapm {
 // ParallelOptions::min_subset_faces chosen by the metric (subset_faces_by_metric).
 inline constexpr uint64_t kByMetric = ~uint64_t{0};
 
-// The faces a subset needs to be worth its round, for a metric whose costings are costly
-// (PriorityModule::costly(): the energy) or cheap (the quadric): 4000 and 8000. A round's
-// fixed work (partition, extraction, edge sample, merge, band pass, the jobs' set-up) is about
-// the same per face for both, while the quadric does about a tenth of the energy's work per
-// face. At 2000 faces a subset for both, 18 meshes at p = 16 took 1.09x (energy) and 1.37x
-// (quadric) the sequential build's CPU (geometric means; 10-25k-face meshes 1.2-1.35x and
-// 1.5-2.1x, in 5-7 rounds); at 4000 and 8000, 0.99x and 1.05x, with RMS as close to the
-// sequential PM's or closer, and the 871k dragon's build unchanged (docs/BENCHMARKS.md, "Subset
+// The faces a subset needs to be worth its round: 4000 for a metric whose costings are costly
+// (PriorityModule::costly(): the energy), 8000 for a cheap one (the quadric). A round's fixed
+// work per face is about the same for both, and the quadric does a tenth of the energy's work
+// per face, so it needs larger subsets to pay for it (decisions/notebook-2026-11.md, "Subset
 // floors by the metric").
 uint64_t subset_faces_by_metric(bool costly_metric);
 
 struct ParallelOptions {
   uint32_t subsets = 2;  // p, in [1, 256]
-  // Parallel rounds, in [1, 64], each on a new partition of the current mesh (the borders
-  // move), with the metric's state travelling in the jobs (job_state.h); 0: by p
-  // (default_rounds).
+  // Scheduled rounds, in [1, 64], each on a new partition of the current mesh (so the borders
+  // move), the metric's state travelling in the jobs (job_state.h); 0: default_rounds(p).
   uint32_t rounds = 0;
-  unsigned threads = 0;  // 0: min(p, hardware threads)
-  // The rounds take the mesh from F faces down to max(target, handover_ratio x F) faces,
-  // geometrically (round r of R aims at F x ratio^((r + 1) / R)); the final pass, sequential
-  // on the whole mesh, collapses what the last round's borders kept and goes on to the
-  // target. The defaults are measured in docs/ARCHITECTURE.md, "Parallel construction".
+  unsigned threads = 0;  // 0: min(p, hardware threads); the .pm does not depend on it
+  // The scheduled rounds take the mesh from F faces down to max(target, handover_ratio x F),
+  // geometrically (round r of R aims at F x handover_ratio^((r + 1) / R)); extra rounds and
+  // the sequential final pass go on from there. In (0, 1].
   double handover_ratio = 0.1;
-  // Past the handover, further rounds in even geometric steps to the target (as many as it is
-  // steps of the scheduled ratio away, rounded; none removing less than 15% of its faces),
-  // while the last round removed at least 90% of the faces its jobs were asked to, each with as
-  // many subsets (up to p, at least 2) as leave each subset at least this many faces (0: none);
-  // after a round that removed only half of it (stopped at its cost ceiling), 2.5 times this
-  // many. A large mesh gets its final pass shorter (the 871k dragon at p = 16: 8 rounds, the
-  // last ones on 16, 9 and 4 subsets; the 203k dragon: one more round, on 2-4 subsets); a
-  // small one does not (docs/BENCHMARKS.md, "After the energy's queue keys", "Narrower extra
-  // rounds", "Extra rounds after a short round", "Extra rounds in even steps").
+  // Past the handover, extra rounds step evenly (geometrically) on to the target while the
+  // last round removed at least 90% of what it was asked, each with as many subsets (2 to p)
+  // as keep at least this many faces each (2.5x this after a round that removed only half);
+  // 0: no extra rounds. They shorten the sequential final pass on large meshes.
   uint64_t extra_round_subset_faces = 2000;
-  // Every round cuts the mesh into at most (its faces / this) subsets (at least 2, else the
-  // rounds end and the final pass does the rest): a subset of few faces is mostly border, which
-  // its job cannot touch, and a round whose border band is a large part of the mesh is shortened
-  // by border_excess, so that a small mesh cut in many subsets took many short rounds of fixed
-  // work (partition, extraction, merge) for few collapses each. 0: p subsets in every scheduled
-  // round; kByMetric: subset_faces_by_metric.
+  // Every round cuts the mesh into at most (its faces / this) subsets; below 2 the rounds end
+  // and the final pass does the rest. Why: a small subset is mostly border, which its job
+  // cannot touch, so its round costs fixed work for few collapses. 0: p subsets in every
+  // scheduled round; kByMetric: subset_faces_by_metric.
   uint64_t min_subset_faces = kByMetric;
-  // The most a round's border band may hold back, as a fraction of the faces the round ends
-  // with. A round cannot remove the faces along its cut (subset_rule.h, border_faces); they
-  // stay at the resolution the round started from while the rest goes on, so every level
-  // inside the round has that many faces too many where they are not needed, and less
-  // precision elsewhere (error falls about as 1 / faces). A band of b x the faces, in a round
-  // from S to E faces, holds b S (1 - E / S) faces in excess at its end, so a round ends at
-  // E >= S / (1 + border_excess / b), and removes at least kMinRoundRemoval of its faces
-  // (parallel_build.cpp). A round shortened this way does not count against `rounds`. The
-  // band is a larger part of a small mesh cut in many subsets: the 12k-17k-face meshes at
-  // p = 16 have 22-24%, the 871k dragon 0.7% at p = 2 and 4.3% at p = 16. 0: the geometric
-  // rounds only. On 18 meshes the 50% level went from 1.03-1.07 of the sequential RMS to
-  // 1.02-1.03 with 0.05 and 1.00-1.02 with 0.02, which takes half as many rounds again
-  // (docs/BENCHMARKS.md, "Rounds bounded by their border band").
+  // A round ends early where its border band (the faces along its cut, which it cannot
+  // remove: subset_rule.h) would hold more than this fraction of the faces it ends with in
+  // excess: those faces stay at the round's starting resolution, costing precision elsewhere.
+  // With a band of b x the faces, a round from S faces ends at E >= S / (1 + border_excess /
+  // b), removing at least kMinRoundRemoval of its faces; a round so shortened does not count
+  // against `rounds`. In [0, 0.5]; 0: the geometric rounds only (decisions/notebook-2026-11.md,
+  // "Rounds bounded by their border band").
   double border_excess = 0.05;
-  // Jobs leave alone edges costing more than this factor times the round's water level
-  // (parallel_build.cpp, sample_round_costs: the cost below which a sample of the edges
-  // would give the round's collapses), besides stopping at their share of the faces; 0:
-  // shares only.
+  // Jobs leave alone edges costing more than this factor times the round's water level (the
+  // cost below which a sample of the edges would give the round's collapses;
+  // parallel_build.cpp, sample_round_costs), besides stopping at their share; 0: shares only.
   double water_level_factor = 8;
   // The round's faces divided among the jobs in proportion to their removable faces times
   // their fraction of cheap edges in the same sample (parallel_build.cpp, set_targets); off:
@@ -89,18 +69,16 @@ struct ParallelOptions {
   // Round 1's partition drawn beside round 0's jobs, on the mesh as round 0 found it
   // (RoundStats::partition_foreseen); off: after round 0's merge, on the mesh it left.
   bool early_partition = true;
-  // After each round but the first, a sequential pass over the edges around vertices no
-  // collapse has touched, up to the 95th percentile of the round's costs (parallel_build.cpp).
+  // After each round but the first, a sequential pass over the edges with a lagging end,
+  // up to the 95th percentile of the round's costs (parallel_build.cpp).
   bool band_pass = true;
   // Queue keys still current after a round (no collapse changed an end of their edge) travel
   // into the next round's jobs and the final pass, which cost only the other edges
   // (edge_keys.h; the energy only: the quadric's costings are cheaper than carrying them).
-  // Off: every job costs every edge afresh (for measuring; the PM differs a little,
-  // docs/BENCHMARKS.md "Carried queue keys").
+  // Off (for measuring): every job costs every edge afresh, and the PM differs a little.
   bool carry_keys = true;
-  // With carry_keys: the edges the jobs left deferred travel too (SubsetJob::deferred), queued
-  // deferred again as the sequential build would hold them, not costed afresh. Off: for
-  // measuring what that saves (docs/BENCHMARKS.md, "Deferred edges carried").
+  // With carry_keys, the edges the jobs left deferred travel too (SubsetJob::deferred),
+  // deferred again as the sequential build would hold them. Off: for measuring what it saves.
   bool carry_deferred = true;
   // Tests only: the master follows each round by re-running its module's collapsed() on every
   // merged record (the first step's path) instead of importing the jobs' returned states.
@@ -232,7 +210,7 @@ struct ParallelEvents {
 // it removes. 18 meshes, energy, RMS against the sequential PM at 50 / 10 / 2%: p = 2 two
 // rounds 1.011 / 0.996 / 0.996, three 1.028 / 1.017 / 1.061; p = 4 1.013 / 1.003 / 0.986
 // against 1.019 / 0.990 / 1.031, with the textured bunny's 50% level worse at two; p = 16 two
-// rounds 1.105 at 50%, three 1.034 (docs/BENCHMARKS.md, "Two rounds at p = 2").
+// rounds 1.105 at 50%, three 1.034 (docs/decisions/notebook-2026-11.md, "Two rounds at p = 2").
 uint32_t default_rounds(uint32_t p);
 // The rounds a build with these options schedules: `rounds`, or default_rounds(subsets).
 uint32_t scheduled_rounds(const ParallelOptions& parallel);

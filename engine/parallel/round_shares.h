@@ -30,21 +30,18 @@ struct RoundCosts {
 };
 
 // Cheap edges counted per collapse of the round: a sequential run's costs grow as a region
-// coarsens, so the collapses it makes in a region follow the edges there below a cost a
-// few times the round's first quantile. Measured on the energy (docs/BENCHMARKS.md, "Shares
-// by cheap edges"): 1 and 1.5 left the 50% level of fandisk at p = 8 10% / 4% worse than
-// 2.5, 4 made it 15% worse; the 203k dragon's levels moved by less than 2%.
-constexpr double kCheapEdgesPerCollapse = 2.5;
-// Fewer made fandisk's shares at p = 8 worse (docs/BENCHMARKS.md, "The edge sample, fewer
+// coarsens, so the collapses it makes in a region follow the edges there below a cost a few
+// times the round's first quantile (the value: decisions/notebook-2026-11.md, "Shares by cheap
 // edges").
+constexpr double kCheapEdgesPerCollapse = 2.5;
+// Edges sampled per subset: enough for its share to be stable (decisions/notebook-2026-11.md, "The
+// edge sample, fewer edges").
 constexpr uint64_t kSampledEdgesPerSubset = 1024;
 
 // One subset's part of the sample: its inner edges, and the costs of every stride-th of those
-// with two free ends. Only those: the job costs only them, and joins their costs to its keys;
-// an edge next to the border costed here was costed for nothing (the rocker arm's samples at
-// p = 16: 9.0k of their 35k costings, 8% of the build's; docs/BENCHMARKS.md, "Deferred edges
-// carried"). Each cost stands for inner_edges / costs.size() edges: the subset's free edges
-// cost alike, for the round's quantiles, as all its inner edges.
+// with two free ends. Only those: the job costs only them and joins their costs to its keys,
+// so no sampled costing is wasted. Each cost stands for inner_edges / costs.size() edges: the
+// subset's free edges cost alike, for the round's quantiles, as all its inner edges.
 struct SubsetSample {
   uint64_t inner_edges = 0;
   uint64_t costings = 0;      // edges the sample's module costed (the carried keys answer others)
@@ -62,9 +59,8 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 
 // The sample of a job's subset (a job with the master's state: Error(kInternal) otherwise),
 // costed by the job's own module, imported from the job's state as simplify_subset imports
-// it, so that the subsets' samples are costed side by side (in the extraction's tasks).
-// Costed on the master, one after the other, the sample was the largest sequential step of a
-// round: 0.04-0.09 s per round on the 871k dragon at p = 16.
+// it, so that the subsets' samples are costed side by side (in the extraction's tasks), not
+// one after the other on the master's critical path.
 // `free`: free_vertices of the job. `keys` (with carry_keys): the job's carried keys (local
 // ids, sorted), which answer the edges they cover; the sampled edges join them, so that the
 // job does not cost them again (its module costs them alike: same state).
@@ -75,8 +71,7 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
 // sampled_edges(job, ...), translated to global ids): the costs the job's own module would
 // give (its state is the master's, job_state.h), without building the job's mesh and module a
 // second time. For a cheap metric (PriorityModule::costly() false: the quadric, whose sampled
-// costs never travel as keys): its sample, costed in the extraction's tasks, spent more on
-// those copies (3 ms of a 45 ms build on the rocker arm) than on its costings. Not
+// costs never travel as keys), for which those copies cost more than the costings. Not
 // thread-safe (the master's module); out.costings counts the master's costings of it.
 SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
                               const CollapseMesh& whole, const PriorityModule& master);
@@ -86,18 +81,15 @@ SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
 // removes, `factor`: the water level's factor (0: no ceiling). Deterministic.
 RoundCosts round_costs_of(const std::vector<SubsetSample>& samples, uint64_t remove, double factor);
 
-// Each subset removes a share of the faces it can remove, so that its inside leaves the round
-// as coarse as the whole mesh should. Its border stays finer, for the next round's new
-// partition or the final pass to take, cheapest first, as a sequential run would have. (A
-// share of all its faces made a job coarsen its inside further to make up for its border: the
-// level a round left was uneven, up to 11% worse in RMS than the sequential one on a small
-// mesh cut in 8; docs/BENCHMARKS.md, "Shares of the removable faces".)
-// Without `cheap_fraction`, every share is the round's fraction (faces_before - goal) /
-// faces_before of the subset's removable faces. With it, the same total is divided in
-// proportion to the subset's removable faces times its fraction of cheap edges (at most 95%
-// of its removable faces): a sequential run takes more from a flat region than from a curved
-// one, and equal shares left the 50% level of the energy's PM up to 6% (the 203k dragon at
-// p = 8, 16) and 29% (fandisk at p = 8) worse than the sequential one (docs/BENCHMARKS.md,
+// Each subset removes a share of the faces it can remove (not of all its faces: asked for its
+// border too, a job would coarsen its inside further to make up, and the round's level would
+// be uneven), so that its inside leaves the round as coarse as the whole mesh should; its
+// border stays finer, for the next round's partition or the final pass to take, cheapest
+// first, as a sequential run would have. Without `cheap_fraction`, every share is the round's
+// fraction (faces_before - goal) / faces_before of the subset's removable faces. With it, the
+// same total is divided in proportion to the subset's removable faces times its fraction of
+// cheap edges (at most 95% of its removable faces): a sequential run takes more from a flat
+// region than from a curved one (decisions/notebook-2026-11.md, "Shares of the removable faces",
 // "Shares by cheap edges"). Returns the faces asked of all jobs.
 uint64_t set_targets(std::vector<SubsetJob>& jobs, const std::vector<uint64_t>& removable,
                      uint64_t faces_before, uint64_t goal,

@@ -14,8 +14,8 @@ uint32_t local_of(const std::vector<uint32_t>& ids, uint32_t global) {
 
 // Per thread (jobs are built concurrently, one per pool task), a stamp and a slot per element
 // of the whole mesh: the extraction collects each face and vertex once, and finds a corner's
-// local id, without sorting every corner or searching for it (on the 871k dragon both were an
-// eighth of the quadric's parallel build).
+// local id, without sorting every corner or searching for it (either would be a large part of
+// the quadric's parallel build).
 class Marks {
  public:
   void begin(size_t size) {

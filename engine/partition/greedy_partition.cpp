@@ -20,9 +20,9 @@ namespace {
 
 // Balance by faces (graph.has_faces()). A face goes to the majority subset of its corners,
 // else the smallest of the three (assign_faces). Counted by their corners, the subsets grown
-// first ended ~0.5% above their share of the faces on average (their fronts, taken by least
-// updated degree, complete faces) and the last one short by all of it: the 11k dragon at
-// p = 64, 181 faces for 171.6 and the last 111. So the greedy counts a face once its owner is
+// first end a little above their share of the faces (their fronts, taken by least updated
+// degree, complete faces) and the last one short by all of their excess. So the greedy counts
+// a face once its owner is
 // settled (its second corner in the subset of its first, or its third corner), 3 per face as
 // the targets count corners, and grows subset k until the faces settled so far reach the
 // targets of subsets 0 ... k together: no subset's excess carries over to the last. (A face

@@ -858,8 +858,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     // the input surface) from the two ends, a star costed by moments from the midpoint only
     // (its solve is the dear part). A projected star's key is still an upper bound of the cost
     // measured at the top, looser where the midpoint's start would win: such edges come a little
-    // later. Measured, not argued: faster, and the levels came out better at 50% and 10%
-    // (docs/BENCHMARKS.md, "Queue keys from fewer starts").
+    // later. Chosen by measurement: faster, and no level worse (decisions/notebook-2026-11.md,
+    // "Queue keys from fewer starts").
     std::array<Vec3, 3> starts{pa, pb, mid};
     std::span<const Vec3> tried(starts);
     if (costing == Costing::kQueue) {
@@ -914,9 +914,9 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     project_points(star_points_, star_homes_, chosen->v, &projected_);
   }
   // E_scalar counts the star's points; the star's planes stand for star_planes_weight times as
-  // many between them, which carry attributes too: without this factor the geometry would
-  // outweigh the attributes that much more than before (the airplane's colour RMS at 10%
-  // doubled: 0.0119 -> 0.0232; with it 0.0110, docs/BENCHMARKS.md).
+  // many between them, which carry attributes too, so the attributes' change is weighted as
+  // over all of them: else the geometry would outweigh the attributes star_planes_weight times
+  // more than E_scalar's weight says.
   if (scalar_.enabled()) out.cost += (1 + options_.star_planes_weight) * scalar_change();
   // Penalised, not forbidden (Hoppe 96), at a price per point of the star.
   if (topology) out.cost += topology_price_ * std::max(1.0, points_around);

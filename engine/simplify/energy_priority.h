@@ -48,8 +48,8 @@
 //   and vertex samples alone bend.
 // - volume preservation: the change of enclosed volume, spread over the star's area, costed
 //   as if every point of the star moved by that mean displacement, times volume_weight.
-// Both are quadratic in v: the solves minimise them with the rest (measured: docs/BENCHMARKS.md,
-// "The star's planes and its volume").
+// Both are quadratic in v: the solves minimise them with the rest (measured:
+// docs/decisions/notebook-2026-11.md, "The star's planes and its volume").
 //
 // Queue keys (Costing::kQueue) are most of the evaluations and most are never used: they try
 // fewer starts (a young star the two ends, a star costed by moments the midpoint), and each
@@ -92,7 +92,7 @@ struct EnergyOptions {
   // E_spring's kappa is Hoppe's schedule (spring_constant) times this. Hoppe's own values,
   // with one point per vertex (about one per two faces), make a young star's springs outweigh
   // its points' distances many times over: collapses are then ordered and placed by edge
-  // length, a smoothing, not by distance (docs/BENCHMARKS.md, "E_spring's weight").
+  // length, a smoothing, not by distance (docs/decisions/notebook-2026-11.md, "E_spring's weight").
   double spring_scale = 0.03;
   int solves_per_start = 1;     // least-squares solves after the first projection, per start
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
@@ -157,9 +157,9 @@ class EnergyPriority : public PriorityModule {
   // changed, in global ids: the faces around the vertices its collapses moved or removed
   // (changed: per local vertex; dead faces with empty lists), their corners and wedges. Those
   // vertices are free (subset_rule.h), so all of it is the job's own; the rest of its part is
-  // as the master exported it, and the master keeps it (on the 871k dragon at p = 16 every
-  // round's states carried all 437k points, most of them untouched). import_global: the
-  // master overwrites the state's faces, vertices and wedges.
+  // as the master exported it, and the master keeps it (so a returned state holds what
+  // changed, not every point of the job). import_global: the master overwrites the state's
+  // faces, vertices and wedges.
   EnergyState export_local(const IdMaps& maps) const;
   void import_local(const CollapseMesh& mesh, const EnergyState& state);
   EnergyState export_global(const CollapseMesh& mesh, const IdMaps& maps,

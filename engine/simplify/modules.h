@@ -41,8 +41,8 @@ class PriorityModule {
   // initialize() cut into independent parts, which may run in any order or side by side (each
   // writes its own part of the module; all only read `mesh`, which must outlive them): running
   // them all is initialize(). The parallel build runs them on its pool, beside the first
-  // partition (the energy's sharp curves took 0.13 s of its 0.19 s on the 871k dragon). A
-  // wrapper keeps this default: its parts are its own initialize(), whatever it does.
+  // partition, so that the set-up is not one thread's work. A wrapper keeps this default: its
+  // parts are its own initialize(), whatever it does.
   virtual std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) {
     return {[this, &mesh] { initialize(mesh); }};
   }
@@ -61,10 +61,9 @@ class PriorityModule {
   // rules before it costs an edge on top of the queue or one vetoed before whose star changed:
   // one they veto again waits among the vetoed edges, uncosted, instead of being costed twice
   // (queue key, then on top) only to be vetoed. Not before every costing: most edges pass, and
-  // the checks would cost a tenth of the energy's time (docs/BENCHMARKS.md, "Vetoed edges").
-  // The parallel build carries only a costly module's queue keys from round to round
-  // (edge_keys.h): the quadric's costings take tens of nanoseconds, and on the 871k dragon the
-  // memo's bookkeeping cost three times its costings.
+  // the checks would cost more than the costings they save (decisions/notebook-2026-11.md,
+  // "Vetoed edges"). The parallel build carries only a costly module's queue keys from round
+  // to round (edge_keys.h): for a cheap one, carrying costs more than costing again.
   virtual bool costly() const { return false; }
   // The edges this module has costed itself so far (its evaluate calls; a wrapper's own
   // answers, such as a carried key or a subset rule's refusal, are not counted). Summed over a
@@ -120,9 +119,8 @@ class ConstraintModule {
 // `components`, when given, are the mesh's connected components as connected_components
 // numbered them on this mesh or on it before some legal collapses (which neither merge nor split
 // components): the minimum-size rule then counts the live vertices per component instead of
-// finding the components again, an O(faces) union-find over the whole capacity that the
-// parallel build's band passes and final pass each paid on the whole mesh (2-7 ms on the 871k
-// dragon).
+// finding the components again (an O(faces) union-find over the whole capacity, which the
+// parallel build's band passes and final pass would each pay on the whole mesh).
 std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
     const std::vector<uint8_t>& locked,
     std::shared_ptr<const std::vector<uint32_t>> components = {});

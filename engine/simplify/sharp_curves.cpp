@@ -27,8 +27,8 @@ void erase_value(std::vector<VertexId>& list, VertexId v) {
 // fragments (nefertiti-100k: 597 creases at 60 degrees, 535 of them of 1 to 3 edges), and a
 // curve's ends never merge but through a penalised collapse, so each fragment would hold two
 // or more vertices until every ordinary collapse is done: at 2% of the faces those vertices
-// were most of the mesh (docs/BENCHMARKS.md, "The star's planes and its volume; noise
-// creases").
+// were most of the mesh (docs/decisions/notebook-2026-11.md, "The star's planes and its volume;
+// noise creases").
 void keep_long_creases(const CollapseMesh& mesh, const SharpEdgeOptions& options,
                        std::vector<std::pair<VertexId, VertexId>>& creases) {
   if (options.min_crease_edges <= 1 || creases.empty()) return;

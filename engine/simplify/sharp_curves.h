@@ -25,8 +25,8 @@ struct SharpEdgeOptions {
   // A crease of fewer edges than min_crease_edges and shorter than long_crease_diagonals of
   // the bounding-box diagonal is a scan's noise, not kept (1: every crease is). 8 edges
   // measured better on 18 meshes than 4, or than a length of 1% or 2% alone; the length
-  // clause keeps a coarse mesh's few but long creases (docs/BENCHMARKS.md, "The star's planes
-  // and its volume; noise creases").
+  // clause keeps a coarse mesh's few but long creases (docs/decisions/notebook-2026-11.md, "The
+  // star's planes and its volume; noise creases").
   uint32_t min_crease_edges = 8;
   double long_crease_diagonals = 0.05;
 };

@@ -73,16 +73,14 @@ struct SimplifierLimits {
   // a little below its last key (the lower of its two faces' remembered keys, less half its
   // magnitude; at the end of the queue if the module refused it last time) and is costed when
   // it comes to the top, then queued again at its true key: most of them change again before
-  // they get there. Below it every one is costed at once, so the
-  // coarse levels, where one collapse out of order costs most, keep the exact order.
-  // SIZE_MAX: never deferred. (Bunny: 402k costings -> 284k; docs/BENCHMARKS.md, "Deferred
-  // re-costing".)
+  // they get there, so about a third of the costings are saved (decisions/notebook-2026-11.md,
+  // "Deferred re-costing"). Below it every one is costed at once, so the coarse levels, where
+  // one collapse out of order costs most, keep the exact order. SIZE_MAX: never deferred.
   size_t defer_above_faces = SIZE_MAX;
   // When set, the first queue holds only the edges with an end in this list (live vertices),
   // not every edge of the mesh: for a module that refuses every other edge until a collapse
   // changes it (the parallel build's band pass, whose lagging vertices are a thin band of a
-  // large mesh), the same run, without costing the whole mesh's edges to refuse them (0.28 of
-  // the band passes' 0.43 s on the 871k dragon at p = 16).
+  // large mesh), the same run, without costing the whole mesh's edges only to refuse them.
   const std::vector<VertexId>* first_queue_around = nullptr;
   // Edges whose last costing is known to be outdated (a collapse changed an end since), each
   // with that costing's key, sorted by (a, b): while the run defers (above
@@ -90,8 +88,7 @@ struct SimplifierLimits {
   // made those collapses itself would hold them, instead of costing them at once. Another
   // key (infinite: refused), or an edge that is not live, is taken as it is or ignored. The
   // parallel build carries a job's still-deferred edges (deferred_edges()) into the next
-  // round's jobs: costed afresh, they were a fifth of a small mesh's work at p = 4
-  // (docs/BENCHMARKS.md, "Deferred edges carried").
+  // round's jobs, which would otherwise cost them all afresh.
   const std::vector<DeferredEdge>* first_deferred = nullptr;
   // An edge costing more is not collapsed: it stays in the queue at its cost, as a run without
   // the ceiling would hold it, and the run ends once the queue's cheapest edge costs more

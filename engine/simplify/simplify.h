@@ -47,13 +47,11 @@ struct SimplifyOptions {
   uint64_t seed = 1;        // of the randomised steps (the energy's extra points)
   bool keep_order = false;  // store the input's vertex and face order in the PM
   // The repair splits a non-manifold input vertex into copies, one per sheet meeting there.
-  // false: the copies never move (locked_vertices), so the sheets meet at every level; they and
-  // their edges are then what remains at coarse levels (the 203k dragon: 10.5k faces at least,
-  // 65% of its 10% level's vertices). true: they simplify like any vertex, and the sheets part
-  // at coarse levels (cracks), by far more than the level's distance error: at 10% of the
-  // faces, the dragon's copies are 0.17% of the diagonal apart on average (10x its RMS error),
-  // up to 3.2%; cad-cycloidal-43k's 1.6-1.9% on average, up to 6.8-7.4% (pm/copy_separation.h).
-  // Full resolution is exact either way.
+  // false: the copies never move (locked_vertices), so the sheets meet at every level, and on
+  // a mesh with many copies they and their edges are what remains at coarse levels (the
+  // simplification stops above the target). true: they simplify like any vertex, and the
+  // sheets part at coarse levels (cracks, often far wider than the level's distance error:
+  // pm/copy_separation.h measures them). Full resolution is exact either way.
   bool free_copies = false;
   // Re-costing deferred above a tenth of the input's faces (SimplifierLimits::
   // defer_above_faces; the energy only). Off: every edge around a collapse is costed at once

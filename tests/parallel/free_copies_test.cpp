@@ -73,7 +73,8 @@ TEST(FreeCopies, ReachFurtherAndStayLosslessOnACadPart) {
 }
 
 // The 203k dragon: 6247 copies, 65% of its locked 10% level's vertices. Free, its 10% level is
-// closer to the input (the engine's surface distance; metro agrees, docs/BENCHMARKS.md).
+// closer to the input (the engine's surface distance; metro agrees,
+// docs/decisions/notebook-2026-11.md).
 TEST(FreeCopies, BringTheDragonsTenthLevelCloser) {
   const std::filesystem::path path = shared_meshes_dir() / "stanford-dragon-res2-203k.ply.gz";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/meshes is not present";

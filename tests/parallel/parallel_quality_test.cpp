@@ -13,7 +13,7 @@
 // their removable faces: 0.99-1.06; 1.08-1.09 on the vessel before; 2026-11-25, since the
 // repair's spatial order and the greedy partitioner's settled faces: 1.08 on the bunny, 1.00
 // on the vessel, while the 18 meshes' 10% geometric mean stayed 1.00 at p = 4 and 16:
-// docs/BENCHMARKS.md, "Memory order"), the worst cells under RMS
+// docs/decisions/notebook-2026-11.md, "Memory order"), the worst cells under RMS
 // 1.35 (the energy's pooled cells: 1.6, as single cells of the bunny's 2% level range over
 // 0.84-1.45 from one draw to the next) and Hausdorff 2.6. Issue 5's target, every cell within
 // 5% (RMS) and 10% (Hausdorff), is NOT met on these small meshes (at p = 16 the bunny's
@@ -21,9 +21,10 @@
 // the bunny's 10% level was 1.17-1.34 in every draw; since the simplifier's requeue and the
 // carried keys, 2026-11-22, it is 0.99-1.05, but its 2% and base levels 0.90-1.37; since the
 // springs' scale the vessel's 10% level, the rounds' handover, was 1.05-1.13, since the
-// shares of removable faces 0.99-1.02); it is on the 203k dragon (docs/BENCHMARKS.md,
-// bench/parallel.sh with metro). One more test, on fandisk from ../shared/meshes, checks the
-// jobs' shares by cheap edges against equal shares at the 50% level.
+// shares of removable faces 0.99-1.02); it is on the 203k dragon
+// (docs/decisions/notebook-2026-11.md, bench/parallel.sh with metro). One more test, on fandisk
+// from ../shared/meshes, checks the jobs' shares by cheap edges against equal shares at the 50%
+// level.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -154,18 +155,18 @@ TEST(ParallelQuality, EnergyLevelsMatchTheSequentialOnes) {
 // input (RMS 8.3e-6 against 4.1e-5): its flat sides now cost nothing at all, and a round
 // cannot take the flat faces along its borders, so the jobs take costlier ones inside
 // instead: 1.11 by cheap edges, 1.30 equal shares (1.01 at p = 2, 1.23 at p = 16; the
-// parallel level is still 4x closer than the sequential one was; docs/BENCHMARKS.md). The
-// rounds are the geometric ones (border_excess 0), so that the 50% level lies inside round 0,
-// whose shares this is about: rounds bounded by their border band put it in round 2 of 14,
-// where it is 1.17 by cheap edges and 1.16 equal shares (fandisk's near-exact 50% level is
-// the one the bound does not help: docs/BENCHMARKS.md, "Rounds bounded by their border band").
-// Since the greedy partitioner counts settled faces (2026-11-25), 8 subsets of fandisk are cut
-// elsewhere: 1.18-1.19 by cheap edges, 1.27-1.36 equal shares, in the input's numbering and in
-// the repair's spatial order alike. Since the energy's springs left its cost (2026-11-26,
-// docs/DECISIONS.md) the sequential 50% level is near exact (metro RMS 5.9e-7 against 8.3e-6
-// before, 2.1x CGAL Lindstrom-Turk's): 1.65 by cheap edges, 2.12 equal shares, the parallel
-// level about 10x closer to the input than before; the bound follows (issue 37's target,
-// within 5% of the sequential level, is not met here).
+// parallel level is still 4x closer than the sequential one was;
+// docs/decisions/notebook-2026-11.md). The rounds are the geometric ones (border_excess 0), so that
+// the 50% level lies inside round 0, whose shares this is about: rounds bounded by their border
+// band put it in round 2 of 14, where it is 1.17 by cheap edges and 1.16 equal shares (fandisk's
+// near-exact 50% level is the one the bound does not help: docs/decisions/notebook-2026-11.md,
+// "Rounds bounded by their border band"). Since the greedy partitioner counts settled faces
+// (2026-11-25), 8 subsets of fandisk are cut elsewhere: 1.18-1.19 by cheap edges, 1.27-1.36 equal
+// shares, in the input's numbering and in the repair's spatial order alike. Since the energy's
+// springs left its cost (2026-11-26, docs/DECISIONS.md) the sequential 50% level is near exact
+// (metro RMS 5.9e-7 against 8.3e-6 before, 2.1x CGAL Lindstrom-Turk's): 1.65 by cheap edges, 2.12
+// equal shares, the parallel level about 10x closer to the input than before; the bound follows
+// (issue 37's target, within 5% of the sequential level, is not met here).
 TEST(ParallelQuality, SharesByCheapEdgesFollowTheSequentialOrder) {
   const std::filesystem::path path = shared_meshes_dir() / "fandisk-13k.obj";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/meshes is not present";

@@ -59,7 +59,7 @@ TEST(DeferredRecosting, AboveTheInputItChangesNothing) {
 // Deferred down to a tenth of the faces, as the sequential build does: most re-costings are
 // saved (2026-11-22: 402k -> 284k costings on the bunny, 29% fewer on the 871k dragon), and the
 // levels keep their error (18 meshes, RMS at 50 / 10 / 2%: geometric means 0.99 / 0.99 / 1.00
-// of the immediate build's; docs/BENCHMARKS.md, "Deferred re-costing").
+// of the immediate build's; docs/decisions/notebook-2026-11.md, "Deferred re-costing").
 TEST(DeferredRecosting, SavesCostingsAndKeepsTheLevels) {
   const RepairedMesh repaired =
       repair_mesh(read_mesh(testing::test_data("pymeshlab-bunny-textured-10k.obj")));

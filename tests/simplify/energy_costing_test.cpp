@@ -205,8 +205,8 @@ Mesh live_mesh(const CollapseMesh& mesh) {
 // own values, and as low at 2% (2026-11-22: 0.733 and 0.978 of it; with queue keys from all
 // three starts it was 0.70 and 0.95; with the star's planes and volume 0.855 and 0.967; with the
 // repair's spatial order, which only renumbers the mesh, 0.866 and 1.007: at 2% the two are
-// within the numbering's noise; nine meshes of ../shared/meshes in docs/BENCHMARKS.md,
-// "E_spring's weight").
+// within the numbering's noise; nine meshes of ../shared/meshes in
+// docs/decisions/notebook-2026-11.md, "E_spring's weight").
 TEST(EnergyCosting, ScaledSpringsKeepTheSurfaceCloserThanHoppesValues) {
   const Mesh input = repair_mesh(read_mesh(testing::test_data("gmsh-aneurysm-20k.stl.gz"))).mesh;
   for (const double ratio : {0.1, 0.02}) {
@@ -226,9 +226,9 @@ TEST(EnergyCosting, ScaledSpringsKeepTheSurfaceCloserThanHoppesValues) {
 // The star's planes and volume preservation (energy_priority.h) measure the surface between
 // the points, which one point per vertex does not see: with them a scanned vessel and a CAD
 // part (flat and cylindrical patches) come out closer to their inputs at 50% and 10% (on 18
-// meshes of ../shared/meshes: RMS 0.48x and 0.72x, docs/BENCHMARKS.md). Here: 0.53-0.56x at
-// 50%; at 10% 0.835 / 0.838 in the input's numbering, 0.845 / 0.945 in the repair's spatial
-// order (the CAD part's level without the terms moved by 8% with the numbering alone).
+// meshes of ../shared/meshes: RMS 0.48x and 0.72x, docs/decisions/notebook-2026-11.md). Here:
+// 0.53-0.56x at 50%; at 10% 0.835 / 0.838 in the input's numbering, 0.845 / 0.945 in the repair's
+// spatial order (the CAD part's level without the terms moved by 8% with the numbering alone).
 TEST(EnergyCosting, StarPlanesAndVolumeKeepTheSurfaceCloser) {
   for (const char* name : {"gmsh-aneurysm-20k.stl.gz", "cad-cycloidal-43k.ply"}) {
     const Mesh input = repair_mesh(read_mesh(testing::test_data(name))).mesh;
