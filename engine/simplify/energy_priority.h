@@ -205,6 +205,9 @@ class EnergyPriority : public PriorityModule {
   void set_max_sampled_points(uint32_t n) { options_.max_sampled_points = n; }
 
  private:
+  // kTopologyPrice's price per point for a mesh of this diagonal (the whole mesh's in every
+  // subset, so that every job prices alike): (kTopologyPrice x diagonal)^2.
+  static double topology_price(double diagonal);
   static constexpr uint32_t kNoPoint = 0xffffffffu;
   // A point as its face holds it: each face keeps its points contiguously, so that the late
   // collapses, whose stars hold hundreds of points, read them in sequence, not one cache miss
