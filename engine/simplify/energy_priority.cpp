@@ -362,12 +362,11 @@ bool EnergyPriority::folds(const Vec3& v) const {
   return false;
 }
 
-bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                              CollapseCandidate& out, Costing costing) const {
-  ++costings_;
+EnergyPriority::Survivor EnergyPriority::choose_survivor(const CollapseMesh& mesh, VertexId a,
+                                                         VertexId b) const {
   const bool locked_a = !locked_.empty() && locked_[a];
   const bool locked_b = !locked_.empty() && locked_[b];
-  if (locked_a && locked_b) return false;
+  if (locked_a && locked_b) return {};
   const bool boundary_a = mesh.is_boundary(a), boundary_b = mesh.is_boundary(b);
   // Discontinuity curves (boundaries, creases, seams): a vertex on a curve does not leave
   // it for an inner vertex, nor a curve's corner or end (not two sharp edges) for a vertex
@@ -390,11 +389,18 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     keep_b = b < a;
   }
   const bool fixed = locked_a || locked_b || curve_a != curve_b || corner_a != corner_b || topology;
-  out.vs = keep_b ? b : a;
-  out.vt = keep_b ? a : b;
-  const Vec3& pa = mesh.position(a);
-  const Vec3& pb = mesh.position(b);
+  Survivor survivor;
+  survivor.possible = true;
+  survivor.keep_b = keep_b;
+  survivor.fixed = fixed;
+  survivor.topology = topology;
+  survivor.boundary_a = boundary_a;
+  survivor.boundary_b = boundary_b;
+  return survivor;
+}
 
+EnergyPriority::StarSums EnergyPriority::gather_star(const CollapseMesh& mesh, VertexId a,
+                                                     VertexId b) const {
   // The star: every face around a or b; after the collapse those without both ends remain,
   // with the moving corner first. Points of the two faces that disappear are homed next to
   // their apex once the fan is known.
@@ -410,7 +416,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   // of normal.corner (the tetrahedra between v and the faces have signed volumes summing to
   // (normals.v - offsets) / 6), and twice its area; about a's position, so that the quadric's
   // value, a small difference of large terms far from the model's origin, stays exact.
-  star_origin_ = pa;
+  star_origin_ = mesh.position(a);
   Quadric star_planes;
   Vec3 normals{};
   double offsets = 0, area2 = 0;
@@ -457,7 +463,17 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       }
     }
   }
-  if (star_.empty()) return false;
+  StarSums sums;
+  sums.planes = star_planes;
+  sums.normals = normals;
+  sums.offsets = offsets;
+  sums.area2 = area2;
+  sums.edge_apexes = edge_apexes;
+  sums.edge_faces = edge_faces;
+  return sums;
+}
+
+double EnergyPriority::link_fan(const StarSums& sums, VertexId a, VertexId b) const {
   // The fan around the moved vertex, and homes for the points of the two removed faces.
   std::array<int, 2> apex_home{0, 0};
   double parked_around = 0;
@@ -480,8 +496,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     }
     face.next = next;
     face.previous = previous;
-    for (int e = 0; e < edge_faces; ++e)
-      if (face.id1 == edge_apexes[e] || face.id2 == edge_apexes[e]) apex_home[e] = j;
+    for (int e = 0; e < sums.edge_faces; ++e)
+      if (face.id1 == sums.edge_apexes[e] || face.id2 == sums.edge_apexes[e]) apex_home[e] = j;
     // A neighbour's parked sample sits on the star's rim: half of it counts as the star's.
     if (parked_point_[face.id1] != kNoPoint) parked_around += 0.5;
   }
@@ -494,6 +510,10 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       parked_ends_.push_back(parked(parked_point_[end]));
       parked_end_homes_.push_back(end == a ? -1 : -2);
     }
+  return parked_around;
+}
+
+EnergyPriority::StarPoints EnergyPriority::gather_star_points(double parked_around) const {
   // How many points the star holds: the faces' counts are their moments' (kept per face).
   size_t in_faces = 0;
   for (const auto& list : star_lists_) in_faces += face_points_[list.first].size();
@@ -509,7 +529,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   const size_t sampled = options_.max_sampled_points;
   auto gather_all = [&] {
     for (const auto& [f, home] : star_lists_)
-      gather_face(f, home < 0 ? apex_home[-2 - home] : home);
+      gather_face(f, home < 0 ? edge_face_homes_[-2 - home] : home);
     star_points_.insert(star_points_.end(), parked_ends_.begin(), parked_ends_.end());
     star_homes_.insert(star_homes_.end(), parked_end_homes_.begin(), parked_end_homes_.end());
   };
@@ -524,7 +544,8 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       star_homes_.push_back(home);
     };
     for (const auto& [f, home] : star_lists_)
-      for (const FacePoint& p : face_points_[f]) take(p, home < 0 ? apex_home[-2 - home] : home);
+      for (const FacePoint& p : face_points_[f])
+        take(p, home < 0 ? edge_face_homes_[-2 - home] : home);
     for (size_t i = 0; i < parked_ends_.size(); ++i) take(parked_ends_[i], parked_end_homes_[i]);
     if (star_points_.empty()) {
       gather_all();
@@ -532,6 +553,50 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       star_point_weight_ = double(total) / double(star_points_.size());
     }
   }
+  return {by_moments, points_around};
+}
+
+void EnergyPriority::set_star_terms(StarSums& sums, double points_around) const {
+  if (star_terms_on_) {
+    // Points spread at density rho = points / area over a face of the star, v moving by h off
+    // its plane, are moved by h times their barycentric coordinate of v: rho area h^2 / 6 in
+    // all. The volume's change over the star's area is a mean displacement of
+    // (sums.normals.v - sums.offsets) / (3 sums.area2), for all the star's points.
+    const double points = std::max(1.0, points_around);
+    star_terms_ = Quadric{};
+    if (sums.area2 > 0 && options_.star_planes_weight > 0) {
+      sums.planes *= options_.star_planes_weight * points / (6 * sums.area2);
+      star_terms_ += sums.planes;
+    }
+    const double normals_length = length(sums.normals);
+    if (sums.area2 > 0 && normals_length > 0 && options_.volume_weight > 0) {
+      Quadric volume =
+          Quadric::from_plane(scale(sums.normals, 1 / normals_length),
+                              -sums.offsets / normals_length, normals_length * normals_length);
+      volume *= options_.volume_weight * points / (9 * sums.area2 * sums.area2);
+      star_terms_ += volume;
+    }
+  }
+}
+
+bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
+                              CollapseCandidate& out, Costing costing) const {
+  ++costings_;
+  const Survivor survivor = choose_survivor(mesh, a, b);
+  if (!survivor.possible) return false;
+  const bool keep_b = survivor.keep_b, fixed = survivor.fixed, topology = survivor.topology;
+  const bool boundary_a = survivor.boundary_a, boundary_b = survivor.boundary_b;
+  out.vs = keep_b ? b : a;
+  out.vt = keep_b ? a : b;
+  const Vec3& pa = mesh.position(a);
+  const Vec3& pb = mesh.position(b);
+
+  StarSums sums = gather_star(mesh, a, b);
+  if (star_.empty()) return false;
+  const double parked_around = link_fan(sums, a, b);
+  const StarPoints points = gather_star_points(parked_around);
+  const bool by_moments = points.by_moments;
+  const double points_around = points.points_around;
   curves_.gather(a, b, mesh, options_.max_sampled_points);
   const double curve_before = curves_.gathered_distance_sq();
   const double distance_before = by_moments ? moment_distance_before(mesh) : exact_distance_sq();
@@ -542,27 +607,10 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   for (const StarFace& f : star_) spring_pull = add(spring_pull, add(f.p1, f.p2));
   spring_pull = scale(spring_pull, 0.5 * kappa);
   const double spring_weight = kappa * double(star_.size());
-  if (star_terms_on_) {
-    // Points spread at density rho = points / area over a face of the star, v moving by h off
-    // its plane, are moved by h times their barycentric coordinate of v: rho area h^2 / 6 in
-    // all. The volume's change over the star's area is a mean displacement of
-    // (normals.v - offsets) / (3 area2), for all the star's points.
-    const double points = std::max(1.0, points_around);
-    star_terms_ = Quadric{};
-    if (area2 > 0 && options_.star_planes_weight > 0) {
-      star_planes *= options_.star_planes_weight * points / (6 * area2);
-      star_terms_ += star_planes;
-    }
-    const double normals_length = length(normals);
-    if (area2 > 0 && normals_length > 0 && options_.volume_weight > 0) {
-      Quadric volume =
-          Quadric::from_plane(scale(normals, 1 / normals_length), -offsets / normals_length,
-                              normals_length * normals_length);
-      volume *= options_.volume_weight * points / (9 * area2 * area2);
-      star_terms_ += volume;
-    }
-  }
+  set_star_terms(sums, points_around);
 
+  // 6. Placements: the fixed survivor's place, or from each start a measure and solves
+  //    (fewer starts for a queue key); 7. the lowest that folds no face, priced.
   static constexpr size_t kNotProjected = ~size_t{0};
   struct Placement {
     Vec3 v;

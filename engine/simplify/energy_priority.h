@@ -299,6 +299,41 @@ class EnergyPriority : public PriorityModule {
                     EnergyState& out) const;
   bool folds(const Vec3& v) const;
 
+  // evaluate()'s steps, in order. Each fills the scratch members it names; none is
+  // thread-safe (the scratch is the module's).
+  // 1. Which end survives, and whether its place is fixed (a locked end, an end on a curve the
+  //    other is not on, a corner, or a change of the curves' topology); not possible when both
+  //    ends are locked.
+  struct Survivor {
+    bool possible = false;
+    bool keep_b = false, fixed = false, topology = false, boundary_a = false, boundary_b = false;
+  };
+  Survivor choose_survivor(const CollapseMesh& mesh, VertexId a, VertexId b) const;
+  // 2. The star (star_, star_lists_, edge_faces_, joined_, a_side_faces_, star_origin_), and
+  //    the sums over its faces before the collapse: the area-weighted planes, the faces'
+  //    normals and normal.corner, twice the area, about star_origin_.
+  struct StarSums {
+    Quadric planes;
+    Vec3 normals{};
+    double offsets = 0, area2 = 0;
+    std::array<VertexId, 2> edge_apexes{kNoId, kNoId};
+    int edge_faces = 0;
+  };
+  StarSums gather_star(const CollapseMesh& mesh, VertexId a, VertexId b) const;
+  // 3. The fan's order (StarFace::next, previous), the homes of the removed faces' points
+  //    (edge_face_homes_) and the samples of a and b still parked (parked_ends_). Returns the
+  //    parked samples around the star, each counted half (they sit on its rim).
+  double link_fan(const StarSums& sums, VertexId a, VertexId b) const;
+  // 4. The star's points (star_points_, star_homes_, star_point_weight_), all, or thinned
+  //    for E_scalar on a large star; whether the star is costed by its faces' moments.
+  struct StarPoints {
+    bool by_moments = false;
+    double points_around = 0;  // the points the star holds, its rim's parked half included
+  };
+  StarPoints gather_star_points(double parked_around) const;
+  // 5. star_terms_: the star's planes and its volume, weighted for points_around points.
+  void set_star_terms(StarSums& sums, double points_around) const;
+
   std::vector<uint8_t> locked_;
   EnergyOptions options_;
   std::vector<Vec3> positions_;                      // per point (they never move)
