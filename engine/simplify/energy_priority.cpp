@@ -104,12 +104,12 @@ double EnergyPriority::diagonal_of(const CollapseMesh& mesh) const {
 
 void EnergyPriority::gather_face(FaceId f, int home) const {
   const auto& list = face_points_[f];
-  const size_t first = star_points_.size();
-  star_points_.insert(star_points_.end(), list.begin(), list.end());
-  star_homes_.insert(star_homes_.end(), list.size(), home);
+  const size_t first = scratch_.points.size();
+  scratch_.points.insert(scratch_.points.end(), list.begin(), list.end());
+  scratch_.homes.insert(scratch_.homes.end(), list.size(), home);
   if (drift_[f] != 0)  // rare: a face left with its points by a rich star's collapse
-    for (size_t i = first; i < star_points_.size(); ++i)
-      star_points_[i].distance_sq = bounded_distance_sq(f, star_points_[i]);
+    for (size_t i = first; i < scratch_.points.size(); ++i)
+      scratch_.points[i].distance_sq = bounded_distance_sq(f, scratch_.points[i]);
 }
 
 const PointMoments& EnergyPriority::moments_of(FaceId f) const {
@@ -175,11 +175,11 @@ double EnergyPriority::rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Ve
   const double h_sq = h * h / n_sq;
   double closest = project_on_triangle(m.mean, q0, q1, q2).distance_sq;
   if (star_face >= 0)
-    for (const int beside : {star_[star_face].next, star_[star_face].previous})
+    for (const int beside : {scratch_.star[star_face].next, scratch_.star[star_face].previous})
       if (beside >= 0 && closest > h_sq)
-        closest = std::min(
-            closest,
-            project_on_triangle(m.mean, q0, star_[beside].p1, star_[beside].p2).distance_sq);
+        closest = std::min(closest, project_on_triangle(m.mean, q0, scratch_.star[beside].p1,
+                                                        scratch_.star[beside].p2)
+                                        .distance_sq);
   return closest > h_sq ? m.count * (closest - h_sq) : 0;
 }
 
@@ -187,13 +187,14 @@ double EnergyPriority::rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Ve
 // to the cost at the chosen placement only: the placements are compared on the planes.
 double EnergyPriority::moment_rim_change(const CollapseMesh& mesh, const Vec3& v) const {
   double change = 0;
-  for (size_t j = 0; j < star_.size(); ++j)
-    change += rim_sq(star_[j].source, v, star_[j].p1, star_[j].p2, int(j)) -
-              own_error_of(mesh, star_[j].source).rim_sq;
+  for (size_t j = 0; j < scratch_.star.size(); ++j)
+    change += rim_sq(scratch_.star[j].source, v, scratch_.star[j].p1, scratch_.star[j].p2, int(j)) -
+              own_error_of(mesh, scratch_.star[j].source).rim_sq;
   for (int e = 0; e < 2; ++e)
-    if (const FaceId f = edge_faces_[e]; f != kNoId) {
-      const StarFace& home = star_[edge_face_homes_[e]];
-      change += rim_sq(f, v, home.p1, home.p2, edge_face_homes_[e]) - own_error_of(mesh, f).rim_sq;
+    if (const FaceId f = scratch_.edge_faces[e]; f != kNoId) {
+      const StarFace& home = scratch_.star[scratch_.edge_face_homes[e]];
+      change += rim_sq(f, v, home.p1, home.p2, scratch_.edge_face_homes[e]) -
+                own_error_of(mesh, f).rim_sq;
     }
   return change;
 }
@@ -205,21 +206,22 @@ double EnergyPriority::moment_rim_change(const CollapseMesh& mesh, const Vec3& v
 // projected one by one.
 double EnergyPriority::moment_distance_before(const CollapseMesh& mesh) const {
   double sum = 0;
-  for (const StarFace& f : star_) sum += own_error_of(mesh, f.source).plane_sq;
-  for (const FaceId f : edge_faces_)
+  for (const StarFace& f : scratch_.star) sum += own_error_of(mesh, f.source).plane_sq;
+  for (const FaceId f : scratch_.edge_faces)
     if (f != kNoId) sum += own_error_of(mesh, f).plane_sq;
   return sum;
 }
 
 double EnergyPriority::moment_distance_after(const Vec3& v) const {
   double sum = 0;
-  for (const StarFace& f : star_) sum += plane_distance_sq(f.source, v, f.p1, f.p2);
+  for (const StarFace& f : scratch_.star) sum += plane_distance_sq(f.source, v, f.p1, f.p2);
   for (int e = 0; e < 2; ++e)
-    if (edge_faces_[e] != kNoId) {
-      const StarFace& home = star_[edge_face_homes_[e]];
-      sum += plane_distance_sq(edge_faces_[e], v, home.p1, home.p2);
+    if (scratch_.edge_faces[e] != kNoId) {
+      const StarFace& home = scratch_.star[scratch_.edge_face_homes[e]];
+      sum += plane_distance_sq(scratch_.edge_faces[e], v, home.p1, home.p2);
     }
-  if (!parked_ends_.empty()) sum += project_points(parked_ends_, parked_end_homes_, v).distance_sq;
+  if (!scratch_.parked_ends.empty())
+    sum += project_points(scratch_.parked_ends, scratch_.parked_end_homes, v).distance_sq;
   return sum;
 }
 
@@ -237,21 +239,23 @@ Vec3 EnergyPriority::moment_solve(const Vec3& from, double iso_a, const Vec3& is
     const double n_sq = dot(n, n);
     if (n_sq > 0) add_plane_quadratic(m, p1, p2, 1.0 / n_sq, planes.h, planes.r, planes.k);
   };
-  for (const StarFace& f : star_) add_face(f.source, f.p1, f.p2);
+  for (const StarFace& f : scratch_.star) add_face(f.source, f.p1, f.p2);
   for (int e = 0; e < 2; ++e)
-    if (edge_faces_[e] != kNoId)
-      add_face(edge_faces_[e], star_[edge_face_homes_[e]].p1, star_[edge_face_homes_[e]].p2);
-  if (!parked_ends_.empty()) planes.ends = project_points(parked_ends_, parked_end_homes_, from);
+    if (scratch_.edge_faces[e] != kNoId)
+      add_face(scratch_.edge_faces[e], scratch_.star[scratch_.edge_face_homes[e]].p1,
+               scratch_.star[scratch_.edge_face_homes[e]].p2);
+  if (!scratch_.parked_ends.empty())
+    planes.ends = project_points(scratch_.parked_ends, scratch_.parked_end_homes, from);
   Eigen::Matrix3d h = planes.h + Eigen::Matrix3d::Identity() * (iso_a + planes.ends.a);
   Eigen::Vector3d r =
       planes.r + Eigen::Vector3d(iso_b[0] + planes.ends.b[0], iso_b[1] + planes.ends.b[1],
                                  iso_b[2] + planes.ends.b[2]);
   if (star_terms_on_) {
-    // The star's quadric is about star_origin_: (v - o)^T A (v - o) + 2 b.(v - o) + c.
-    const Quadric& q = star_terms_;
+    // The star's quadric is about scratch_.origin: (v - o)^T A (v - o) + 2 b.(v - o) + c.
+    const Quadric& q = scratch_.terms;
     Eigen::Matrix3d a;
     a << q.a00, q.a01, q.a02, q.a01, q.a11, q.a12, q.a02, q.a12, q.a22;
-    const Eigen::Vector3d o(star_origin_[0], star_origin_[1], star_origin_[2]);
+    const Eigen::Vector3d o(scratch_.origin[0], scratch_.origin[1], scratch_.origin[2]);
     h += a;
     r += a * o - Eigen::Vector3d(q.b0, q.b1, q.b2);
   }
@@ -270,10 +274,10 @@ Vec3 EnergyPriority::projection_solve(const Fit& fit, double iso_a, const Vec3& 
   if (!(diagonal > 0)) return from;
   const Vec3 pull = add(fit.b, iso_b);
   if (star_terms_on_) {
-    // In coordinates about star_origin_ (u = v - o), where the star's quadric is kept: the
+    // In coordinates about scratch_.origin (u = v - o), where the star's quadric is kept: the
     // isotropic part d |u + o|^2 - 2 pull.(u + o) adds d to A's diagonal and d o - pull to b.
-    Quadric q = star_terms_;
-    const Vec3& o = star_origin_;
+    Quadric q = scratch_.terms;
+    const Vec3& o = scratch_.origin;
     q.a00 += diagonal, q.a11 += diagonal, q.a22 += diagonal;
     q.b0 += diagonal * o[0] - pull[0], q.b1 += diagonal * o[1] - pull[1];
     q.b2 += diagonal * o[2] - pull[2];
@@ -286,7 +290,7 @@ Vec3 EnergyPriority::projection_solve(const Fit& fit, double iso_a, const Vec3& 
 
 double EnergyPriority::exact_distance_sq() const {
   double sum = 0;
-  for (const FacePoint& p : star_points_) sum += p.distance_sq;
+  for (const FacePoint& p : scratch_.points) sum += p.distance_sq;
   return sum;
 }
 
@@ -294,7 +298,7 @@ void EnergyPriority::unpark(VertexId v) {
   const uint32_t id = parked_point_[v];
   if (id == kNoPoint) return;
   parked_point_[v] = kNoPoint;
-  star_points_.push_back(parked(id));
+  scratch_.points.push_back(parked(id));
 }
 
 EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>& points,
@@ -305,8 +309,9 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
   if (points.empty()) return fit;
   // Every face up front: a star's few points (5 on 8 faces, typically: most samples are
   // parked at their vertices) touch nearly all of them, and the loop below stays small.
-  prepared_.resize(star_.size());
-  for (size_t j = 0; j < star_.size(); ++j) prepared_[j].reset(v, star_[j].p1, star_[j].p2);
+  scratch_.prepared.resize(scratch_.star.size());
+  for (size_t j = 0; j < scratch_.star.size(); ++j)
+    scratch_.prepared[j].reset(v, scratch_.star[j].p1, scratch_.star[j].p2);
   for (size_t i = 0; i < points.size(); ++i) {
     const Vec3& x = points[i].position;
     // A point moves at most one face along the fan per projection: its face's image and the
@@ -315,34 +320,35 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
     best.distance_sq = std::numeric_limits<double>::infinity();
     int best_j = 0;
     auto consider = [&](int j) {
-      const Projection p = prepared_[j].project(x);
+      const Projection p = scratch_.prepared[j].project(x);
       if (p.distance_sq < best.distance_sq) best = p, best_j = j;
     };
     // A face whose plane is already farther than the best cannot win.
     auto consider_near = [&](int j) {
-      if (prepared_[j].plane_distance_sq(x) <= best.distance_sq) consider(j);
+      if (scratch_.prepared[j].plane_distance_sq(x) <= best.distance_sq) consider(j);
     };
     const int home = homes[i];
     if (home < 0) {
       // The sample of a (b), at a's old position: v moved away from it, towards the other
       // end, so it lies over the faces that were a's (b's).
       const bool a_side = home == -1;
-      int begin = a_side ? 0 : a_side_faces_, end = a_side ? a_side_faces_ : int(star_.size());
+      int begin = a_side ? 0 : scratch_.a_side_faces,
+          end = a_side ? scratch_.a_side_faces : int(scratch_.star.size());
       if (x == v) {
         // At the start where v is that end: on the first face, at distance 0, as projecting
         // onto each face (all meet at v) would find.
         best = {{1, 0, 0}, 0};
         best_j = begin < end ? begin : 0;
       } else {
-        if (begin == end) begin = 0, end = int(star_.size());
+        if (begin == end) begin = 0, end = int(scratch_.star.size());
         for (int j = begin; j < end; ++j) consider_near(j);
       }
     } else {
       consider(home);
-      if (star_[home].next >= 0) consider_near(star_[home].next);
-      if (star_[home].previous >= 0) consider_near(star_[home].previous);
+      if (scratch_.star[home].next >= 0) consider_near(scratch_.star[home].next);
+      if (scratch_.star[home].previous >= 0) consider_near(scratch_.star[home].previous);
     }
-    const StarFace* best_face = &star_[best_j];
+    const StarFace* best_face = &scratch_.star[best_j];
     if (where) (*where)[i] = {best_j, best.bary};
     fit.distance_sq += best.distance_sq;
     fit.max_distance_sq = std::max(fit.max_distance_sq, best.distance_sq);
@@ -357,7 +363,7 @@ EnergyPriority::Fit EnergyPriority::project_points(const std::vector<FacePoint>&
 }
 
 bool EnergyPriority::folds(const Vec3& v) const {
-  for (const StarFace& f : star_)
+  for (const StarFace& f : scratch_.star)
     if (face_folds(f.before, f.p1, f.p2, v, f.p1, f.p2)) return true;
   return false;
 }
@@ -404,24 +410,24 @@ EnergyPriority::StarSums EnergyPriority::gather_star(const CollapseMesh& mesh, V
   // The star: every face around a or b; after the collapse those without both ends remain,
   // with the moving corner first. Points of the two faces that disappear are homed next to
   // their apex once the fan is known.
-  star_.clear();
-  star_lists_.clear();
-  star_points_.clear();
-  star_homes_.clear();
+  scratch_.star.clear();
+  scratch_.lists.clear();
+  scratch_.points.clear();
+  scratch_.homes.clear();
   std::array<VertexId, 2> edge_apexes{kNoId, kNoId};
   int edge_faces = 0;
-  edge_faces_ = {kNoId, kNoId};
-  joined_count_ = 0;
+  scratch_.edge_faces = {kNoId, kNoId};
+  scratch_.joined_count = 0;
   // The star's planes before the collapse (area weighted), the sum of its faces' normals and
   // of normal.corner (the tetrahedra between v and the faces have signed volumes summing to
   // (normals.v - offsets) / 6), and twice its area; about a's position, so that the quadric's
   // value, a small difference of large terms far from the model's origin, stays exact.
-  star_origin_ = mesh.position(a);
+  scratch_.origin = mesh.position(a);
   Quadric star_planes;
   Vec3 normals{};
   double offsets = 0, area2 = 0;
   for (VertexId end : {a, b}) {
-    if (end == b) a_side_faces_ = int(star_.size());
+    if (end == b) scratch_.a_side_faces = int(scratch_.star.size());
     const VertexId other = end == a ? b : a;
     for (FaceId f : mesh.faces_of(end)) {
       const Triangle& t = mesh.face(f);
@@ -434,7 +440,7 @@ EnergyPriority::StarSums EnergyPriority::gather_star(const CollapseMesh& mesh, V
       if (star_terms_on_) {
         const Vec3 n = triangle_normal(p0, p1, p2);
         const double n_length = length(n);
-        const double offset = dot(n, sub(p0, star_origin_));
+        const double offset = dot(n, sub(p0, scratch_.origin));
         normals = add(normals, n);
         offsets += offset;
         area2 += n_length;
@@ -446,20 +452,20 @@ EnergyPriority::StarSums EnergyPriority::gather_star(const CollapseMesh& mesh, V
           edge_apexes[edge_faces] = t[3 - k - other_corner];
           if (scalar_.enabled()) {
             const auto& w = mesh.corner_wedges(f);
-            joined_[joined_count_++] = {w[k], w[other_corner]};
+            scratch_.joined[scratch_.joined_count++] = {w[k], w[other_corner]};
           }
-          edge_faces_[edge_faces] = f;
-          star_lists_.push_back({f, -2 - edge_faces});
+          scratch_.edge_faces[edge_faces] = f;
+          scratch_.lists.push_back({f, -2 - edge_faces});
           ++edge_faces;
         }
       } else {
-        star_.push_back({p1, p2, p0, t[(k + 1) % 3], t[(k + 2) % 3]});
-        star_.back().source = f;
+        scratch_.star.push_back({p1, p2, p0, t[(k + 1) % 3], t[(k + 2) % 3]});
+        scratch_.star.back().source = f;
         if (scalar_.enabled()) {
           const auto& w = mesh.corner_wedges(f);
-          star_.back().wedges = {w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
+          scratch_.star.back().wedges = {w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
         }
-        star_lists_.push_back({f, int(star_.size()) - 1});
+        scratch_.lists.push_back({f, int(scratch_.star.size()) - 1});
       }
     }
   }
@@ -478,21 +484,21 @@ double EnergyPriority::link_fan(const StarSums& sums, VertexId a, VertexId b) co
   std::array<int, 2> apex_home{0, 0};
   double parked_around = 0;
   // Linking is quadratic in the valence: scan packed ids, not the star's faces.
-  fan_first_ids_.clear();
-  fan_second_ids_.clear();
-  for (const StarFace& face : star_) {
-    fan_first_ids_.push_back(face.id1);
-    fan_second_ids_.push_back(face.id2);
+  scratch_.fan_first_ids.clear();
+  scratch_.fan_second_ids.clear();
+  for (const StarFace& face : scratch_.star) {
+    scratch_.fan_first_ids.push_back(face.id1);
+    scratch_.fan_second_ids.push_back(face.id2);
   }
-  const int star_size = int(star_.size());
+  const int star_size = int(scratch_.star.size());
   for (int j = 0; j < star_size; ++j) {
-    StarFace& face = star_[j];
+    StarFace& face = scratch_.star[j];
     const VertexId first = face.id1, second = face.id2;
     // Branch-free (the last match wins), so that the compiler vectorises the scan.
     int next = face.next, previous = face.previous;
     for (int k = 0; k < star_size; ++k) {
-      next = fan_first_ids_[k] == second ? k : next;
-      previous = fan_second_ids_[k] == first ? k : previous;
+      next = scratch_.fan_first_ids[k] == second ? k : next;
+      previous = scratch_.fan_second_ids[k] == first ? k : previous;
     }
     face.next = next;
     face.previous = previous;
@@ -501,14 +507,14 @@ double EnergyPriority::link_fan(const StarSums& sums, VertexId a, VertexId b) co
     // A neighbour's parked sample sits on the star's rim: half of it counts as the star's.
     if (parked_point_[face.id1] != kNoPoint) parked_around += 0.5;
   }
-  edge_face_homes_ = apex_home;
+  scratch_.edge_face_homes = apex_home;
   // The samples of a and b themselves, where they still are.
-  parked_ends_.clear();
-  parked_end_homes_.clear();
+  scratch_.parked_ends.clear();
+  scratch_.parked_end_homes.clear();
   for (VertexId end : {a, b})
     if (parked_point_[end] != kNoPoint) {
-      parked_ends_.push_back(parked(parked_point_[end]));
-      parked_end_homes_.push_back(end == a ? -1 : -2);
+      scratch_.parked_ends.push_back(parked(parked_point_[end]));
+      scratch_.parked_end_homes.push_back(end == a ? -1 : -2);
     }
   return parked_around;
 }
@@ -516,8 +522,8 @@ double EnergyPriority::link_fan(const StarSums& sums, VertexId a, VertexId b) co
 EnergyPriority::StarPoints EnergyPriority::gather_star_points(double parked_around) const {
   // How many points the star holds: the faces' counts are their moments' (kept per face).
   size_t in_faces = 0;
-  for (const auto& list : star_lists_) in_faces += face_points_[list.first].size();
-  const size_t total = in_faces + parked_ends_.size();
+  for (const auto& list : scratch_.lists) in_faces += face_points_[list.first].size();
+  const size_t total = in_faces + scratch_.parked_ends.size();
   const double points_around = double(total) + parked_around;
   const size_t cap = std::max<uint32_t>(1, options_.max_points_per_evaluation);
   // A star with more points than cap is placed and costed on its faces' point moments, in
@@ -525,13 +531,15 @@ EnergyPriority::StarPoints EnergyPriority::gather_star_points(double parked_arou
   // hundreds of points. A smaller one projects each point, exactly. With E_scalar the points
   // are gathered either way: the attributes need where each one lands.
   const bool by_moments = total > cap;
-  star_point_weight_ = 1;
+  scratch_.point_weight = 1;
   const size_t sampled = options_.max_sampled_points;
   auto gather_all = [&] {
-    for (const auto& [f, home] : star_lists_)
-      gather_face(f, home < 0 ? edge_face_homes_[-2 - home] : home);
-    star_points_.insert(star_points_.end(), parked_ends_.begin(), parked_ends_.end());
-    star_homes_.insert(star_homes_.end(), parked_end_homes_.begin(), parked_end_homes_.end());
+    for (const auto& [f, home] : scratch_.lists)
+      gather_face(f, home < 0 ? scratch_.edge_face_homes[-2 - home] : home);
+    scratch_.points.insert(scratch_.points.end(), scratch_.parked_ends.begin(),
+                           scratch_.parked_ends.end());
+    scratch_.homes.insert(scratch_.homes.end(), scratch_.parked_end_homes.begin(),
+                          scratch_.parked_end_homes.end());
   };
   if (!by_moments || (scalar_.enabled() && (sampled == 0 || total <= sampled))) {
     gather_all();
@@ -540,17 +548,18 @@ EnergyPriority::StarPoints EnergyPriority::gather_star_points(double parked_arou
     const size_t stride = (total + sampled - 1) / sampled;
     auto take = [&](const FacePoint& p, int home) {
       if (!kept_when_thinned(point_id_.empty() ? p.id : point_id_[p.id], stride)) return;
-      star_points_.push_back(p);
-      star_homes_.push_back(home);
+      scratch_.points.push_back(p);
+      scratch_.homes.push_back(home);
     };
-    for (const auto& [f, home] : star_lists_)
+    for (const auto& [f, home] : scratch_.lists)
       for (const FacePoint& p : face_points_[f])
-        take(p, home < 0 ? edge_face_homes_[-2 - home] : home);
-    for (size_t i = 0; i < parked_ends_.size(); ++i) take(parked_ends_[i], parked_end_homes_[i]);
-    if (star_points_.empty()) {
+        take(p, home < 0 ? scratch_.edge_face_homes[-2 - home] : home);
+    for (size_t i = 0; i < scratch_.parked_ends.size(); ++i)
+      take(scratch_.parked_ends[i], scratch_.parked_end_homes[i]);
+    if (scratch_.points.empty()) {
       gather_all();
     } else {
-      star_point_weight_ = double(total) / double(star_points_.size());
+      scratch_.point_weight = double(total) / double(scratch_.points.size());
     }
   }
   return {by_moments, points_around};
@@ -563,10 +572,10 @@ void EnergyPriority::set_star_terms(StarSums& sums, double points_around) const 
     // all. The volume's change over the star's area is a mean displacement of
     // (sums.normals.v - sums.offsets) / (3 sums.area2), for all the star's points.
     const double points = std::max(1.0, points_around);
-    star_terms_ = Quadric{};
+    scratch_.terms = Quadric{};
     if (sums.area2 > 0 && options_.star_planes_weight > 0) {
       sums.planes *= options_.star_planes_weight * points / (6 * sums.area2);
-      star_terms_ += sums.planes;
+      scratch_.terms += sums.planes;
     }
     const double normals_length = length(sums.normals);
     if (sums.area2 > 0 && normals_length > 0 && options_.volume_weight > 0) {
@@ -574,7 +583,7 @@ void EnergyPriority::set_star_terms(StarSums& sums, double points_around) const 
           Quadric::from_plane(scale(sums.normals, 1 / normals_length),
                               -sums.offsets / normals_length, normals_length * normals_length);
       volume *= options_.volume_weight * points / (9 * sums.area2 * sums.area2);
-      star_terms_ += volume;
+      scratch_.terms += volume;
     }
   }
 }
@@ -592,7 +601,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   const Vec3& pb = mesh.position(b);
 
   StarSums sums = gather_star(mesh, a, b);
-  if (star_.empty()) return false;
+  if (scratch_.star.empty()) return false;
   const double parked_around = link_fan(sums, a, b);
   const StarPoints points = gather_star_points(parked_around);
   const bool by_moments = points.by_moments;
@@ -602,11 +611,11 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   const double distance_before = by_moments ? moment_distance_before(mesh) : exact_distance_sq();
 
   const double kappa =
-      options_.spring_scale * spring_constant(points_around / double(star_.size()));
+      options_.spring_scale * spring_constant(points_around / double(scratch_.star.size()));
   Vec3 spring_pull{};  // kappa/2 * sum (p1 + p2): the springs' part of the normal equations
-  for (const StarFace& f : star_) spring_pull = add(spring_pull, add(f.p1, f.p2));
+  for (const StarFace& f : scratch_.star) spring_pull = add(spring_pull, add(f.p1, f.p2));
   spring_pull = scale(spring_pull, 0.5 * kappa);
-  const double spring_weight = kappa * double(star_.size());
+  const double spring_weight = kappa * double(scratch_.star.size());
   set_star_terms(sums, points_around);
 
   // 6. Placements: the fixed survivor's place, or from each start a measure and solves
@@ -616,7 +625,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     Vec3 v;
     double energy;
     double max_distance_sq;
-    size_t index;  // into placement_projections_; kNotProjected for a modelled placement
+    size_t index;  // into scratch_.placement_projections; kNotProjected for a modelled placement
   };
   std::array<Placement, 16> placements;
   size_t placed = 0;
@@ -629,14 +638,14 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
       fit = Fit{};
       fit.distance_sq = moment_distance_after(v);
     } else {
-      fit = project_points(star_points_, star_homes_, v,
+      fit = project_points(scratch_.points, scratch_.homes, v,
                            keep_projections && placed < placements.size()
-                               ? &placement_projections_[placed]
+                               ? &scratch_.placement_projections[placed]
                                : nullptr);
     }
     curve_fit = curves_.gathered() ? curves_.project(v) : SharpCurves::Fit{};
     double energy = fit.distance_sq + curve_fit.distance_sq;
-    if (star_terms_on_) energy += star_terms_.evaluate(sub(v, star_origin_));
+    if (star_terms_on_) energy += scratch_.terms.evaluate(sub(v, scratch_.origin));
     if (placed < placements.size()) {
       placements[placed] = {v, energy, std::max(fit.max_distance_sq, curve_fit.max_distance_sq),
                             placed};
@@ -678,7 +687,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     if (costing == Costing::kQueue) {
       if (by_moments) {
         tried = tried.subspan(2);
-      } else if (!parked_ends_.empty()) {
+      } else if (!scratch_.parked_ends.empty()) {
         tried = tried.first(2);
       }
     }
@@ -696,7 +705,7 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
           if (placed < placements.size()) {
             const double distance = by_moments ? plane_model.at(v) : fit.model_at(v);
             double energy = distance + curve_fit.model_at(v);
-            if (star_terms_on_) energy += star_terms_.evaluate(sub(v, star_origin_));
+            if (star_terms_on_) energy += scratch_.terms.evaluate(sub(v, scratch_.origin));
             placements[placed++] = {v, energy, 0, kNotProjected};
           }
           break;
@@ -722,9 +731,9 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   if (by_moments) out.cost += moment_rim_change(mesh, chosen->v);
   // E_scalar wants every point's projection at the chosen placement.
   if (keep_projections && chosen->index != kNotProjected) {
-    projected_.swap(placement_projections_[chosen->index]);
+    scratch_.projected.swap(scratch_.placement_projections[chosen->index]);
   } else if (scalar_.enabled()) {
-    project_points(star_points_, star_homes_, chosen->v, &projected_);
+    project_points(scratch_.points, scratch_.homes, chosen->v, &scratch_.projected);
   }
   // E_scalar counts the star's points; the star's planes stand for star_planes_weight times as
   // many between them, which carry attributes too, so the attributes' change is weighted as
@@ -736,20 +745,20 @@ bool EnergyPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   return std::isfinite(out.cost);
 }
 
-// The change of E_scalar over the star's points, projected as in projected_, with the
+// The change of E_scalar over the star's points, projected as in scratch_.projected, with the
 // wedges of the moving vertex at their best values.
 double EnergyPriority::scalar_change() const {
-  scalar_.begin_star(joined_, joined_count_);
-  for (StarFace& face : star_) face.group = scalar_.group_of(face.wedges[0]);
+  scalar_.begin_star(scratch_.joined, scratch_.joined_count);
+  for (StarFace& face : scratch_.star) face.group = scalar_.group_of(face.wedges[0]);
   double before = 0;
-  for (size_t i = 0; i < star_points_.size(); ++i) {
-    const uint32_t id = star_points_[i].id;
-    const Projected& p = projected_[i];
-    const StarFace& face = star_[p.face];
+  for (size_t i = 0; i < scratch_.points.size(); ++i) {
+    const uint32_t id = scratch_.points[i].id;
+    const Projected& p = scratch_.projected[i];
+    const StarFace& face = scratch_.star[p.face];
     scalar_.add(face.group, id, p.bary[0], face.wedges[1], p.bary[1], face.wedges[2], p.bary[2]);
     before += scalar_.residual(id);
   }
-  return (scalar_.star_energy() - before) * star_point_weight_;
+  return (scalar_.star_energy() - before) * scratch_.point_weight;
 }
 
 // E_scalar after a performed collapse: the wedges joined for good, the star's wedges given the
@@ -770,18 +779,18 @@ void EnergyPriority::update_attributes(const CollapseMesh& mesh, CollapseCandida
     const auto& w = mesh.corner_wedges(f);
     return std::array<WedgeId, 3>{w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
   };
-  for (size_t i = 0; i < star_points_.size(); ++i) {
+  for (size_t i = 0; i < scratch_.points.size(); ++i) {
     const FaceId f = moved_faces_[i];
     const int k = corner_of(mesh.face(f), done.vs);
     const auto& b = moved_bary_[i];
     const auto w = corners(f, k);
-    scalar_.add(scalar_.group_of(w[0]), star_points_[i].id, b[k], w[1], b[(k + 1) % 3], w[2],
+    scalar_.add(scalar_.group_of(w[0]), scratch_.points[i].id, b[k], w[1], b[(k + 1) % 3], w[2],
                 b[(k + 2) % 3]);
   }
   scalar_.apply(done.changed_wedges, done.changed_values);
-  for (size_t i = 0; i < star_points_.size(); ++i) {
+  for (size_t i = 0; i < scratch_.points.size(); ++i) {
     const FaceId f = moved_faces_[i];
-    const uint32_t id = star_points_[i].id;
+    const uint32_t id = scratch_.points[i].id;
     scalar_.set_residual(id, scalar_.residual_against(id, mesh.corner_wedges(f), moved_bary_[i]));
   }
 }
@@ -803,12 +812,12 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
       if (corner_of(mesh.face(faces[j]), corner) >= 0) return int(j);
     return -1;
   };
-  star_points_.clear();
-  star_homes_.clear();
+  scratch_.points.clear();
+  scratch_.homes.clear();
   auto take = [&](FaceId f, int home) {
     auto& list = face_points_[f];
-    star_points_.insert(star_points_.end(), list.begin(), list.end());
-    star_homes_.insert(star_homes_.end(), list.size(), home);
+    scratch_.points.insert(scratch_.points.end(), list.begin(), list.end());
+    scratch_.homes.insert(scratch_.homes.end(), list.size(), home);
     list.clear();
     moments_ready_[f] = 0;
     drift_[f] = 0;
@@ -828,7 +837,7 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   // values.
   if (vs_sample != kNoPoint && (positions_[vs_sample] != done.position || scalar_.enabled()))
     unpark(done.vs);
-  star_homes_.resize(star_points_.size(), -1);  // the unparked samples: no home
+  scratch_.homes.resize(scratch_.points.size(), -1);  // the unparked samples: no home
   double max_distance_sq = curves_.collapsed(done.vs, done.vt, mesh);
   if (faces.empty()) return;
   if (keep_faces) {
@@ -847,12 +856,12 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
     }
   }
   prepare_fan(mesh, done.vs);
-  moved_faces_.resize(star_points_.size());
-  moved_bary_.resize(star_points_.size());
+  moved_faces_.resize(scratch_.points.size());
+  moved_bary_.resize(scratch_.points.size());
   // Last point first: each face then lists its points newest first (see initialize()).
-  for (size_t i = star_points_.size(); i-- > 0;) {
-    FacePoint& point = star_points_[i];
-    const auto [j, best] = closest_fan_face(mesh, faces, point, star_homes_[i]);
+  for (size_t i = scratch_.points.size(); i-- > 0;) {
+    FacePoint& point = scratch_.points[i];
+    const auto [j, best] = closest_fan_face(mesh, faces, point, scratch_.homes[i]);
     const FaceId face = faces[j];
     moved_faces_[i] = face;
     moved_bary_[i] = best.bary;
@@ -871,12 +880,12 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
 // bounds distances by (FanFace).
 void EnergyPriority::prepare_fan(const CollapseMesh& mesh, VertexId vs) {
   const auto& faces = mesh.faces_of(vs);
-  prepared_.clear();
+  scratch_.prepared.clear();
   fan_.clear();
   for (FaceId f : faces) {
     const Triangle& t = mesh.face(f);
     const Vec3 &p0 = mesh.position(t[0]), &p1 = mesh.position(t[1]), &p2 = mesh.position(t[2]);
-    prepared_.emplace_back(p0, p1, p2);
+    scratch_.prepared.emplace_back(p0, p1, p2);
     FanFace fan;
     fan.center = scale(add(add(p0, p1), p2), 1.0 / 3);
     double radius_sq = 0;
@@ -909,7 +918,7 @@ std::pair<int, Projection> EnergyPriority::closest_fan_face(const CollapseMesh& 
   Projection best;
   double best_score = std::numeric_limits<double>::infinity();
   auto consider = [&](int j) {
-    const Projection p = prepared_[j].project(x);
+    const Projection p = scratch_.prepared[j].project(x);
     const double score = scalar_.enabled()
                              ? p.distance_sq + scalar_.residual_against(
                                                    point.id, mesh.corner_wedges(faces[j]), p.bary)
@@ -939,7 +948,7 @@ std::pair<int, Projection> EnergyPriority::closest_fan_face(const CollapseMesh& 
   }
   if (best_j < 0) {  // nothing finite: the first face, as the exhaustive scan would
     best_j = 0;
-    best = prepared_[0].project(x);
+    best = scratch_.prepared[0].project(x);
   }
   return {best_j, best};
 }

@@ -309,9 +309,9 @@ class EnergyPriority : public PriorityModule {
     bool keep_b = false, fixed = false, topology = false, boundary_a = false, boundary_b = false;
   };
   Survivor choose_survivor(const CollapseMesh& mesh, VertexId a, VertexId b) const;
-  // 2. The star (star_, star_lists_, edge_faces_, joined_, a_side_faces_, star_origin_), and
+  // 2. The star (scratch_: star, lists, edge_faces, joined, a_side_faces, origin), and
   //    the sums over its faces before the collapse: the area-weighted planes, the faces'
-  //    normals and normal.corner, twice the area, about star_origin_.
+  //    normals and normal.corner, twice the area, about scratch_.origin.
   struct StarSums {
     Quadric planes;
     Vec3 normals{};
@@ -321,17 +321,17 @@ class EnergyPriority : public PriorityModule {
   };
   StarSums gather_star(const CollapseMesh& mesh, VertexId a, VertexId b) const;
   // 3. The fan's order (StarFace::next, previous), the homes of the removed faces' points
-  //    (edge_face_homes_) and the samples of a and b still parked (parked_ends_). Returns the
-  //    parked samples around the star, each counted half (they sit on its rim).
+  //    (scratch_.edge_face_homes) and the samples of a and b still parked (scratch_.parked_ends).
+  //    Returns the parked samples around the star, each counted half (they sit on its rim).
   double link_fan(const StarSums& sums, VertexId a, VertexId b) const;
-  // 4. The star's points (star_points_, star_homes_, star_point_weight_), all, or thinned
+  // 4. The star's points (scratch_: points, homes, point_weight), all, or thinned
   //    for E_scalar on a large star; whether the star is costed by its faces' moments.
   struct StarPoints {
     bool by_moments = false;
     double points_around = 0;  // the points the star holds, its rim's parked half included
   };
   StarPoints gather_star_points(double parked_around) const;
-  // 5. star_terms_: the star's planes and its volume, weighted for points_around points.
+  // 5. scratch_.terms: the star's planes and its volume, weighted for points_around points.
   void set_star_terms(StarSums& sums, double points_around) const;
 
   std::vector<uint8_t> locked_;
@@ -346,28 +346,38 @@ class EnergyPriority : public PriorityModule {
   double topology_price_ = 0;        // per point of the star, for a change of the curves' topology
   std::vector<uint32_t> point_id_;   // a job's: per point, the master's id (empty: identity)
 
-  // Scratch of one evaluation (evaluate is const but, like CollapseMesh, not thread-safe).
-  mutable std::vector<StarFace> star_;
-  // The faces whose points are the star's (the star's sources and the two removed faces),
-  // with the star face their points are measured against (-2, -3: the removed faces, homed
-  // once the fan is known).
-  mutable std::vector<std::pair<FaceId, int>> star_lists_;
-  mutable std::vector<VertexId> fan_first_ids_, fan_second_ids_;  // star_'s id1, id2
-  mutable std::vector<FacePoint> star_points_;
-  // Per star point: the star face its face becomes (-1, -2: the samples of a and b). In
-  // collapsed(): the index among vs's faces of its old face's image (-1: an unparked sample).
-  mutable std::vector<int> star_homes_;
-  mutable double star_point_weight_ = 1;  // how many points each of star_points_ stands for
-  // The star's planes and volume terms of one evaluation, as one quadric in v - star_origin_
-  // (star_terms_on_: either weight is non-zero).
-  mutable Quadric star_terms_;
-  mutable Vec3 star_origin_{};
-  bool star_terms_on_ = false;
-  mutable int a_side_faces_ = 0;
-  mutable std::array<FaceId, 2> edge_faces_{kNoId, kNoId};  // the two faces the collapse removes
-  mutable std::array<int, 2> edge_face_homes_{};            // the star faces their points go to
-  mutable std::vector<FacePoint> parked_ends_;              // the samples of a and b, while parked
-  mutable std::vector<int> parked_end_homes_;
+  // The working memory of evaluate() and collapsed() for the star at hand: rebuilt by each
+  // call, so a module is used by one thread at a time (the parallel build gives each job its
+  // own module); evaluate() is const and writes only here, in the caches below and in
+  // costings_.
+  struct StarScratch {
+    std::vector<StarFace> star;
+    // The faces whose points are the star's (the star's sources and the two removed faces),
+    // with the star face their points are measured against (-2, -3: the removed faces, homed
+    // once the fan is known).
+    std::vector<std::pair<FaceId, int>> lists;
+    std::vector<VertexId> fan_first_ids, fan_second_ids;  // star's id1, id2
+    std::vector<FacePoint> points;
+    // Per star point: the star face its face becomes (-1, -2: the samples of a and b). In
+    // collapsed(): the index among vs's faces of its old face's image (-1: an unparked sample).
+    std::vector<int> homes;
+    double point_weight = 1;  // how many points each of `points` stands for
+    // The star's planes and volume terms, as one quadric in v - origin (with star_terms_on_).
+    Quadric terms;
+    Vec3 origin{};
+    int a_side_faces = 0;
+    std::array<FaceId, 2> edge_faces{kNoId, kNoId};  // the two faces the collapse removes
+    std::array<int, 2> edge_face_homes{};            // the star faces their points go to
+    std::vector<FacePoint> parked_ends;              // the samples of a and b, while parked
+    std::vector<int> parked_end_homes;
+    std::array<std::pair<WedgeId, WedgeId>, 2> joined{};  // wedges of a, b in fl, fr
+    int joined_count = 0;
+    std::vector<Projected> projected;  // per star point, at the chosen placement
+    std::array<std::vector<Projected>, 16> placement_projections;
+    std::vector<PreparedTriangle> prepared;  // star with v at the projected position
+  };
+  mutable StarScratch scratch_;
+  bool star_terms_on_ = false;  // either of the star's weights is non-zero
   // Per face, the moments of the points projecting onto it (computed when first needed,
   // forgotten when its point list changes).
   mutable std::vector<PointMoments> moments_;
@@ -379,10 +389,6 @@ class EnergyPriority : public PriorityModule {
   // how far the closest surface points of its points may have moved since they were stored.
   mutable std::vector<double> max_distance_sq_;
   std::vector<double> drift_;
-  mutable std::array<std::pair<WedgeId, WedgeId>, 2> joined_{};  // wedges of a, b in fl, fr
-  mutable int joined_count_ = 0;
-  mutable std::vector<Projected> projected_;  // per star point, at the chosen placement
-  mutable std::array<std::vector<Projected>, 16> placement_projections_;
   // collapsed(): per face around vs, its centroid, the radius of the disc around it that holds
   // the face, and its unit normal (0 for a degenerate face).
   struct FanFace {
@@ -397,7 +403,6 @@ class EnergyPriority : public PriorityModule {
   uint32_t import_generation_ = 0;
   std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
   std::vector<std::array<double, 3>> moved_bary_;
-  mutable std::vector<PreparedTriangle> prepared_;  // star_ with v at the projected position
 };
 
 }  // namespace parapm
