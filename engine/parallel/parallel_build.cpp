@@ -119,10 +119,9 @@ Beside run_beside(unsigned threads, const std::function<void()>& work,
 // Whether a partition drawn on the mesh as the last round found it keeps that round's borders:
 // more than half of the last round's bound vertices still alive are bound again. The greedy
 // partitioner is deterministic from its start vertex, the seed's pick among a few vertices of
-// least degree: two seeds can pick the same one and draw the same partition of the same mesh
-// (the stratocaster, gears-19k at p = 4; the bunny and fandisk too before kStartCandidates),
-// and a round on it would leave the last round's borders as they were (fandisk's 50% level went
-// to 1.62 of the sequential RMS at p = 8, from 1.19). Different partitions bind 1-13% again.
+// least degree: two seeds can pick the same one and draw the same partition of the same mesh,
+// and a round on it would leave the last round's borders as they were, unmended. Different
+// partitions bind 1-13% of those vertices again.
 // `bound`: the partition's bound vertices, found here.
 bool repeats_borders(const CollapseMesh& mesh, const std::vector<uint32_t>& vertex_subset,
                      const std::vector<uint8_t>& bound_before, std::vector<uint8_t>& bound) {
@@ -388,8 +387,8 @@ ProgressiveMesh build_progressive_mesh_parallel(
   const bool carry_keys = parallel.carry_keys && master->costly();
   const bool carry_deferred = carry_keys && parallel.carry_deferred;
   // What the band passes and the final pass cost with. Without carried keys the memo would
-  // answer nothing, and its lookups (a walk of every edge ever costed at the vertex) took the
-  // quadric's final pass on fandisk-13k to 1.7x the sequential build's time.
+  // answer nothing, and its lookups (a walk of every edge ever costed at the vertex) would only
+  // cost time.
   PriorityModule& master_queue = carry_keys ? static_cast<PriorityModule&>(keys) : *master;
   // The setup's own time: the first partition is round 0's (which the critical path counts
   // only where it outlasts the initialisation: RoundStats::partition_overlap_seconds).

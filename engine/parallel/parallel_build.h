@@ -207,10 +207,7 @@ struct ParallelEvents {
 // The rounds of ParallelOptions::rounds = 0: two at p = 2, three above. Fewer, larger rounds
 // leave fewer cuts to mend and less fixed work per round (partition, extraction, merge, band
 // pass); with more subsets a round's shares follow the sequential order less closely the more
-// it removes. 18 meshes, energy, RMS against the sequential PM at 50 / 10 / 2%: p = 2 two
-// rounds 1.011 / 0.996 / 0.996, three 1.028 / 1.017 / 1.061; p = 4 1.013 / 1.003 / 0.986
-// against 1.019 / 0.990 / 1.031, with the textured bunny's 50% level worse at two; p = 16 two
-// rounds 1.105 at 50%, three 1.034 (docs/decisions/notebook-2026-11.md, "Two rounds at p = 2").
+// it removes, so p > 2 takes three (decisions/notebook-2026-11.md, "Two rounds at p = 2").
 uint32_t default_rounds(uint32_t p);
 // The rounds a build with these options schedules: `rounds`, or default_rounds(subsets).
 uint32_t scheduled_rounds(const ParallelOptions& parallel);

@@ -20,11 +20,8 @@
 //
 // Normals are solved like the rest (the unit direction of the least-squares fit) but their
 // error is not part of the energy, so it does not order the collapses: normals follow the
-// geometry, and costing them made both worse. On horse-97k (normals only) E_scalar's normal
-// term at the default weight ruled the order: 13x / 9x / 10x the geometric RMS at 50 / 10 /
-// 2% of the faces, 18% slivers against 0.3%, and normals 5.2 / 10.2 / 20.1 degrees off against
-// 2.0 / 4.1 / 10.0 with them fitted but not costed (docs/decisions/notebook-2026-11.md, "Normals
-// follow the geometry").
+// geometry. Costing them let the normal term rule the order, and made both the geometry and
+// the normals worse (decisions/notebook-2026-11.md, "Normals follow the geometry").
 #pragma once
 
 #include <array>
