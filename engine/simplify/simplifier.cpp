@@ -212,9 +212,7 @@ CollapseRecord Simplifier::perform(CollapseCandidate c, const EdgeFaces& edge) {
   return r;
 }
 
-std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
-                                            const ProgressCallback& progress,
-                                            const CancelToken* cancel) {
+void Simplifier::begin_run(const SimplifierLimits& limits) {
   stats_ = {};
   priority_.initialize(mesh_);
   for (const auto& module : constraints_) module->initialize(mesh_);
@@ -227,7 +225,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   face_keys_.assign(defer_ ? 3 * size_t(mesh_.face_capacity()) : 0,
                     std::numeric_limits<float>::quiet_NaN());
   screen_ = priority_.costly();
+}
 
+void Simplifier::build_first_queue(const SimplifierLimits& limits, const CancelToken* cancel) {
   // Every undirected edge once. The heap's order does not depend on the order of insertion.
   heap_.clear();
   compacted_size_ = 0;
@@ -274,6 +274,13 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     }
   }
   heap_.rebuild();
+}
+
+std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
+                                            const ProgressCallback& progress,
+                                            const CancelToken* cancel) {
+  begin_run(limits);
+  build_first_queue(limits, cancel);
 
   const size_t start_faces = mesh_.live_faces();
   const uint64_t total = start_faces > limits.target_faces ? start_faces - limits.target_faces : 0;

@@ -162,6 +162,10 @@ class Simplifier {
   };
 
   void push_edge(VertexId a, VertexId b);
+  // run()'s first steps: the per-run state reset (and the modules initialised), then the
+  // first queue (every live edge once, or those around limits.first_queue_around).
+  void begin_run(const SimplifierLimits& limits);
+  void build_first_queue(const SimplifierLimits& limits, const CancelToken* cancel);
   // The first queue from the edges around `vertices` only (SimplifierLimits::first_queue_around).
   void queue_edges_around(const std::vector<VertexId>& vertices, const CancelToken* cancel);
   // Queues edge {a, b} below its remembered key, uncosted; false when it has none.
