@@ -95,6 +95,12 @@ CallAdmission::Ticket::~Ticket() {
 void CallAdmission::Ticket::touch() {
   std::lock_guard lock(owner_.mutex_);
   entry_->last_moved = Clock::now();
+  entry_->working = false;
+}
+
+void CallAdmission::Ticket::working() {
+  std::lock_guard lock(owner_.mutex_);
+  entry_->working = true;
 }
 
 bool CallAdmission::Ticket::past_total() const {
@@ -121,9 +127,9 @@ void CallAdmission::watch_loop() {
     const auto now = Clock::now();
     for (Entry& entry : open_) {
       if (entry.expired) continue;
-      const char* why = now - entry.last_moved > limits_.idle ? "idle"
-                        : now - entry.opened > limits_.total  ? "open too long"
-                                                              : nullptr;
+      const char* why = !entry.working && now - entry.last_moved > limits_.idle ? "idle"
+                        : now - entry.opened > limits_.total                    ? "open too long"
+                                                                                : nullptr;
       if (!why) continue;
       release(entry);
       entry.expired = why;

@@ -47,7 +47,10 @@ class CallAdmission {
     ~Ticket();
     Ticket(const Ticket&) = delete;
     Ticket& operator=(const Ticket&) = delete;
-    void touch();             // a message moved: the idle clock starts again
+    void touch();  // a message moved: the idle clock starts again
+    // The server works on the call (parsing an upload, loading a PM, cutting a level), not
+    // waiting for the client: the idle limit does not apply until the next touch().
+    void working();
     bool past_total() const;  // open for longer than the total limit
     // The status to end with once the watchdog cancelled the call (idle or past the total),
     // else nullopt.
@@ -73,6 +76,7 @@ class CallAdmission {
     std::string call, client;
     std::chrono::steady_clock::time_point opened, last_moved;
     const char* expired = nullptr;  // "idle" or "open too long" once cancelled
+    bool working = false;           // Ticket::working() since the last touch()
   };
   // Gives back the place of an admitted stream (once: at expiry or at the ticket's end).
   void release(Entry& entry);

@@ -31,6 +31,7 @@ bool send_chunks(grpc::ServerWriter<parapm::v1::Chunk>* writer, std::string_view
                  rpc::CallAdmission::Ticket& ticket) {
   parapm::v1::Chunk chunk;
   chunk.set_total(bytes.size());
+  ticket.touch();  // the work is done: from here the idle clock waits on the client
   for (size_t at = 0; at < bytes.size() || at == 0; at += kChunkBytes) {
     chunk.set_offset(at);
     chunk.set_data(std::string(bytes.substr(at, kChunkBytes)));
@@ -66,6 +67,7 @@ grpc::Status MeshService::Upload(grpc::ServerContext* context,
     } while (reader->Read(&chunk));
     if (auto expired = ticket->expired()) return *expired;
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "upload cut off");
+    ticket->working();  // parsing a large mesh may take longer than the idle limit
     const UploadResult result = coordinator_.finish_upload(std::move(upload));
     reply->set_mesh_id(result.mesh.mesh_id);
     reply->set_content_sha256(result.mesh.sha256);
@@ -205,6 +207,7 @@ grpc::Status MeshService::Download(grpc::ServerContext* context, const parapm::v
     grpc::Status refused;
     const auto ticket = streams_.admit(context, "Download", &refused);
     if (!ticket) return refused;
+    ticket->working();  // loading (reading, hashing, decoding) a large PM
     const auto loaded = coordinator_.pm(request->job_id());  // its hash checked
     if (!send_chunks(writer, loaded->bytes, *ticket)) return stopped(*ticket);
     return grpc::Status::OK;
@@ -219,6 +222,7 @@ grpc::Status MeshService::GetLevel(grpc::ServerContext* context,
     grpc::Status refused;
     const auto ticket = streams_.admit(context, "GetLevel", &refused);
     if (!ticket) return refused;
+    ticket->working();  // loading the PM and cutting the level
     const std::string format = request->format().empty() ? "obj" : request->format();
     if (format != "obj" && format != "ply") throw_invalid("format must be \"obj\" or \"ply\"");
     if (request->cut_case() == parapm::v1::LevelRequest::CUT_NOT_SET)
@@ -257,6 +261,7 @@ grpc::Status MeshService::StreamPM(grpc::ServerContext* context,
     grpc::Status refused;
     const auto ticket = streams_.admit(context, "StreamPM", &refused);
     if (!ticket) return refused;
+    ticket->working();  // loading the PM
     const auto loaded = coordinator_.pm(request->job_id());
     const uint64_t n = loaded->pm.splits.size();
     uint64_t end = n;
@@ -273,6 +278,7 @@ grpc::Status MeshService::StreamPM(grpc::ServerContext* context,
         request->batch_vsplits() ? std::min(request->batch_vsplits(), 1u << 20) : 4096u;
     parapm::v1::PmStreamMessage message;
     message.set_total_vsplits(n);
+    ticket->touch();  // the PM is loaded: from here the idle clock waits on the client
     if (request->from_vsplit() == 0) {
       message.set_header_and_base(loaded->bytes.substr(0, loaded->splits_begin));
       message.set_first_vsplit(0);

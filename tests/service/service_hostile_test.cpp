@@ -100,6 +100,28 @@ TEST_F(ServiceHostile, SilentStreamsAreBoundedAndClosedWhileWorkersKeepBeating) 
   EXPECT_NE(service().coordinator().log().find("moved nothing for 2 s"), std::string::npos);
 }
 
+// The idle limit waits on the client, not on the server: an upload whose parsing takes longer
+// than the idle limit (a 1.3M-face grid, 0.1 s) is not cut off, and neither is its download.
+TEST_F(ServiceHostile, TheIdleLimitDoesNotCountTheServersOwnWork) {
+  start(1, {"--stream-idle-s", "0.1"});
+  std::string obj;
+  constexpr int kSide = 800;
+  for (int y = 0; y <= kSide; ++y)
+    for (int x = 0; x <= kSide; ++x)
+      obj += "v " + std::to_string(x) + " " + std::to_string(y) + " " +
+             std::to_string((x * y) % 7) + "\n";
+  auto id = [](int x, int y) { return std::to_string(y * (kSide + 1) + x + 1); };
+  for (int y = 0; y < kSide; ++y)
+    for (int x = 0; x < kSide; ++x)
+      obj += "f " + id(x, y) + " " + id(x + 1, y) + " " + id(x + 1, y + 1) + "\nf " + id(x, y) +
+             " " + id(x + 1, y + 1) + " " + id(x, y + 1) + "\n";
+  parapm::v1::UploadReply reply;
+  const grpc::Status status = service().try_upload("grid.obj", obj, &reply);
+  ASSERT_TRUE(status.ok()) << status_text(status);
+  EXPECT_EQ(reply.faces(), 2u * kSide * kSide);
+  EXPECT_EQ(service().coordinator().log().find("moved nothing"), std::string::npos);
+}
+
 // Unary calls are bounded too (each holds a thread while it runs): eight threads asking at once
 // with a bound of one call per client get answers or RESOURCE_EXHAUSTED, nothing else, and the
 // worker keeps beating.
