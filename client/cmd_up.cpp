@@ -229,6 +229,7 @@ int run_up(const UpArgs& args) {
                address.c_str(), args.data.c_str(), args.workers, threads);
 
   const int exit_code = supervise(children[0], workers, signals);
+  if (exit_code != 0) children.clear();  // the coordinator exited, and was reaped
   for (const WorkerProcess& worker : workers)
     if (worker.pid > 0) children.push_back(worker.pid);
   stop_all(children, std::chrono::seconds(10));

@@ -45,11 +45,6 @@ CallAdmission::~CallAdmission() {
   watchdog_.join();
 }
 
-size_t CallAdmission::open_streams() const {
-  std::lock_guard lock(mutex_);
-  return admitted_;
-}
-
 void CallAdmission::release(Entry& entry) {
   if (entry.expired) return;  // released when it expired
   --admitted_;

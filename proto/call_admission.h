@@ -67,9 +67,6 @@ class CallAdmission {
   std::unique_ptr<Ticket> admit(grpc::ServerContext* context, const char* call,
                                 grpc::Status* refused);
 
-  const CallLimits& limits() const { return limits_; }
-  size_t open_streams() const;
-
  private:
   struct Entry {
     grpc::ServerContext* context;
@@ -78,7 +75,7 @@ class CallAdmission {
     const char* expired = nullptr;  // "idle" or "open too long" once cancelled
     bool working = false;           // Ticket::working() since the last touch()
   };
-  // Gives back the place of an admitted stream (once: at expiry or at the ticket's end).
+  // Gives back the place of an admitted call (once: at expiry or at the ticket's end).
   void release(Entry& entry);
   void watch_loop();
 
@@ -86,7 +83,7 @@ class CallAdmission {
   mutable std::mutex mutex_;
   std::condition_variable stop_changed_;
   bool stopping_ = false;
-  std::list<Entry> open_;  // admitted streams whose handlers are still running
+  std::list<Entry> open_;  // admitted calls whose handlers are still running
   size_t admitted_ = 0;    // those of open_ not expired: an expired one is on its way out
   std::map<std::string, unsigned> per_client_;  // admitted, per client
   std::thread watchdog_;
