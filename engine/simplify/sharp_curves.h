@@ -24,7 +24,7 @@ struct SharpEdgeOptions {
   bool seams = true;  // edges across which a corner's wedge changes
   // A crease of fewer edges than min_crease_edges and shorter than long_crease_diagonals of
   // the bounding-box diagonal is a scan's noise, not kept (1: every crease is); the length
-  // clause keeps a coarse mesh's few but long creases (DECISIONS.md, "Creases of fewer than 8
+  // clause keeps a coarse mesh's few but long creases (docs/DECISIONS.md, "Creases of fewer than 8
   // edges and shorter than 5% of the diagonal are noise").
   uint32_t min_crease_edges = 8;
   double long_crease_diagonals = 0.05;
