@@ -62,6 +62,16 @@ void EnergyPriority::initialize_curves(const CollapseMesh& mesh) {
   }
 }
 
+void EnergyPriority::reset_point_lists(const CollapseMesh& mesh) {
+  face_points_.assign(mesh.face_capacity(), {});
+  moments_.assign(mesh.face_capacity(), PointMoments{});
+  moments_ready_.assign(mesh.face_capacity(), 0);
+  own_.assign(mesh.face_capacity(), OwnError{});
+  max_distance_sq_.assign(mesh.face_capacity(), 0);
+  drift_.assign(mesh.face_capacity(), 0);
+  parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
+}
+
 void EnergyPriority::initialize_points(const CollapseMesh& mesh) {
   const std::vector<SurfaceSample> samples =
       sample_surface(mesh, options_.samples_per_face, options_.seed);
@@ -75,13 +85,7 @@ void EnergyPriority::initialize_points(const CollapseMesh& mesh) {
   point_id_.clear();
   positions_.clear();
   positions_.reserve(samples.size());
-  face_points_.assign(mesh.face_capacity(), {});
-  moments_.assign(mesh.face_capacity(), PointMoments{});
-  moments_ready_.assign(mesh.face_capacity(), 0);
-  own_.assign(mesh.face_capacity(), OwnError{});
-  max_distance_sq_.assign(mesh.face_capacity(), 0);
-  drift_.assign(mesh.face_capacity(), 0);
-  parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
+  reset_point_lists(mesh);
   for (const SurfaceSample& s : samples) {
     const auto id = uint32_t(positions_.size());
     positions_.push_back(s.position);
@@ -395,14 +399,7 @@ EnergyPriority::Survivor EnergyPriority::choose_survivor(const CollapseMesh& mes
     keep_b = b < a;
   }
   const bool fixed = locked_a || locked_b || curve_a != curve_b || corner_a != corner_b || topology;
-  Survivor survivor;
-  survivor.possible = true;
-  survivor.keep_b = keep_b;
-  survivor.fixed = fixed;
-  survivor.topology = topology;
-  survivor.boundary_a = boundary_a;
-  survivor.boundary_b = boundary_b;
-  return survivor;
+  return {true, keep_b, fixed, topology, boundary_a, boundary_b};
 }
 
 EnergyPriority::StarSums EnergyPriority::gather_star(const CollapseMesh& mesh, VertexId a,
@@ -469,14 +466,7 @@ EnergyPriority::StarSums EnergyPriority::gather_star(const CollapseMesh& mesh, V
       }
     }
   }
-  StarSums sums;
-  sums.planes = star_planes;
-  sums.normals = normals;
-  sums.offsets = offsets;
-  sums.area2 = area2;
-  sums.edge_apexes = edge_apexes;
-  sums.edge_faces = edge_faces;
-  return sums;
+  return {star_planes, normals, offsets, area2, edge_apexes, edge_faces};
 }
 
 double EnergyPriority::link_fan(const StarSums& sums, VertexId a, VertexId b) const {

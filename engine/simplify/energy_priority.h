@@ -294,6 +294,9 @@ class EnergyPriority : public PriorityModule {
   double diagonal_of(const CollapseMesh& mesh) const;
   void initialize_curves(const CollapseMesh& mesh);  // curves_ only
   void initialize_points(const CollapseMesh& mesh);  // everything else
+  // Empty point lists, moments and drifts for every face, no parked sample: the start of
+  // initialize_points and import_local.
+  void reset_point_lists(const CollapseMesh& mesh);
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
                     EnergyState& out) const;

@@ -93,13 +93,7 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   const size_t n = state.points.size();
   positions_.resize(n);
   point_id_.resize(n);
-  face_points_.assign(mesh.face_capacity(), {});
-  moments_.assign(mesh.face_capacity(), PointMoments{});
-  moments_ready_.assign(mesh.face_capacity(), 0);
-  own_.assign(mesh.face_capacity(), OwnError{});
-  max_distance_sq_.assign(mesh.face_capacity(), 0);
-  drift_.assign(mesh.face_capacity(), 0);
-  parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
+  reset_point_lists(mesh);
   // The faces keep the written order.
   for (size_t i = 0; i < n; ++i) {
     const EnergyState::Point& p = state.points[i];

@@ -20,21 +20,7 @@ namespace {
 
 using parapm::v1::JobEvent;
 
-class ServiceFaults : public ServiceTest {
- protected:
-  // A small good job end to end: upload, build, lossless. The proof the service still serves.
-  void expect_serves(uint64_t seed) {
-    const fs::path file = mesh("cad-featuretype-3k.stl");
-    const auto upload = service().upload_file(file);
-    const auto job = service().wait_for_job(
-        service()
-            .submit(upload.mesh_id(), options(2, parapm::v1::METRIC_QUADRIC, 0.2, seed))
-            .job_id(),
-        seconds(15));
-    ASSERT_EQ(job.state(), parapm::v1::DONE) << job.failure_reason();
-    EXPECT_EQ(lossless_failure(service().download(job.job_id()), file, dir()), "");
-  }
-};
+class ServiceFaults : public ServiceTest {};
 
 // SIGKILL of the worker named in the first "subset started": its call fails, the subset goes
 // to another worker (attempt 2), and the PM is still the in-process one.

@@ -20,19 +20,6 @@ using Clock = std::chrono::steady_clock;
 
 class ServiceHostile : public ServiceTest {
  protected:
-  // A small good job end to end on the worker: upload, build, lossless.
-  void expect_serves(uint64_t seed) {
-    const fs::path file = mesh("cad-featuretype-3k.stl");
-    const auto upload = service().upload_file(file);
-    const auto job = service().wait_for_job(
-        service()
-            .submit(upload.mesh_id(), options(2, parapm::v1::METRIC_QUADRIC, 0.2, seed))
-            .job_id(),
-        seconds(30));
-    ASSERT_EQ(job.state(), parapm::v1::DONE) << job.failure_reason();
-    EXPECT_EQ(lossless_failure(service().download(job.job_id()), file, dir()), "");
-  }
-
   // Peak resident memory of the coordinator so far, bytes (VmHWM).
   uint64_t coordinator_peak_bytes() {
     std::ifstream status("/proc/" + std::to_string(service().coordinator().pid()) + "/status");
