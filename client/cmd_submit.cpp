@@ -184,7 +184,7 @@ void add_submit_command(CLI::App& app, int& exit_code) {
                   "than --crease-min-edges edges) are noise (default 0.05)")
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--star-planes-weight", args->star_planes_weight,
-                  "energy: weight of the star's planes against the points (default 10; 0: off)")
+                  "energy: weight of the star's planes against the points (default 30; 0: off)")
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--volume-weight", args->volume_weight,
                   "energy: weight of the enclosed volume's change (default 4; 0: off)")

@@ -91,37 +91,55 @@ RemoteRunner::RemoteRunner(WorkerRegistry& registry, WorkerChannels& channels,
       options_(std::move(options)),
       on_event_(std::move(on_event)) {}
 
-std::vector<SubsetResult> RemoteRunner::run(std::vector<SubsetJob>& jobs,
-                                            const CancelToken* cancel) {
-  const size_t n = jobs.size();
-  std::vector<SubsetResult> results(n);
-  std::vector<parapm::v1::SubsetRequest> requests(n);
-  const auto encode_start = std::chrono::steady_clock::now();
-  for (size_t i = 0; i < n; ++i) {
-    requests[i].set_job_id(options_.job_id);
-    requests[i].set_round(jobs[i].round);
-    requests[i].set_subset(jobs[i].subset);
-    requests[i].set_job(encode_subset_job(jobs[i]));
-    transport_.job_bytes += requests[i].job().size();
-  }
-  transport_.encode_seconds += seconds_since(encode_start);
-  std::deque<size_t> pending;
-  for (size_t i = 0; i < n; ++i) pending.push_back(i);
-  std::vector<uint32_t> attempts(n, 0);
-  std::vector<std::string> last_worker(n);
-  std::vector<std::unique_ptr<Flight>> flights;
-  std::mutex mutex;
-  std::condition_variable changed;
-  size_t done = 0;
-  unsigned local_running = 0;
-  bool warned_waiting = false;
+// One run(): a round's subsets from their requests to their results. Its flights' threads
+// write only their own Flight; everything else is the dispatching thread's.
+class RemoteRunner::Dispatch {
+ public:
+  Dispatch(RemoteRunner& runner, std::vector<SubsetJob>& jobs, const CancelToken* cancel)
+      : runner_(runner),
+        jobs_(jobs),
+        cancel_(cancel),
+        results_(jobs.size()),
+        attempts_(jobs.size(), 0),
+        last_worker_(jobs.size()) {}
 
-  auto event = [&](SubsetEvent::Kind kind, const Flight& f) {
-    if (!on_event_) return;
+  std::vector<SubsetResult> run() {
+    encode_requests();
+    for (size_t i = 0; i < jobs_.size(); ++i) pending_.push_back(i);
+    try {
+      while (done_ < jobs_.size()) {
+        if (cancel_) cancel_->check();
+        harvest();
+        dispatch_pending();
+        wait_for_a_flight();
+      }
+    } catch (...) {
+      stop_all();
+      throw;
+    }
+    return std::move(results_);
+  }
+
+ private:
+  void encode_requests() {
+    const auto encode_start = std::chrono::steady_clock::now();
+    requests_.resize(jobs_.size());
+    for (size_t i = 0; i < jobs_.size(); ++i) {
+      requests_[i].set_job_id(runner_.options_.job_id);
+      requests_[i].set_round(jobs_[i].round);
+      requests_[i].set_subset(jobs_[i].subset);
+      requests_[i].set_job(encode_subset_job(jobs_[i]));
+      runner_.transport_.job_bytes += requests_[i].job().size();
+    }
+    runner_.transport_.encode_seconds += seconds_since(encode_start);
+  }
+
+  void event(SubsetEvent::Kind kind, const Flight& f) const {
+    if (!runner_.on_event_) return;
     SubsetEvent e;
     e.kind = kind;
-    e.round = jobs[f.index].round;
-    e.subset = jobs[f.index].subset;
+    e.round = jobs_[f.index].round;
+    e.subset = jobs_[f.index].subset;
     e.worker = f.slot.worker_id.empty() ? "coordinator" : f.slot.name;
     e.attempt = f.attempt;
     if (kind == SubsetEvent::Kind::kDone) {
@@ -133,49 +151,53 @@ std::vector<SubsetResult> RemoteRunner::run(std::vector<SubsetJob>& jobs,
     } else if (kind == SubsetEvent::Kind::kRetry) {
       e.reason = f.status.error_message();
     }
-    on_event_(e);
-  };
+    runner_.on_event_(e);
+  }
+
   // Gives back what a flight held once its thread is done.
-  auto release = [&](Flight& f) {
+  void release(Flight& f) {
     if (f.slot.worker_id.empty())
-      --local_running;
+      --local_running_;
     else
-      registry_.release(f.slot.worker_id);
-  };
-  auto stop_all = [&] {
-    for (auto& f : flights) f->context.TryCancel();
-    for (auto& f : flights) {
+      runner_.registry_.release(f.slot.worker_id);
+  }
+
+  void stop_all() {
+    for (auto& f : flights_) f->context.TryCancel();
+    for (auto& f : flights_) {
       f->thread.join();
       release(*f);
     }
-    flights.clear();
-  };
-  auto launch = [&](size_t i, std::optional<WorkerSlot> slot) {
+    flights_.clear();
+  }
+
+  // Subset i on `slot`'s worker, or in-process without one, on a thread of its own.
+  void launch(size_t i, std::optional<WorkerSlot> slot) {
     auto flight = std::make_unique<Flight>();
     Flight& f = *flight;
     f.index = i;
-    f.attempt = ++attempts[i];
+    f.attempt = ++attempts_[i];
     f.start = std::chrono::steady_clock::now();
-    auto finish = [&f, &changed, &mutex] {
+    auto finish = [&f, this] {
       {
-        std::lock_guard lock(mutex);
+        std::lock_guard lock(mutex_);
         f.finished = true;
       }
-      changed.notify_all();
+      changed_.notify_all();
     };
     if (slot) {
       f.slot = *slot;
-      rpc::attach_token(f.context, options_.token);
-      auto stub = parapm::v1::WorkerService::NewStub(channels_.get(slot->address));
-      f.thread = std::thread([&f, &requests, i, stub = std::move(stub), finish] {
-        call_worker(f, *stub, requests[i]);
+      rpc::attach_token(f.context, runner_.options_.token);
+      auto stub = parapm::v1::WorkerService::NewStub(runner_.channels_.get(slot->address));
+      f.thread = std::thread([&f, request = &requests_[i], stub = std::move(stub), finish] {
+        call_worker(f, *stub, *request);
         finish();
       });
     } else {
-      ++local_running;
-      f.thread = std::thread([&f, &jobs, i, cancel, finish] {
+      ++local_running_;
+      f.thread = std::thread([&f, job = &jobs_[i], cancel = cancel_, finish] {
         try {
-          f.result = simplify_subset(jobs[i], {}, cancel);
+          f.result = simplify_subset(*job, {}, cancel);
         } catch (...) {
           f.status = rpc::status_of_current_exception();
         }
@@ -183,102 +205,129 @@ std::vector<SubsetResult> RemoteRunner::run(std::vector<SubsetJob>& jobs,
       });
     }
     event(SubsetEvent::Kind::kStarted, f);
-    flights.push_back(std::move(flight));
-  };
-
-  try {
-    while (done < n) {
-      if (cancel) cancel->check();
-      // Harvest finished flights.
-      for (auto it = flights.begin(); it != flights.end();) {
-        if (!(*it)->finished) {
-          // A worker that stopped beating will not answer: give its subset to another.
-          Flight& f = **it;
-          if (!f.slot.worker_id.empty() && !registry_.alive(f.slot.worker_id))
-            f.context.TryCancel();
-          ++it;
-          continue;
-        }
-        // Out of the list before anything can throw: stop_all must not see it again.
-        const std::unique_ptr<Flight> done_flight = std::move(*it);
-        it = flights.erase(it);
-        Flight& f = *done_flight;
-        f.thread.join();
-        release(f);
-        if (f.status.ok() && !f.slot.worker_id.empty() &&
-            f.result.state.metric != jobs[f.index].state.metric)
-          f.status = {grpc::StatusCode::DATA_LOSS,
-                      "the worker returned a state of metric '" + f.result.state.metric + "'"};
-        if (f.status.ok()) {
-          if (!f.slot.worker_id.empty()) {
-            transport_.call_overhead_seconds +=
-                std::max(0.0, f.call_seconds - f.result.wall_seconds);
-            transport_.result_bytes += f.result_bytes;
-            ++transport_.calls;
-          }
-          event(SubsetEvent::Kind::kDone, f);
-          results[f.index] = std::move(f.result);
-          ++done;
-        } else if (f.slot.worker_id.empty() ||
-                   f.status.error_code() == grpc::StatusCode::INVALID_ARGUMENT) {
-          // In-process failures and jobs a worker calls malformed are not the worker's
-          // fault: another attempt would fail the same way.
-          throw Error(
-              rpc::error_code_of(f.status.error_code()),
-              "subset " + std::to_string(jobs[f.index].subset) + ": " + f.status.error_message());
-        } else {
-          spdlog::warn("job {}: subset {} of round {} failed on worker {} (attempt {}): {}",
-                       options_.job_id, jobs[f.index].subset, jobs[f.index].round, f.slot.name,
-                       f.attempt, f.status.error_message());
-          if (f.status.error_code() == grpc::StatusCode::UNAVAILABLE)
-            registry_.suspect(f.slot.worker_id);
-          if (attempts[f.index] >= options_.max_attempts)
-            throw Error(ErrorCode::kIo, "subset " + std::to_string(jobs[f.index].subset) +
-                                            " failed " + std::to_string(attempts[f.index]) +
-                                            " times; last: " + f.status.error_message());
-          event(SubsetEvent::Kind::kRetry, f);
-          last_worker[f.index] = f.slot.worker_id;
-          pending.push_front(f.index);
-        }
-      }
-      // Dispatch what waits.
-      while (!pending.empty()) {
-        const size_t i = pending.front();
-        std::optional<WorkerSlot> slot = registry_.acquire({last_worker[i]});
-        if (!slot) slot = registry_.acquire();
-        if (slot) {
-          pending.pop_front();
-          launch(i, slot);
-          continue;
-        }
-        if (registry_.live_count() == 0 && options_.local_threads > 0) {
-          if (local_running >= options_.local_threads) break;
-          if (!warned_waiting)
-            spdlog::warn("job {}: no worker registered; running subsets in the coordinator",
-                         options_.job_id);
-          warned_waiting = true;
-          pending.pop_front();
-          launch(i, std::nullopt);
-          continue;
-        }
-        if (registry_.live_count() == 0 && !warned_waiting) {
-          spdlog::warn("job {}: waiting for a worker to register", options_.job_id);
-          warned_waiting = true;
-        }
-        break;
-      }
-      std::unique_lock lock(mutex);
-      changed.wait_for(lock, std::chrono::milliseconds(100), [&] {
-        for (auto& f : flights)
-          if (f->finished) return true;
-        return false;
-      });
-    }
-  } catch (...) {
-    stop_all();
-    throw;
+    flights_.push_back(std::move(flight));
   }
-  return results;
+
+  // Takes the finished flights' outcomes; cancels the calls of workers that stopped beating
+  // (they will not answer: their subsets go to another).
+  void harvest() {
+    for (auto it = flights_.begin(); it != flights_.end();) {
+      if (!(*it)->finished) {
+        Flight& f = **it;
+        if (!f.slot.worker_id.empty() && !runner_.registry_.alive(f.slot.worker_id))
+          f.context.TryCancel();
+        ++it;
+        continue;
+      }
+      // Out of the list before anything can throw: stop_all must not see it again.
+      const std::unique_ptr<Flight> done_flight = std::move(*it);
+      it = flights_.erase(it);
+      Flight& f = *done_flight;
+      f.thread.join();
+      release(f);
+      take_outcome(f);
+    }
+  }
+
+  // A finished flight: its result, or a retry elsewhere, or the job's failure (Error).
+  void take_outcome(Flight& f) {
+    const SubsetJob& job = jobs_[f.index];
+    if (f.status.ok() && !f.slot.worker_id.empty() && f.result.state.metric != job.state.metric)
+      f.status = {grpc::StatusCode::DATA_LOSS,
+                  "the worker returned a state of metric '" + f.result.state.metric + "'"};
+    if (f.status.ok()) {
+      if (!f.slot.worker_id.empty()) {
+        TransportStats& transport = runner_.transport_;
+        transport.call_overhead_seconds += std::max(0.0, f.call_seconds - f.result.wall_seconds);
+        transport.result_bytes += f.result_bytes;
+        ++transport.calls;
+      }
+      event(SubsetEvent::Kind::kDone, f);
+      results_[f.index] = std::move(f.result);
+      ++done_;
+      return;
+    }
+    // In-process failures and jobs a worker calls malformed are not the worker's fault:
+    // another attempt would fail the same way.
+    if (f.slot.worker_id.empty() || f.status.error_code() == grpc::StatusCode::INVALID_ARGUMENT)
+      throw Error(rpc::error_code_of(f.status.error_code()),
+                  "subset " + std::to_string(job.subset) + ": " + f.status.error_message());
+    spdlog::warn("job {}: subset {} of round {} failed on worker {} (attempt {}): {}",
+                 runner_.options_.job_id, job.subset, job.round, f.slot.name, f.attempt,
+                 f.status.error_message());
+    if (f.status.error_code() == grpc::StatusCode::UNAVAILABLE)
+      runner_.registry_.suspect(f.slot.worker_id);
+    if (attempts_[f.index] >= runner_.options_.max_attempts)
+      throw Error(ErrorCode::kIo, "subset " + std::to_string(job.subset) + " failed " +
+                                      std::to_string(attempts_[f.index]) +
+                                      " times; last: " + f.status.error_message());
+    event(SubsetEvent::Kind::kRetry, f);
+    last_worker_[f.index] = f.slot.worker_id;
+    pending_.push_front(f.index);
+  }
+
+  // Launches what waits on the free workers (another than the one it failed on, where
+  // possible), or in-process when no worker is registered and the options allow it.
+  void dispatch_pending() {
+    const RemoteOptions& options = runner_.options_;
+    WorkerRegistry& registry = runner_.registry_;
+    while (!pending_.empty()) {
+      const size_t i = pending_.front();
+      std::optional<WorkerSlot> slot = registry.acquire({last_worker_[i]});
+      if (!slot) slot = registry.acquire();
+      if (slot) {
+        pending_.pop_front();
+        launch(i, slot);
+        continue;
+      }
+      if (registry.live_count() == 0 && options.local_threads > 0) {
+        if (local_running_ >= options.local_threads) break;
+        if (!warned_waiting_)
+          spdlog::warn("job {}: no worker registered; running subsets in the coordinator",
+                       options.job_id);
+        warned_waiting_ = true;
+        pending_.pop_front();
+        launch(i, std::nullopt);
+        continue;
+      }
+      if (registry.live_count() == 0 && !warned_waiting_) {
+        spdlog::warn("job {}: waiting for a worker to register", options.job_id);
+        warned_waiting_ = true;
+      }
+      break;
+    }
+  }
+
+  // Until a flight finishes, or 100 ms (heartbeats, cancellation and new workers are
+  // checked between waits).
+  void wait_for_a_flight() {
+    std::unique_lock lock(mutex_);
+    changed_.wait_for(lock, std::chrono::milliseconds(100), [&] {
+      for (auto& f : flights_)
+        if (f->finished) return true;
+      return false;
+    });
+  }
+
+  RemoteRunner& runner_;
+  std::vector<SubsetJob>& jobs_;
+  const CancelToken* cancel_;
+  std::vector<parapm::v1::SubsetRequest> requests_;
+  std::vector<SubsetResult> results_;
+  std::deque<size_t> pending_;            // subsets waiting for a worker, retries first
+  std::vector<uint32_t> attempts_;        // per subset
+  std::vector<std::string> last_worker_;  // per subset: the worker it last failed on
+  std::vector<std::unique_ptr<Flight>> flights_;
+  std::mutex mutex_;  // guards the flights' `finished` with changed_
+  std::condition_variable changed_;
+  size_t done_ = 0;
+  unsigned local_running_ = 0;
+  bool warned_waiting_ = false;
+};
+
+std::vector<SubsetResult> RemoteRunner::run(std::vector<SubsetJob>& jobs,
+                                            const CancelToken* cancel) {
+  return Dispatch(*this, jobs, cancel).run();
 }
 
 }  // namespace parapm::service

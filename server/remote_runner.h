@@ -71,6 +71,7 @@ class RemoteRunner : public SubsetRunner {
   const TransportStats& transport() const { return transport_; }
 
  private:
+  class Dispatch;  // one run's state (remote_runner.cpp)
   TransportStats transport_;
   WorkerRegistry& registry_;
   WorkerChannels& channels_;

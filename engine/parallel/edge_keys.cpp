@@ -42,7 +42,7 @@ void KeyMemo::store(Entry* found, VertexId a, VertexId b, double cost, bool carr
 }
 
 bool KeyMemo::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                       Costing costing) const {
+                       Costing costing) {
   if (costing != Costing::kQueue) return inner_.evaluate(mesh, a, b, out, costing);
   const VertexId lo = std::min(a, b), hi = std::max(a, b);
   Entry* const e = find(lo, hi);

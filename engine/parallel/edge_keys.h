@@ -52,7 +52,7 @@ class KeyMemo : public PriorityWrapper {
  public:
   KeyMemo(PriorityModule& inner, size_t vertex_capacity);
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) const override;
+                Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
 
   // Forgets every key, then carries `keys` in. Throws Error(kInvalidInput) for a key that is

@@ -47,7 +47,7 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
     memo.emplace(*module, local.vertex_capacity());
     memo->reset(keys);
   }
-  const PriorityModule& costing = memo ? static_cast<const PriorityModule&>(*memo) : *module;
+  PriorityModule& costing = memo ? static_cast<PriorityModule&>(*memo) : *module;
   const size_t carried = keys.size();
   for (const auto& [a, b] : sampled.edges) {
     CollapseCandidate c;
@@ -63,7 +63,7 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
 }
 
 SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
-                              const CollapseMesh& whole, const PriorityModule& master) {
+                              const CollapseMesh& whole, PriorityModule& master) {
   SubsetSample out;
   out.inner_edges = edges.inner_edges;
   const uint64_t costings_before = master.costings();

@@ -74,7 +74,7 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
 // costs never travel as keys), for which those copies cost more than the costings. Not
 // thread-safe (the master's module); out.costings counts the master's costings of it.
 SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
-                              const CollapseMesh& whole, const PriorityModule& master);
+                              const CollapseMesh& whole, PriorityModule& master);
 
 // The round's costs from its subsets' samples (one per job, in order), each sampled edge
 // standing for its subset's inner edges over its sampled ones; `remove`: the faces the round

@@ -56,7 +56,7 @@ class SubsetPriority : public PriorityWrapper {
   SubsetPriority(PriorityModule& inner, std::vector<uint8_t> free_vertex)
       : PriorityWrapper(inner), free_(std::move(free_vertex)) {}
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) const override {
+                Costing costing) override {
     if (!free_[a] || !free_[b]) return false;
     return inner_.evaluate(mesh, a, b, out, costing);
   }

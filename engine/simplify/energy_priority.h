@@ -54,11 +54,16 @@
 // Queue keys (Costing::kQueue) are most of the evaluations and most are never used: they try
 // fewer starts (a young star the two ends, a star costed by moments the midpoint), and each
 // start is measured and solved, but the solved position is costed on the model it was solved
-// on, not measured again (see evaluate()).
+// on, not measured again (EnergyEvaluator::place).
 //
 // The sample of a vertex that has not moved lies on the mesh, on that vertex, whatever
 // happens around it: it is "parked" at its vertex (in no face's list) and costs nothing until
 // a collapse moves or removes the vertex. Early on, that is almost every point.
+//
+// The module is in three parts: the state and the performed collapse (this class,
+// energy_priority.cpp), the costing of a candidate (EnergyEvaluator, energy_evaluator.h, one
+// per module, owning its working memory), and the state's transfer to and from the parallel
+// build's jobs (energy_state_transfer.cpp).
 #pragma once
 
 #include <cmath>
@@ -68,6 +73,7 @@
 
 #include <Eigen/Core>
 
+#include "simplify/energy_evaluator.h"
 #include "simplify/module_state.h"
 #include "simplify/modules.h"
 #include "simplify/point_moments.h"
@@ -106,10 +112,9 @@ struct EnergyOptions {
   // of the mesh the module is given. A subset job passes the whole mesh's, so that the costs of
   // different subsets (and the weights derived from the diagonal) are comparable.
   double reference_diagonal = 0;
-  // The star's planes and volume preservation (see the top; 0: off). Chosen on 18 meshes
-  // among 1 ... 100 and 0 ... 16: larger plane weights lowered RMS at 50% further but raised
-  // Hausdorff at 10%, at more time.
-  double star_planes_weight = 10;
+  // The star's planes and volume preservation (see the top; 0: off). The weights' choice:
+  // docs/DECISIONS.md, "The star's planes".
+  double star_planes_weight = 30;
   double volume_weight = 4;
 };
 
@@ -131,23 +136,29 @@ class EnergyPriority : public PriorityModule {
   // that on average waits behind it.
   static constexpr double kTopologyPrice = 0.003;
 
+  static constexpr uint32_t kNoPoint = 0xffffffffu;
+
   EnergyPriority(std::vector<uint8_t> locked, EnergyOptions options,
                  WedgeAttributes attributes = {})
       : locked_(std::move(locked)),
         options_(options),
         attributes_(std::move(attributes)),
         star_terms_on_(options.star_planes_weight > 0 || options.volume_weight > 0) {}
+  EnergyPriority(const EnergyPriority&) = delete;  // its evaluator refers to it
+  EnergyPriority& operator=(const EnergyPriority&) = delete;
   std::string name() const override { return "energy"; }
   bool costly() const override { return true; }
   void initialize(const CollapseMesh& mesh) override;
   // The sharp curves, and the rest (the sample points, the per-face lists, E_scalar).
   std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) override;
-  // With Costing::kQueue each start's solve is costed on the model it was solved on, not
-  // measured again (see evaluate()).
+  // Costed by the module's evaluator (energy_evaluator.h). With Costing::kQueue each start's
+  // solve is costed on the model it was solved on, not measured again.
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) const override;
+                Costing costing) override {
+    return evaluator_.evaluate(mesh, a, b, out, costing);
+  }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
-  uint64_t costings() const override { return costings_; }
+  uint64_t costings() const override { return evaluator_.costings(); }
 
   // State export/import for the parallel construction (module_state.h). export_local: the
   // state of a job's faces and vertices (maps: its local -> global ids; the points on its
@@ -205,85 +216,18 @@ class EnergyPriority : public PriorityModule {
   void set_max_sampled_points(uint32_t n) { options_.max_sampled_points = n; }
 
  private:
+  friend class EnergyEvaluator;  // the costing half of the module: reads its state
+  using FacePoint = EnergyFacePoint;
   // kTopologyPrice's price per point for a mesh of this diagonal (the whole mesh's in every
   // subset, so that every job prices alike): (kTopologyPrice x diagonal)^2.
   static double topology_price(double diagonal);
-  static constexpr uint32_t kNoPoint = 0xffffffffu;
-  // A point as its face holds it: each face keeps its points contiguously, so that the late
-  // collapses, whose stars hold hundreds of points, read them in sequence, not one cache miss
-  // per point.
-  struct FacePoint {
-    Vec3 position{};
-    double distance_sq = 0;  // to its face, as of the last collapse that touched it
-    uint32_t id = kNoPoint;
-  };
-  // A face of the star after the collapse: (v, p1, p2) counter-clockwise, v the moving vertex
-  // (which was at `before`). `next` and `previous` are the faces across the edges (v, p2) and
-  // (v, p1) in the fan around v (-1 on a boundary).
-  struct StarFace {
-    Vec3 p1, p2, before;
-    VertexId id1, id2;
-    FaceId source = kNoId;  // the face it is the image of
-    int next = -1, previous = -1;
-    std::array<WedgeId, 3> wedges{};  // of the corners v, p1, p2 (with E_scalar)
-    int group = 0;                    // E_scalar's group of the corner at v
-  };
-  // Where one point projected: a star face and barycentric coordinates on (v, p1, p2).
-  struct Projected {
-    int face = 0;
-    std::array<double, 3> bary{};
-  };
-  // The projections of the evaluated points onto the star with v at one position, summed
-  // for the energy and for the next least-squares solve.
-  struct Fit {
-    double distance_sq = 0;      // sum over the evaluated points
-    double max_distance_sq = 0;  // largest single one
-    double a = 0;                // sum of b0^2 (b0: barycentric coordinate of v)
-    Vec3 b{};                    // sum of b0 (x - b1 p1 - b2 p2)
-    double c = 0;                // sum of |x - b1 p1 - b2 p2|^2
-    // The points' squared distances to where their barycentric coordinates put them with the
-    // moving vertex at w: sum |x - b0 w - b1 p1 - b2 p2|^2 (the least-squares solve's model).
-    double model_at(const Vec3& w) const { return c - 2 * dot(b, w) + a * dot(w, w); }
-  };
-  // The moment solve's model (moment_solve): the planes' squared distances, each weighted by
-  // its normal's length at the start, w^T h w - 2 r.w + k, plus the parked ends' Fit model.
-  struct PlaneModel {
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d r = Eigen::Vector3d::Zero();
-    double k = 0;
-    Fit ends;
-    double at(const Vec3& w) const {
-      const Eigen::Vector3d x(w[0], w[1], w[2]);
-      return x.dot(h * x) - 2 * r.dot(x) + k + ends.model_at(w);
-    }
-  };
 
-  Fit project_points(const std::vector<FacePoint>& points, const std::vector<int>& homes,
-                     const Vec3& v, std::vector<Projected>* where = nullptr) const;
-  double scalar_change() const;
-  const PointMoments& moments_of(FaceId f) const;
-  // Face f's points against its own plane and rim as the mesh has it now: the "before" of
-  // every star holding f, kept with its moments.
-  struct OwnError {
-    double plane_sq = 0, rim_sq = 0;
-  };
-  const OwnError& own_error_of(const CollapseMesh& mesh, FaceId f) const;
-  double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2) const;
-  double rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2, int star_face = -1) const;
-  double moment_rim_change(const CollapseMesh& mesh, const Vec3& v) const;
-  double exact_distance_sq() const;
-  double moment_distance_before(const CollapseMesh& mesh) const;
-  double moment_distance_after(const Vec3& v) const;
-  Vec3 moment_solve(const Vec3& from, double iso_a, const Vec3& iso_b,
-                    PlaneModel* model = nullptr) const;
-  Vec3 projection_solve(const Fit& fit, double iso_a, const Vec3& iso_b, const Vec3& from) const;
   void prepare_fan(const CollapseMesh& mesh, VertexId vs);
   std::pair<int, Projection> closest_fan_face(const CollapseMesh& mesh,
                                               const std::vector<FaceId>& faces,
                                               const FacePoint& point, int home) const;
   void update_attributes(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge);
-  void gather_face(FaceId f, int home) const;
-  // The points' stored squared distance to face f, raised by its drift (an upper bound).
+  // The stored squared distance of a point of face f, raised by f's drift (an upper bound).
   double bounded_distance_sq(FaceId f, const FacePoint& p) const {
     if (drift_[f] == 0) return p.distance_sq;
     const double d = std::sqrt(p.distance_sq) + drift_[f];
@@ -300,112 +244,45 @@ class EnergyPriority : public PriorityModule {
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
                     EnergyState& out) const;
-  bool folds(const Vec3& v) const;
-
-  // evaluate()'s steps, in order. Each fills the scratch members it names; none is
-  // thread-safe (the scratch is the module's).
-  // 1. Which end survives, and whether its place is fixed (a locked end, an end on a curve the
-  //    other is not on, a corner, or a change of the curves' topology); not possible when both
-  //    ends are locked.
-  struct Survivor {
-    bool possible = false;
-    bool keep_b = false, fixed = false, topology = false, boundary_a = false, boundary_b = false;
-  };
-  Survivor choose_survivor(const CollapseMesh& mesh, VertexId a, VertexId b) const;
-  // 2. The star (scratch_: star, lists, edge_faces, joined, a_side_faces, origin), and
-  //    the sums over its faces before the collapse: the area-weighted planes, the faces'
-  //    normals and normal.corner, twice the area, about scratch_.origin.
-  struct StarSums {
-    Quadric planes;
-    Vec3 normals{};
-    double offsets = 0, area2 = 0;
-    std::array<VertexId, 2> edge_apexes{kNoId, kNoId};
-    int edge_faces = 0;
-  };
-  StarSums gather_star(const CollapseMesh& mesh, VertexId a, VertexId b) const;
-  // 3. The fan's order (StarFace::next, previous), the homes of the removed faces' points
-  //    (scratch_.edge_face_homes) and the samples of a and b still parked (scratch_.parked_ends).
-  //    Returns the parked samples around the star, each counted half (they sit on its rim).
-  double link_fan(const StarSums& sums, VertexId a, VertexId b) const;
-  // 4. The star's points (scratch_: points, homes, point_weight), all, or thinned
-  //    for E_scalar on a large star; whether the star is costed by its faces' moments.
-  struct StarPoints {
-    bool by_moments = false;
-    double points_around = 0;  // the points the star holds, its rim's parked half included
-  };
-  StarPoints gather_star_points(double parked_around) const;
-  // 5. scratch_.terms: the star's planes and its volume, weighted for points_around points.
-  void set_star_terms(StarSums& sums, double points_around) const;
 
   std::vector<uint8_t> locked_;
   EnergyOptions options_;
   std::vector<Vec3> positions_;                      // per point (they never move)
   std::vector<std::vector<FacePoint>> face_points_;  // per face: the points projecting onto it
   std::vector<uint32_t> parked_point_;  // per vertex: its sample while it has not moved
+  // Per face: how far the closest surface points of its points may have moved since their
+  // distances were stored (a rich star's collapse leaves a face its points: see the top).
+  std::vector<double> drift_;
   SharpCurves curves_;
   WedgeAttributes attributes_;  // the input's; initialize copies them into scalar_
-  mutable uint64_t costings_ = 0;
-  mutable ScalarAttributes scalar_;  // its star scratch is used by the const evaluate
-  double topology_price_ = 0;        // per point of the star, for a change of the curves' topology
-  std::vector<uint32_t> point_id_;   // a job's: per point, the master's id (empty: identity)
+  // Its star scratch (begin_star, add) is written by the evaluator, which holds the module
+  // const: the one part of the module's state a costing writes.
+  mutable ScalarAttributes scalar_;
+  double topology_price_ = 0;       // per point of the star, for a change of the curves' topology
+  std::vector<uint32_t> point_id_;  // a job's: per point, the master's id (empty: identity)
+  bool star_terms_on_ = false;      // either of the star's weights is non-zero
+  EnergyEvaluator evaluator_{*this};
 
-  // The working memory of evaluate() and collapsed() for the star at hand: rebuilt by each
-  // call, so a module is used by one thread at a time (the parallel build gives each job its
-  // own module); evaluate() is const and writes only here, in the caches below and in
-  // costings_.
-  struct StarScratch {
-    std::vector<StarFace> star;
-    // The faces whose points are the star's (the star's sources and the two removed faces),
-    // with the star face their points are measured against (-2, -3: the removed faces, homed
-    // once the fan is known).
-    std::vector<std::pair<FaceId, int>> lists;
-    std::vector<VertexId> fan_first_ids, fan_second_ids;  // star's id1, id2
-    std::vector<FacePoint> points;
-    // Per star point: the star face its face becomes (-1, -2: the samples of a and b). In
-    // collapsed(): the index among vs's faces of its old face's image (-1: an unparked sample).
-    std::vector<int> homes;
-    double point_weight = 1;  // how many points each of `points` stands for
-    // The star's planes and volume terms, as one quadric in v - origin (with star_terms_on_).
-    Quadric terms;
-    Vec3 origin{};
-    int a_side_faces = 0;
-    std::array<FaceId, 2> edge_faces{kNoId, kNoId};  // the two faces the collapse removes
-    std::array<int, 2> edge_face_homes{};            // the star faces their points go to
-    std::vector<FacePoint> parked_ends;              // the samples of a and b, while parked
-    std::vector<int> parked_end_homes;
-    std::array<std::pair<WedgeId, WedgeId>, 2> joined{};  // wedges of a, b in fl, fr
-    int joined_count = 0;
-    std::vector<Projected> projected;  // per star point, at the chosen placement
-    std::array<std::vector<Projected>, 16> placement_projections;
-    std::vector<PreparedTriangle> prepared;  // star with v at the projected position
-  };
-  mutable StarScratch scratch_;
-  bool star_terms_on_ = false;  // either of the star's weights is non-zero
-  // Per face, the moments of the points projecting onto it (computed when first needed,
-  // forgotten when its point list changes).
-  mutable std::vector<PointMoments> moments_;
-  // 0: nothing known, 1: moments_, 2: moments_ and own_ (a face's corners move only in a
-  // performed collapse, which resets this to 0, or to 1 when the face keeps its points).
-  mutable std::vector<uint8_t> moments_ready_;
-  mutable std::vector<OwnError> own_;
-  // Per face: the largest stored squared distance of its points (kept with its moments), and
-  // how far the closest surface points of its points may have moved since they were stored.
-  mutable std::vector<double> max_distance_sq_;
-  std::vector<double> drift_;
-  // collapsed(): per face around vs, its centroid, the radius of the disc around it that holds
-  // the face, and its unit normal (0 for a degenerate face).
+  // collapsed()'s working memory: the points it moves, where they go, the fan around vs.
   struct FanFace {
-    Vec3 center{};
-    double radius = 0;
-    Vec3 normal{};
+    Vec3 center{};      // the face's centroid
+    double radius = 0;  // of the disc around the centroid that holds the face
+    Vec3 normal{};      // unit (0 for a degenerate face)
   };
-  std::vector<FanFace> fan_;
+  struct Reprojection {
+    std::vector<FacePoint> points;
+    // Per point: the index among vs's faces of its old face's image (-1: an unparked sample).
+    std::vector<int> homes;
+    std::vector<PreparedTriangle> prepared;  // vs's faces
+    std::vector<FanFace> fan;
+    std::vector<FaceId> faces;                // per point, its new face
+    std::vector<std::array<double, 3>> bary;  // and its barycentric coordinates there
+  };
+  Reprojection moved_;
   // check_global's marks: (generation << 10) | (subset << 1) | given. Each check writes its own
   // subset's faces, vertices and the points on them; the points' marks through atomic_ref.
   mutable std::vector<uint32_t> face_tag_, vertex_tag_, point_tag_;
   uint32_t import_generation_ = 0;
-  std::vector<FaceId> moved_faces_;  // collapsed: per star point, its new face
-  std::vector<std::array<double, 3>> moved_bary_;
 };
 
 }  // namespace parapm

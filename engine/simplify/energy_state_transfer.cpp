@@ -199,7 +199,7 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
 void EnergyPriority::apply_global(const EnergyState& state, const GlobalImport& import) {
   for (FaceId f : state.faces) {
     face_points_[f].clear();
-    moments_ready_[f] = 0;
+    evaluator_.forget(f);
     drift_[f] = 0;
   }
   for (VertexId v : state.vertices) parked_point_[v] = kNoPoint;

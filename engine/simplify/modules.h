@@ -47,9 +47,10 @@ class PriorityModule {
     return {[this, &mesh] { initialize(mesh); }};
   }
   // Costs the collapse of edge {a, b}, choosing which end survives and where. Returns false
-  // when the collapse cannot be placed (the edge is then left alone).
+  // when the collapse cannot be placed (the edge is then left alone). Not const: a costing may
+  // write the module's working memory and caches (a module serves one thread at a time).
   virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                        Costing costing) const = 0;
+                        Costing costing) = 0;
   // Called after the mesh performed `done`, to update the module's state. `edge` names the two
   // faces the collapse removed (now dead); done.vs_before where vs was (vt keeps its position
   // in the mesh). The module may refine done.error with what it learns from the performed
@@ -83,7 +84,7 @@ class PriorityWrapper : public PriorityModule {
   uint64_t costings() const override { return inner_.costings(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) const override {
+                Costing costing) override {
     return inner_.evaluate(mesh, a, b, out, costing);
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,

@@ -42,7 +42,7 @@ void QuadricPriority::initialize(const CollapseMesh& mesh) {
 }
 
 bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                               CollapseCandidate& out, Costing) const {
+                               CollapseCandidate& out, Costing) {
   ++costings_;
   const bool locked_a = !locked_.empty() && locked_[a];
   const bool locked_b = !locked_.empty() && locked_[b];

@@ -26,7 +26,7 @@ class QuadricPriority : public PriorityModule {
   std::string name() const override { return "quadric"; }
   void initialize(const CollapseMesh& mesh) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) const override;  // (both costings alike: it is cheap)
+                Costing costing) override;  // (both costings alike: it is cheap)
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override { return costings_; }
 
@@ -48,7 +48,7 @@ class QuadricPriority : public PriorityModule {
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 
  private:
-  mutable uint64_t costings_ = 0;
+  uint64_t costings_ = 0;
   std::vector<uint8_t> locked_;
   QuadricOptions options_;
   std::vector<Quadric> quadrics_;

@@ -18,7 +18,7 @@ namespace parapm {
 // sharp_curves.h). They travel in the parallel build's jobs.
 struct EnergyTuning {
   // The star's planes and volume preservation (Lindstrom-Turk's terms), against E_dist.
-  double star_planes_weight = 10;
+  double star_planes_weight = 30;
   double volume_weight = 4;
   // E_spring's kappa: Hoppe's schedule times this.
   double spring_scale = 0.03;

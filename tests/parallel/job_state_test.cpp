@@ -37,7 +37,7 @@ SimplifyOptions options_of(const std::string& metric) {
 // lists are in another order, which changes the order of the energy's sums, hence the last
 // bits).
 void expect_round_trip(const RepairedMesh& repaired, const SimplifyOptions& options,
-                       const CollapseMesh& whole, const PriorityModule& master, bool exact,
+                       const CollapseMesh& whole, PriorityModule& master, bool exact,
                        const std::string& what) {
   const Mesh& mesh = repaired.mesh;
   const std::vector<uint32_t> one_subset(whole.vertex_capacity(), 0);
@@ -299,7 +299,8 @@ struct TwoHalves {
   std::vector<SubsetJob> jobs;
 };
 
-// `import` throws Error(kInvalidInput) naming `what`, and the master's points are as `before`.
+// `import` throws Error(kInvalidInput) naming `what` (or one of its alternatives, separated by
+// '|'), and the master's points are as `before`.
 void expect_refused_and_unchanged(const std::function<void()>& import, const std::string& what,
                                   const EnergyPriority& energy,
                                   const std::vector<EnergyPriority::PointState>& before) {
@@ -308,7 +309,14 @@ void expect_refused_and_unchanged(const std::function<void()>& import, const std
     ADD_FAILURE() << what << ": accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << what;
-    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    const std::string message = e.what();
+    bool named = false;
+    for (size_t begin = 0; begin <= what.size();) {
+      const size_t end = std::min(what.find('|', begin), what.size());
+      named = named || message.find(what.substr(begin, end - begin)) != std::string::npos;
+      begin = end + 1;
+    }
+    EXPECT_TRUE(named) << what << ": " << message;
   }
   const auto after = energy.point_states();
   ASSERT_EQ(after.size(), before.size());
@@ -425,8 +433,10 @@ TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
       {"is not the job's",
        [&](std::vector<MetricState>& s) { s[0].energy.points.front().id = foreign_point; }},
       // A face its job's collapse removed, left out (a dead face holds no points: nothing else
-      // in the state names it, and the master would keep its old points, held twice).
-      {"does not cover face",
+      // in the state names it, and the master would keep its old points, held twice). Refused
+      // by the coverage check, or before it by the points' when the master held a point on
+      // that face that the job moved: the state then gives a point it does not own.
+      {"does not cover face|is not the job's",
        [&](std::vector<MetricState>& s) {
          std::vector<FaceId>& faces = s[1].energy.faces;
          faces.erase(std::find(faces.begin(), faces.end(), records[1].back().fl));

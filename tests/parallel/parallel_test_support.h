@@ -57,7 +57,7 @@ struct RoundZero {
 
 // Fresh queue keys of the job's edges with two free ends, costed by the master's module on the
 // whole mesh, in the job's local ids: what the job would cost itself.
-inline std::vector<EdgeKey> fresh_keys(const PriorityModule& master, const CollapseMesh& whole,
+inline std::vector<EdgeKey> fresh_keys(PriorityModule& master, const CollapseMesh& whole,
                                        const SubsetJob& job) {
   const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
   std::vector<EdgeKey> keys;

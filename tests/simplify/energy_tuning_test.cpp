@@ -34,7 +34,7 @@ TEST(EnergyTuning, EveryKnobReachesTheMetric) {
   options.target_ratio = 0.1;
   const std::string defaults = pm_bytes(build_progressive_mesh(repaired, options));
   SimplifyOptions spelled = options;
-  spelled.energy = EnergyTuning{10, 4, 0.03, 8, 0.05};
+  spelled.energy = EnergyTuning{30, 4, 0.03, 8, 0.05};
   EXPECT_EQ(pm_bytes(build_progressive_mesh(repaired, spelled)), defaults);
 
   const std::vector<std::pair<const char*, std::function<void(EnergyTuning&)>>> knobs = {

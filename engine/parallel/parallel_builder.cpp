@@ -1,0 +1,926 @@
+#include "parallel/parallel_builder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <future>
+#include <limits>
+#include <memory>
+
+#include <spdlog/spdlog.h>
+
+#include "parallel/collapse_merge.h"
+#include "parallel/edge_keys.h"
+#include "parallel/job_pool.h"
+#include "parallel/job_state.h"
+#include "parallel/round_shares.h"
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_job.h"
+#include "parallel/subset_rule.h"
+#include "partition/partition.h"
+#include "simplify/energy_priority.h"
+#include "simplify/modules.h"
+#include "simplify/pm_builder.h"
+#include "simplify/simplifier.h"
+#include "simplify/surface_samples.h"
+#include "util/clock.h"
+#include "util/error.h"
+#include "util/number_text.h"
+
+namespace parapm {
+namespace {
+
+// The live part of a mesh as a plain mesh (what the partitioner takes), and per vertex of the
+// mesh its id there (kNoId for dead vertices).
+struct LiveCopy {
+  Mesh mesh;
+  std::vector<VertexId> compact;
+};
+LiveCopy live_copy(const CollapseMesh& mesh) {
+  LiveCopy out;
+  out.compact.assign(mesh.vertex_capacity(), kNoId);
+  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
+    if (mesh.vertex_alive(v)) {
+      out.compact[v] = VertexId(out.mesh.positions.size());
+      out.mesh.positions.push_back(mesh.position(v));
+    }
+  out.mesh.faces.reserve(mesh.live_faces());
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
+    if (mesh.face_alive(f)) {
+      const Triangle& t = mesh.face(f);
+      out.mesh.faces.push_back({out.compact[t[0]], out.compact[t[1]], out.compact[t[2]]});
+    }
+  return out;
+}
+
+// Partitions a live copy into p subsets; returns, per vertex of the mesh it was copied from,
+// its subset (0 for vertices dead at the copy).
+std::vector<uint32_t> partition_copy(const LiveCopy& live, uint32_t p,
+                                     const PartitionOptions& options) {
+  const Partition partition = partition_mesh(live.mesh, p, options);
+  std::vector<uint32_t> vertex_subset(live.compact.size(), 0);
+  for (VertexId v = 0; v < live.compact.size(); ++v)
+    if (live.compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[live.compact[v]];
+  return vertex_subset;
+}
+
+std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
+                                     const PartitionOptions& options) {
+  return partition_copy(live_copy(mesh), p, options);
+}
+
+// Runs `work` on this thread and each of `sides` beside it, each on a thread of its own when
+// the build may use more than one (one after the other otherwise). No side may touch what
+// `work` or another side does.
+struct Beside {
+  double work_seconds = 0;
+  std::vector<double> side_seconds;
+  double side_cpu_elsewhere = 0;  // the sides' CPU when they ran on other threads
+};
+Beside run_beside(unsigned threads, const std::function<void()>& work,
+                  const std::vector<std::function<void()>>& sides) {
+  Beside out;
+  out.side_seconds.assign(sides.size(), 0);
+  auto timed_side = [&](size_t i) {
+    const auto ts = std::chrono::steady_clock::now();
+    const double cpu = thread_cpu_seconds();
+    sides[i]();
+    out.side_seconds[i] = seconds_since(ts);
+    return thread_cpu_seconds() - cpu;
+  };
+  std::vector<std::future<double>> beside;
+  if (pool_threads(threads, 2) >= 2)
+    for (size_t i = 0; i < sides.size(); ++i)
+      beside.push_back(std::async(std::launch::async, timed_side, i));
+  const auto tw = std::chrono::steady_clock::now();
+  try {
+    work();
+  } catch (...) {
+    for (std::future<double>& f : beside) f.wait();
+    throw;
+  }
+  out.work_seconds = seconds_since(tw);
+  if (beside.empty()) {
+    for (size_t i = 0; i < sides.size(); ++i) timed_side(i);
+  } else {
+    std::exception_ptr error;
+    for (std::future<double>& f : beside) try {
+        out.side_cpu_elsewhere += f.get();
+      } catch (...) {
+        if (!error) error = std::current_exception();
+      }
+    if (error) std::rethrow_exception(error);
+  }
+  return out;
+}
+
+// Whether a partition drawn on the mesh as the last round found it keeps that round's borders:
+// more than half of the last round's bound vertices still alive are bound again. The greedy
+// partitioner is deterministic from its start vertex, the seed's pick among a few vertices of
+// least degree: two seeds can pick the same one and draw the same partition of the same mesh,
+// and a round on it would leave the last round's borders as they were, unmended. Different
+// partitions bind 1-13% of those vertices again.
+// `bound`: the partition's bound vertices, found here.
+bool repeats_borders(const CollapseMesh& mesh, const std::vector<uint32_t>& vertex_subset,
+                     const std::vector<uint8_t>& bound_before, std::vector<uint8_t>& bound) {
+  bound = bound_vertices(mesh, vertex_subset);
+  size_t before = 0, again = 0;
+  for (VertexId v = 0; v < bound_before.size() && v < bound.size(); ++v)
+    if (bound_before[v] && mesh.vertex_alive(v)) {
+      ++before;
+      again += bound[v];
+    }
+  spdlog::debug("the partition drawn ahead binds {} of the last round's {} bound vertices again",
+                again, before);
+  if (2 * again > before) {
+    bound.clear();
+    return true;
+  }
+  return false;
+}
+
+// The subsets of a round starting at `faces` (ParallelOptions::min_subset_faces); below 2 (with
+// p >= 2), no round.
+uint32_t round_subsets(const ParallelOptions& parallel, uint64_t faces) {
+  if (parallel.min_subset_faces == 0 || parallel.subsets < 2) return parallel.subsets;
+  return uint32_t(std::min<uint64_t>(parallel.subsets, faces / parallel.min_subset_faces));
+}
+
+void check_parallel_options(const ParallelOptions& parallel, size_t vertices) {
+  if (parallel.subsets < 1 || parallel.subsets > kMaxPartitionSubsets)
+    throw_invalid("the subset count p must be in [1, 256], got " +
+                  std::to_string(parallel.subsets));
+  if (parallel.subsets > vertices)
+    throw_invalid("the subset count p = " + std::to_string(parallel.subsets) +
+                  " exceeds the vertex count " + std::to_string(vertices));
+  if (parallel.rounds > 64)
+    throw_invalid("parallel rounds must be in [1, 64] (0: by p), got " +
+                  std::to_string(parallel.rounds));
+  if (!(parallel.border_excess >= 0 && parallel.border_excess <= 0.5))
+    throw_invalid("the border excess must be in [0, 0.5] (0: geometric rounds only), got " +
+                  number_text(parallel.border_excess));
+  if (!(parallel.handover_ratio > 0 && parallel.handover_ratio <= 1))
+    throw_invalid("the handover ratio must be in (0, 1], got " +
+                  number_text(parallel.handover_ratio));
+}
+
+// The partitioner's seed of a round. It picks the start vertex as the (seed mod count)-th
+// vertex of least degree in id order: consecutive seeds pick neighbouring ids, often close on
+// the surface, and nearly the same partition, whose borders would stay where they were. A
+// mixed seed starts each round somewhere else.
+uint64_t round_seed(uint64_t seed, uint32_t round) {
+  if (round == 0) return seed;
+  SplitMix64 mix(seed + round);
+  return mix.next() >> 1;
+}
+
+// The band pass's priority: the master's metric, restricted to edges with a lagging end (bound
+// in this round and the one before, so not moved by either: where two cuts cross, around it
+// faces may remain from two rounds ago) and a cost of at most `ceiling`; an edge above it is
+// left alone until its star changes. A collapse's ends no longer lag.
+class BandPriority : public PriorityWrapper {
+ public:
+  BandPriority(PriorityModule& inner, std::vector<uint8_t> lagging, double ceiling)
+      : PriorityWrapper(inner), lagging_(std::move(lagging)), ceiling_(ceiling) {}
+  void initialize(const CollapseMesh&) override {}
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) override {
+    if (!lagging_[a] && !lagging_[b]) return false;
+    return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= ceiling_;
+  }
+  void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
+                 const EdgeFaces& edge) override {
+    lagging_[done.vs] = lagging_[done.vt] = 0;
+    inner_.collapsed(mesh, done, edge);
+  }
+
+ private:
+  std::vector<uint8_t> lagging_;
+  double ceiling_;
+};
+
+// The master's current keys of the job's edges with two free ends (`free`: free_vertices of
+// the job; the only edges it costs), in its local ids, sorted. Const reads of `memo`: jobs may take
+// theirs concurrently.
+std::vector<EdgeKey> keys_of_job(const KeyMemo& memo, const SubsetJob& job,
+                                 const std::vector<uint8_t>& free) {
+  const std::vector<VertexId>& global = job.global_vertex;
+  std::vector<EdgeKey> keys;
+  for (VertexId a = 0; a < global.size(); ++a) {
+    if (!free[a]) continue;
+    memo.for_each_current_at(global[a], [&](const EdgeKey& k) {
+      const auto it = std::lower_bound(global.begin() + a + 1, global.end(), k.b);
+      if (it == global.end() || *it != k.b) return;
+      const auto b = VertexId(it - global.begin());
+      if (free[b]) keys.push_back({a, b, k.cost});
+    });
+  }
+  sort_keys(keys);
+  return keys;
+}
+
+// The master's deferred edges (global ids, sorted) with two free ends in the job, in its
+// local ids, sorted, but those `keys` (the job's, sorted) answer: a costing known is better
+// than a deferral. Const reads: jobs may take theirs concurrently.
+std::vector<DeferredEdge> deferred_of_job(const std::vector<DeferredEdge>& deferred,
+                                          const SubsetJob& job, const std::vector<uint8_t>& free,
+                                          const std::vector<EdgeKey>& keys) {
+  const std::vector<VertexId>& global = job.global_vertex;
+  std::vector<DeferredEdge> out;
+  if (deferred.empty()) return out;
+  for (VertexId a = 0; a < global.size(); ++a) {
+    if (!free[a]) continue;
+    auto d = std::lower_bound(deferred.begin(), deferred.end(), global[a],
+                              [](const DeferredEdge& e, VertexId v) { return e.a < v; });
+    for (; d != deferred.end() && d->a == global[a]; ++d) {
+      const auto it = std::lower_bound(global.begin() + a + 1, global.end(), d->b);
+      if (it == global.end() || *it != d->b) continue;
+      const auto b = VertexId(it - global.begin());
+      if (free[b] && !has_key(keys, a, b)) out.push_back({a, b, d->key});
+    }
+  }
+  return out;  // sorted: by a, then by b (global order is local order)
+}
+
+// Drops the deferred edges with an end that one of `lists`' collapses changed (its vs or vt:
+// the deferral no longer stands for the edge as it is).
+void drop_changed(std::vector<DeferredEdge>& deferred, size_t vertex_capacity,
+                  const std::vector<const std::vector<CollapseRecord>*>& lists) {
+  std::vector<uint8_t> changed(vertex_capacity, 0);
+  for (const std::vector<CollapseRecord>* list : lists)
+    for (const CollapseRecord& r : *list) changed[r.vs] = changed[r.vt] = 1;
+  std::erase_if(deferred, [&](const DeferredEdge& d) { return changed[d.a] || changed[d.b]; });
+}
+
+// `requested` with a kByMetric floor set for `master`'s metric.
+ParallelOptions with_metric_floor(ParallelOptions requested, const PriorityModule& master) {
+  if (requested.min_subset_faces == kByMetric)
+    requested.min_subset_faces = subset_faces_by_metric(master.costly());
+  return requested;
+}
+
+// A round shortened by its border band still removes this fraction of its faces: on a small
+// mesh cut in many subsets the band is a fifth of the faces or more, and the bound alone would
+// ask for rounds of a few percent (fandisk at p = 16: 13 rounds to the handover).
+constexpr double kMinRoundRemoval = 0.15;
+
+// The face count a round from `faces` may end at so that its border band of `border` faces
+// holds back at most `excess` x that count (ParallelOptions::border_excess); 0 without a bound.
+uint64_t border_bounded_goal(uint64_t faces, uint64_t border, double excess) {
+  if (excess <= 0 || border == 0 || faces == 0) return 0;
+  const double band = double(border) / double(faces);
+  const double ratio = std::min(1.0 - kMinRoundRemoval, 1.0 / (1.0 + excess / band));
+  return uint64_t(std::llround(ratio * double(faces)));
+}
+
+}  // namespace
+
+ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOptions& options,
+                                 const ParallelOptions& requested, ParallelStats* stats,
+                                 const ProgressCallback& progress, const CancelToken* cancel,
+                                 SubsetRunner* runner, const ParallelEvents& events)
+    : repaired_(repaired),
+      mesh_(repaired.mesh),
+      options_(options),
+      requested_(requested),
+      st_(stats ? *stats : local_stats_),
+      progress_(progress),
+      cancel_(cancel),
+      pool_(requested.threads),
+      runner_(runner ? runner : &pool_),
+      events_(events),
+      start_(std::chrono::steady_clock::now()),
+      master_cpu_start_(thread_cpu_seconds()) {
+  check_simplify_options(options);
+  check_parallel_options(requested, mesh_.vertex_count());
+  st_ = {};
+  st_.subsets = requested.subsets;
+  rounds_ = scheduled_rounds(requested);
+  st_.rounds = rounds_;
+  st_.threads = pool_threads(requested.threads, requested.subsets);
+  input_faces_ = mesh_.face_count();
+  target_ = target_face_count(input_faces_, options);
+  handover_ = std::max<uint64_t>(
+      target_, uint64_t(std::llround(requested.handover_ratio * double(input_faces_))));
+  locked_ = locked_vertices(repaired, options.free_copies);
+  defer_line_ = defer_recosting_line(input_faces_);
+  // After two scheduled rounds (a ratio of 0.32 at the default handover), an extra round at
+  // the scheduled ratio would need 3.2 x the floor per subset to start, and mid-sized meshes
+  // at p = 2 would get none (a longer sequential final pass).
+  const double handover_ratio = double(handover_) / double(input_faces_);
+  step_ = std::max(std::pow(handover_ratio, 1.0 / double(rounds_)),
+                   std::pow(handover_ratio, 1.0 / 3.0));
+  scheduled_left_ = rounds_;
+}
+
+void ParallelBuilder::set_up() {
+  const auto t = std::chrono::steady_clock::now();
+  whole_.emplace(mesh_);
+  CollapseMesh& whole = *whole_;
+  master_ = make_priority_module(options_, mesh_, locked_);
+  parallel_ = with_metric_floor(requested_, *master_);
+  // The first round's partition needs the mesh only: it is drawn beside the master's
+  // initialisation, whose independent parts run side by side too (all read `whole`, none
+  // through its marks; each writes its own data).
+  const uint32_t first_subsets = round_subsets(parallel_, whole.live_faces());
+  first_round_ = first_subsets >= std::min(2u, parallel_.subsets) &&
+                 whole.live_vertices() >= 4 * size_t(first_subsets) &&
+                 whole.live_faces() > handover_;
+  auto partition_first_round = [&] {
+    const auto tp = std::chrono::steady_clock::now();
+    PartitionOptions partition_options;
+    partition_options.seed = round_seed(options_.seed, 0);
+    first_partition_ = partition_live(whole, first_subsets, partition_options);
+    first_partition_seconds_ = seconds_since(tp);
+  };
+  std::vector<std::function<void()>> setup_tasks;
+  if (first_round_) setup_tasks.push_back(partition_first_round);
+  const size_t first_part = setup_tasks.size();
+  for (std::function<void()>& part : master_->initialization_parts(whole))
+    setup_tasks.push_back(std::move(part));
+  std::vector<double> task_seconds(setup_tasks.size(), 0);
+  const auto section = std::chrono::steady_clock::now();
+  run_jobs(setup_tasks.size(), parallel_.threads, [&](size_t i) {
+    const auto ti = std::chrono::steady_clock::now();
+    setup_tasks[i]();
+    task_seconds[i] = seconds_since(ti);
+  });
+  // With a core per task, as the critical path assumes: the slowest part.
+  for (size_t i = first_part; i < task_seconds.size(); ++i)
+    initialize_seconds_ = std::max(initialize_seconds_, task_seconds[i]);
+  const double section_seconds = seconds_since(section);
+  keys_.emplace(*master_, whole.vertex_capacity());
+  carry_keys_ = parallel_.carry_keys && master_->costly();
+  carry_deferred_ = carry_keys_ && parallel_.carry_deferred;
+  master_queue_ = carry_keys_ ? static_cast<PriorityModule*>(&*keys_) : master_.get();
+  // The setup's own time: the first partition is round 0's (which the critical path counts
+  // only where it outlasts the initialisation: RoundStats::partition_overlap_seconds).
+  st_.setup_seconds = seconds_since(t) - section_seconds + initialize_seconds_;
+  st_.critical_path_seconds = st_.setup_seconds;
+  subset_options_ = subset_options_of(options_, mesh_);
+  records_.reserve(whole.live_vertices());
+}
+
+std::shared_ptr<const std::vector<uint32_t>> ParallelBuilder::whole_components() {
+  if (!components_) {
+    auto found = std::make_shared<std::vector<uint32_t>>();
+    connected_components(*whole_, *found);
+    components_ = std::move(found);
+  }
+  return components_;
+}
+
+void ParallelBuilder::append_pending() { append_merged_by_cost(pending_lists_, records_); }
+
+ParallelBuilder::RoundPlan ParallelBuilder::plan_round(uint64_t faces, size_t vertices,
+                                                       uint32_t scheduled_rounds_left,
+                                                       const RoundStats* last) const {
+  RoundPlan plan;
+  plan.subsets = round_subsets(parallel_, faces);
+  if (plan.subsets < std::min(2u, parallel_.subsets)) return plan;
+  if (vertices < 4 * size_t(plan.subsets)) return plan;
+  // A round whose jobs removed less than a tenth of what they were asked ends the rounds:
+  // the mesh is stuck (locked copies of non-manifold vertices, or collapses only the final
+  // pass takes, above every ceiling), and rounds on new partitions would
+  // extract, cost and merge it again for nothing (chair-dupfaces-13k, whose every vertex is
+  // locked: three rounds of no collapse took 6-9x the sequential build's CPU).
+  if (last && last->asked_faces > 0 &&
+      double(last->faces_before - last->faces_after) < 0.1 * double(last->asked_faces))
+    return plan;
+  plan.scheduled = scheduled_rounds_left > 0;
+  if (plan.scheduled) {
+    if (faces <= handover_) return plan;
+    // Geometric steps from the present face count to the handover.
+    plan.goal =
+        uint64_t(std::llround(double(faces) * std::pow(double(handover_) / double(faces),
+                                                       1.0 / double(scheduled_rounds_left))));
+  } else {
+    // An extra round, if the last one's jobs did what they were asked (a mesh whose locked
+    // parts stop it short gains nothing from more) and the subsets stay large enough that
+    // their borders do not decide the order. A round that did only half of it stopped at its
+    // cost ceiling: the rest is costlier, its order matters more, so the next round's subsets
+    // must be larger (2.5 x the floor; decisions/notebook-2026-11.md, "Extra rounds after a
+    // short round").
+    if (parallel_.extra_round_subset_faces == 0 || !last) return plan;
+    const double done = double(last->faces_before) - double(last->faces_after);
+    const double asked = double(last->asked_faces);
+    if (!(done >= 0.5 * asked)) return plan;
+    const uint64_t floor = done >= 0.9 * asked ? parallel_.extra_round_subset_faces
+                                               : parallel_.extra_round_subset_faces * 5 / 2;
+    // Even geometric steps to the target, as many as the target is steps away, rounded:
+    // stepping by `step_` and stopping at the target can end on a sliver of a round (asked
+    // only for what the last round's border kept).
+    if (step_ >= 1) return plan;
+    const double to_target = std::max(1.0, double(target_)) / double(faces);
+    const double steps = std::max(1.0, std::round(std::log(to_target) / std::log(step_)));
+    plan.goal = std::max<uint64_t>(
+        target_, uint64_t(std::llround(double(faces) * std::pow(to_target, 1.0 / steps))));
+    // Like a round bounded by its border band, an extra round removes at least 15% of its
+    // faces (or a step, if many rounds make that gentler); the final pass does less.
+    const double least = std::min(kMinRoundRemoval, 1 - step_) * double(faces);
+    if (double(faces) - double(plan.goal) < least) return plan;
+    // Narrower rounds once p subsets would leave fewer faces each than the floor: the mesh
+    // keeps shrinking in parallel, and the sequential final pass stays short at any p.
+    plan.subsets = uint32_t(std::min<uint64_t>(plan.subsets, plan.goal / floor));
+    if (plan.subsets < 2) return plan;
+  }
+  plan.go = true;
+  return plan;
+}
+
+bool ParallelBuilder::counts(const RoundStats& r) {
+  return !r.border_limited || 2 * (r.faces_before - r.faces_after) < r.asked_faces;
+}
+
+void ParallelBuilder::forgo_foreseen() {
+  if (foreseen_.beside_band)
+    st_.critical_path_seconds += std::max(0.0, foreseen_.append_seconds - foreseen_.band_seconds);
+  foreseen_ = Foreseen{};
+}
+
+bool ParallelBuilder::round() {
+  if (round_index_ >= 64) {
+    forgo_foreseen();  // (the rounds' limit)
+    return false;
+  }
+  CollapseMesh& whole = *whole_;
+  Round r;
+  r.rs.round = round_index_;
+  r.rs.faces_before = whole.live_faces();
+  const RoundPlan plan = plan_round(r.rs.faces_before, whole.live_vertices(), scheduled_left_,
+                                    st_.round_stats.empty() ? nullptr : &st_.round_stats.back());
+  if (!plan.go) {
+    forgo_foreseen();
+    return false;
+  }
+  r.subsets = plan.subsets;
+  r.scheduled = plan.scheduled;
+  r.rs.goal_faces = plan.goal;
+  partition(r);
+  bound_goal_by_border(r);
+  extract_jobs(r);
+  run_subsets(r);
+  merge(r);
+  band_pass(r);
+  finish_round(r);
+  ++round_index_;
+  return true;
+}
+
+// A new partition of the current mesh: the previous round's borders, whose vertices could not
+// move, are inside subsets now.
+void ParallelBuilder::partition(Round& r) {
+  RoundStats& rs = r.rs;
+  const uint32_t round = rs.round;
+  auto t = std::chrono::steady_clock::now();
+  // Round 1's partition drawn beside round 0's jobs, unless it keeps round 0's borders.
+  const bool early_drawn =
+      foreseen_.drawn && !foreseen_.beside_band && foreseen_.subsets == r.subsets;
+  const bool early_taken = early_drawn && !repeats_borders(*whole_, foreseen_.vertex_subset,
+                                                           bound_before_, early_bound_);
+  const double early_check_seconds = seconds_since(t);
+  if (round == 0 && first_round_) {
+    // Drawn during the setup (whose first_round_ repeats the plan's checks).
+    r.vertex_subset = std::move(first_partition_);
+    rs.partition_seconds = first_partition_seconds_;
+    rs.partition_overlap_seconds = std::min(first_partition_seconds_, initialize_seconds_);
+  } else if (early_taken) {
+    // Drawn beside round 0's jobs: the critical path counts what of it outlasted the slowest
+    // of them, its check, and the previous round's records, appended now.
+    r.vertex_subset = std::move(foreseen_.vertex_subset);
+    rs.partition_foreseen = true;
+    rs.partition_seconds = foreseen_.partition_seconds + early_check_seconds;
+    rs.partition_overlap_seconds =
+        std::min(foreseen_.partition_seconds, st_.round_stats.back().slowest_subset_cpu_seconds);
+    const auto ta = std::chrono::steady_clock::now();
+    append_pending();
+    rs.append_seconds = seconds_since(ta);
+  } else if (foreseen_.drawn && foreseen_.beside_band && foreseen_.subsets == r.subsets) {
+    // Drawn beside the last band pass, the previous round's records appended beside it too:
+    // the critical path counts what of them outlasted the band pass.
+    r.vertex_subset = std::move(foreseen_.vertex_subset);
+    rs.partition_foreseen = true;
+    rs.partition_seconds = foreseen_.copy_seconds + foreseen_.partition_seconds;
+    rs.append_seconds = foreseen_.append_seconds;
+    const double longest =
+        std::max({foreseen_.partition_seconds, foreseen_.append_seconds, foreseen_.band_seconds});
+    rs.partition_overlap_seconds =
+        foreseen_.partition_seconds + foreseen_.append_seconds - (longest - foreseen_.band_seconds);
+  } else {
+    if (early_drawn)
+      spdlog::debug(
+          "parallel round {}: the partition drawn beside the last round's jobs keeps "
+          "its borders; drawn anew",
+          round);
+    forgo_foreseen();
+    PartitionOptions partition_options;
+    partition_options.seed = round_seed(options_.seed, round);
+    const Beside timed =
+        run_beside(parallel_.threads,
+                   [&] { r.vertex_subset = partition_live(*whole_, r.subsets, partition_options); },
+                   {[this] { append_pending(); }});
+    rs.partition_seconds = timed.work_seconds + early_check_seconds;
+    rs.append_seconds = timed.side_seconds[0];
+    rs.partition_overlap_seconds = std::min(timed.work_seconds, timed.side_seconds[0]);
+    subsets_cpu_ += timed.side_cpu_elsewhere;
+  }
+  foreseen_ = Foreseen{};
+  if (events_.partitioned) events_.partitioned(round, r.subsets, rs.faces_before);
+}
+
+// The partition's border (sequential, O(faces), counted with the partition), and the goal a
+// scheduled round may reach with it (ParallelOptions::border_excess).
+void ParallelBuilder::bound_goal_by_border(Round& r) {
+  RoundStats& rs = r.rs;
+  const auto t = std::chrono::steady_clock::now();
+  r.bound =
+      early_bound_.empty() ? bound_vertices(*whole_, r.vertex_subset) : std::move(early_bound_);
+  early_bound_.clear();
+  rs.border_faces = border_faces(*whole_, r.bound);
+  rs.partition_seconds += seconds_since(t);
+  if (r.scheduled && parallel_.border_excess > 0) {
+    const uint64_t bounded =
+        border_bounded_goal(rs.faces_before, rs.border_faces, parallel_.border_excess);
+    if (bounded > rs.goal_faces) {
+      rs.goal_faces = bounded;
+      rs.border_limited = true;
+    }
+  }
+}
+
+// The jobs: which vertices each subset owns (sequential, O(vertices)), the water level
+// (sequential, on the master), then each job's mesh and the master's state over it, one job per
+// pool task (const reads of the whole mesh and the master: concurrently). With a core per
+// subset, only the slowest job's extraction is on the critical path.
+void ParallelBuilder::extract_jobs(Round& r) {
+  RoundStats& rs = r.rs;
+  const CollapseMesh& whole = *whole_;
+  const uint32_t subsets = r.subsets;
+  const auto t = std::chrono::steady_clock::now();
+  const std::vector<std::vector<VertexId>> owned = owned_vertices(whole, r.vertex_subset, subsets);
+  double sequential_extract = seconds_since(t);
+  const bool sample = parallel_.water_level_factor > 0 || parallel_.cost_shares;
+  std::vector<SubsetJob>& jobs = r.jobs;
+  jobs.resize(subsets);
+  std::vector<uint64_t> removable(subsets, 0);
+  std::vector<SubsetSample> samples(sample ? subsets : 0);
+  // A cheap metric's sample is costed by the master (sample_on_master): the tasks only pick
+  // its edges. A costly one's is costed side by side in the tasks.
+  const bool sample_in_tasks = sample && master_->costly();
+  std::vector<SampledEdges> sampled(sample && !sample_in_tasks ? subsets : 0);
+  // Per face, the subset whose job owns its three corners: the only state that may list it.
+  face_subset_.assign(whole.face_capacity(), kNoId);
+  std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
+  run_jobs(jobs.size(), parallel_.threads, [&](size_t i) {
+    const double cpu = thread_cpu_seconds();
+    // The jobs' meshes carry the input's wedge values; the metric's current ones
+    // (E_scalar) travel in the state.
+    jobs[i] =
+        extract_subset(whole, mesh_.layout, mesh_.wedge_values, mesh_.positions_are_float, locked_,
+                       r.vertex_subset, owned[i], uint32_t(i), rs.round, subset_options_);
+    jobs[i].state = export_job_state(*master_, jobs[i]);
+    for (FaceId f = 0; f < jobs[i].mesh.face_count(); ++f) {
+      const Triangle& c = jobs[i].mesh.faces[f];
+      if (jobs[i].owned[c[0]] && jobs[i].owned[c[1]] && jobs[i].owned[c[2]])
+        face_subset_[jobs[i].global_face[f]] = uint32_t(i);
+    }
+    const std::vector<uint8_t> free = free_vertices(jobs[i].mesh, jobs[i].owned);
+    removable[i] = removable_faces(jobs[i].mesh, free);
+    if (carry_keys_) jobs[i].keys = keys_of_job(*keys_, jobs[i], free);
+    if (sample) {
+      const double sample_start = thread_cpu_seconds();
+      if (sample_in_tasks)
+        samples[i] = sample_subset(jobs[i], free, carry_keys_, jobs[i].keys);
+      else
+        sampled[i] = sampled_edges(jobs[i], free);
+      sample_cpu[i] = thread_cpu_seconds() - sample_start;
+    }
+    if (carry_deferred_) jobs[i].deferred = deferred_of_job(deferred_, jobs[i], free, jobs[i].keys);
+    job_cpu[i] = thread_cpu_seconds() - cpu;
+  });
+  // The water level and the shares (sequential: a sort of the samples).
+  RoundCosts round_costs;
+  if (sample) {
+    const auto ts = std::chrono::steady_clock::now();
+    if (!sample_in_tasks) {
+      const double sample_start = thread_cpu_seconds();
+      for (size_t i = 0; i < jobs.size(); ++i)
+        samples[i] = sample_on_master(jobs[i], sampled[i], whole, *master_);
+      rs.share_seconds += thread_cpu_seconds() - sample_start;
+      for (const SubsetSample& s : samples) master_sample_costings_ += s.costings;
+    }
+    round_costs =
+        round_costs_of(samples, rs.faces_before - rs.goal_faces, parallel_.water_level_factor);
+    if (!parallel_.cost_shares) round_costs.cheap_fraction.clear();
+    if (parallel_.water_level_factor > 0) rs.water_level = round_costs.ceiling;
+    sequential_extract += seconds_since(ts);
+    for (double c : sample_cpu) rs.share_seconds += c;
+    for (const SubsetSample& s : samples) sample_costings_ += s.costings;
+  }
+  rs.asked_faces =
+      set_targets(jobs, removable, rs.faces_before, rs.goal_faces, round_costs.cheap_fraction);
+  // Deferred re-costing as the sequential build has it at these face counts: in every round
+  // that ends at the line or above (by default the last scheduled round ends at it).
+  for (SubsetJob& job : jobs)
+    job.options.defer_recosting = options_.defer_recosting && rs.goal_faces >= defer_line_;
+  if (parallel_.water_level_factor > 0)
+    for (SubsetJob& job : jobs)
+      job.options.max_cost = job.options.max_cost > 0
+                                 ? std::min(job.options.max_cost, rs.water_level)
+                                 : rs.water_level;
+  for (const SubsetJob& job : jobs) {
+    rs.keys_carried += job.keys.size();
+    rs.deferred_carried += job.deferred.size();
+  }
+  for (double c : job_cpu) {
+    subsets_cpu_ += c;  // master work, on the pool's threads
+    rs.slowest_extract_cpu_seconds = std::max(rs.slowest_extract_cpu_seconds, c);
+  }
+  rs.extract_seconds = seconds_since(t);
+  rs.extract_critical_seconds = sequential_extract + rs.slowest_extract_cpu_seconds;
+}
+
+// The jobs, on the runner. Round 1's partition is drawn beside round 0's jobs on the mesh as
+// round 0 found it (the master only waits for them, and the whole mesh changes only at their
+// merge): round 0 has no band pass to draw it beside, and drawn after the merge it would be
+// all on the critical path. The price: its subsets, balanced for round 0's faces, hold round
+// 1's a little unevenly (round 0's jobs stop at its water level).
+void ParallelBuilder::run_subsets(Round& r) {
+  RoundStats& rs = r.rs;
+  auto draw_round_one = [&] {
+    PartitionOptions next_options;
+    next_options.seed = round_seed(options_.seed, 1);
+    foreseen_.vertex_subset = partition_live(*whole_, r.subsets, next_options);
+  };
+  const bool draw_early = rs.round == 0 && parallel_.early_partition;
+  std::vector<std::function<void()>> beside_jobs;
+  if (draw_early) beside_jobs.push_back(draw_round_one);
+  const Beside timed_jobs = run_beside(
+      parallel_.threads, [&] { r.results = runner_->run(r.jobs, cancel_); }, beside_jobs);
+  r.jobs.clear();
+  rs.subsets_seconds = timed_jobs.work_seconds;
+  if (draw_early) {
+    foreseen_.drawn = true;
+    foreseen_.subsets = r.subsets;
+    foreseen_.partition_seconds = timed_jobs.side_seconds[0];
+    subsets_cpu_ += timed_jobs.side_cpu_elsewhere;
+  }
+  if (cancel_) cancel_->check();
+  if (r.results.size() != r.subsets)
+    throw Error(ErrorCode::kInternal, "the subset runner returned " +
+                                          std::to_string(r.results.size()) + " results for " +
+                                          std::to_string(r.subsets) + " jobs");
+}
+
+// The subsets' records replay on the whole mesh, side by side (replay_subsets: by the subset
+// rule they change disjoint parts of it, and the mesh ends as a merged replay leaves it);
+// beside them, the jobs' states go into the master, and the round's water level and keys are
+// taken from the records and results (take_results: the module, the memo's own lists, data
+// the replay does not touch).
+void ParallelBuilder::merge(Round& r) {
+  RoundStats& rs = r.rs;
+  const auto t = std::chrono::steady_clock::now();
+  r.lists.reserve(r.results.size());
+  for (SubsetResult& result : r.results) {
+    rs.subsets.push_back({result.subset, result.faces, result.owned_faces, result.records.size(),
+                          result.wall_seconds, result.cpu_seconds, result.stats.stop_reason});
+    subsets_cpu_ += result.cpu_seconds;
+    job_costings_ += result.costings;
+    rs.slowest_subset_cpu_seconds = std::max(rs.slowest_subset_cpu_seconds, result.cpu_seconds);
+    r.lists.push_back(std::move(result.records));
+    rs.keys_reused += result.keys_reused;
+  }
+  if (parallel_.replay_state) {
+    // Tests only: the merged sequence drives the master's module, one collapse at a time
+    // (merged from a copy: take_results reads the lists).
+    const std::vector<CollapseRecord> merged = merge_by_cost(r.lists);
+    r.replay = replay_collapses(*whole_, merged, master_.get());
+    take_results(r);
+    records_.insert(records_.end(), merged.begin(), merged.end());
+  } else {
+    const auto tr = std::chrono::steady_clock::now();
+    double bookkeeping_seconds = 0;
+    r.replay = replay_subsets(*whole_, r.lists, r.vertex_subset, parallel_.threads,
+                              [&] { bookkeeping_seconds = take_results(r); });
+    // With a core per subset (as the critical path assumes), the slowest subset's replay or
+    // the bookkeeping, whichever is longer.
+    rs.merge_overlap_seconds =
+        std::max(0.0, seconds_since(tr) - std::max(r.replay.slowest_seconds, bookkeeping_seconds));
+    // Into the PM's records at the next step (append_pending): each record moved once (a
+    // merged list moved again took as long as the merge itself).
+    pending_lists_ = std::move(r.lists);
+  }
+  rs.merge_seconds = seconds_since(t);
+}
+
+double ParallelBuilder::take_results(Round& r) {
+  const auto tb = std::chrono::steady_clock::now();
+  double import_saved = 0;  // what the imports side by side save with a core per state
+  if (!parallel_.replay_state) {
+    std::vector<const MetricState*> states;
+    for (const SubsetResult& result : r.results) states.push_back(&result.state);
+    std::vector<const std::vector<CollapseRecord>*> changes;
+    for (const std::vector<CollapseRecord>& list : r.lists) changes.push_back(&list);
+    const ImportTimes import = import_result_states(*master_, states, r.vertex_subset, face_subset_,
+                                                    parallel_.threads, changes);
+    import_saved = std::max(0.0, import.seconds - import.critical_seconds);
+  }
+  std::vector<double> costs;
+  for (const std::vector<CollapseRecord>& list : r.lists)
+    for (const CollapseRecord& record : list) costs.push_back(record.cost);
+  if (!costs.empty()) {
+    const size_t k = costs.size() * 95 / 100;
+    std::nth_element(costs.begin(), costs.begin() + ptrdiff_t(k), costs.end());
+    r.ceiling = costs[k];
+  }
+  // The jobs' keys are current on the master (edge_keys.h). (The replay does not tell the
+  // memo of its collapses: the keys stay current whichever runs first.)
+  std::vector<EdgeKey> returned;
+  if (carry_keys_)
+    for (SubsetResult& result : r.results)
+      returned.insert(returned.end(), result.keys.begin(), result.keys.end());
+  if (carry_deferred_) {
+    // The deferred edges of the jobs' free vertices are the jobs' to report (a job holds
+    // them all in its queue); the others stand unless a collapse changed an end.
+    std::vector<const std::vector<CollapseRecord>*> changes;
+    for (const std::vector<CollapseRecord>& list : r.lists) changes.push_back(&list);
+    drop_changed(deferred_, whole_->vertex_capacity(), changes);
+    // A job reports again what it was given and left as it was: its report first, so
+    // that the stable sort keeps it.
+    std::vector<DeferredEdge> now;
+    for (SubsetResult& result : r.results) {
+      check_deferred_edges(result.deferred, whole_->vertex_capacity());
+      now.insert(now.end(), result.deferred.begin(), result.deferred.end());
+    }
+    now.insert(now.end(), deferred_.begin(), deferred_.end());
+    sort_unique_edges(now);
+    deferred_ = std::move(now);
+  }
+  keys_->reset(returned);
+  return seconds_since(tb) - import_saved;
+}
+
+// The band pass, after every round but the first: what two rounds' borders both kept
+// (vertices bound in both partitions, at the resolution of two rounds before) and is below the
+// round's water level, sequentially on the whole mesh, cheapest first. (After the first round
+// the next round's new partition takes its band in parallel.) Only those: a vertex no collapse
+// has touched yet may just be inside a region a short round did not reach, which the next
+// round takes in parallel. The next round's partition is drawn beside it, on a copy of the
+// mesh as the band pass found it.
+void ParallelBuilder::band_pass(Round& r) {
+  RoundStats& rs = r.rs;
+  CollapseMesh& whole = *whole_;
+  const auto t = std::chrono::steady_clock::now();
+  if (parallel_.band_pass && rs.round >= 1) {
+    // The last round's bound vertices become the lagging ones: bound in this round too.
+    std::vector<VertexId> lagging;
+    for (size_t v = 0; v < r.bound.size(); ++v) {
+      bound_before_[v] &= r.bound[v];
+      if (bound_before_[v]) lagging.push_back(VertexId(v));
+    }
+    BandPriority band(*master_queue_, std::move(bound_before_), r.ceiling);
+    Simplifier pass(whole, band, standard_constraints(locked_, whole_components()));
+    SimplifierLimits band_limits;
+    band_limits.target_faces = std::max<uint64_t>(1, target_);
+    band_limits.first_queue_around = &lagging;  // the band refuses every other edge
+    // The next round as it would be without the band pass's collapses (it removes a few
+    // hundred faces of a round's tens of thousands): its partition is drawn beside it.
+    RoundStats before_band = rs;
+    before_band.faces_after = whole.live_faces();
+    const RoundPlan next =
+        plan_round(before_band.faces_after, whole.live_vertices(),
+                   scheduled_left_ - (r.scheduled && counts(before_band) ? 1 : 0), &before_band);
+    LiveCopy copy;
+    if (next.go) {
+      const auto tc = std::chrono::steady_clock::now();
+      copy = live_copy(whole);
+      foreseen_.copy_seconds = seconds_since(tc);
+      foreseen_.subsets = next.subsets;
+    }
+    std::vector<CollapseRecord> band_records;
+    PartitionOptions next_options;
+    next_options.seed = round_seed(options_.seed, rs.round + 1);
+    const double prepared = seconds_since(t);
+    const Beside timed =
+        run_beside(parallel_.threads, [&] { band_records = pass.run(band_limits, {}, cancel_); },
+                   {[this] { append_pending(); },
+                    [&] {
+                      if (next.go)
+                        foreseen_.vertex_subset = partition_copy(copy, next.subsets, next_options);
+                    }});
+    foreseen_.beside_band = true;
+    foreseen_.drawn = next.go;
+    foreseen_.band_seconds = prepared + timed.work_seconds - foreseen_.copy_seconds;
+    foreseen_.append_seconds = timed.side_seconds[0];
+    foreseen_.partition_seconds = timed.side_seconds[1];
+    subsets_cpu_ += timed.side_cpu_elsewhere;
+    rs.band_pass_collapses = band_records.size();
+    if (carry_deferred_ && !band_records.empty())
+      drop_changed(deferred_, whole.vertex_capacity(), {&band_records});
+    records_.insert(records_.end(), std::make_move_iterator(band_records.begin()),
+                    std::make_move_iterator(band_records.end()));
+  }
+  rs.band_pass_seconds = seconds_since(t);
+  // With one thread, the band pass's time holds the append's and the partition's, which the
+  // critical path counts, beyond the band pass, in the next round (or forgo_foreseen), and
+  // the copy, counted with the partition.
+  if (foreseen_.beside_band) rs.band_pass_seconds = foreseen_.band_seconds;
+}
+
+void ParallelBuilder::finish_round(Round& r) {
+  RoundStats& rs = r.rs;
+  bound_before_ = std::move(r.bound);
+  rs.faces_after = whole_->live_faces();
+  st_.critical_path_seconds += rs.partition_seconds + rs.append_seconds -
+                               rs.partition_overlap_seconds + rs.extract_critical_seconds +
+                               rs.slowest_subset_cpu_seconds + rs.merge_seconds -
+                               rs.merge_overlap_seconds + rs.band_pass_seconds;
+  spdlog::debug(
+      "parallel round {}: {} subsets {}->{} faces (goal {}{}; {} border faces), partition "
+      "{:.3f} s, extract {:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} "
+      "replayed), band pass {} collapses in {:.3f} s",
+      rs.round, r.subsets, rs.faces_before, rs.faces_after, rs.goal_faces,
+      rs.border_limited ? ", bounded by the border band" : "", rs.border_faces,
+      rs.partition_seconds, rs.extract_seconds, rs.subsets_seconds, rs.slowest_subset_cpu_seconds,
+      rs.merge_seconds, r.replay.collapses, rs.band_pass_collapses, rs.band_pass_seconds);
+  if (events_.merged) events_.merged(rs);
+  if (r.scheduled && counts(rs)) --scheduled_left_;
+  st_.round_stats.push_back(std::move(rs));
+  if (progress_) progress_(input_faces_ - whole_->live_faces(), input_faces_ - target_);
+}
+
+void ParallelBuilder::final_pass() {
+  CollapseMesh& whole = *whole_;
+  st_.rounds = uint32_t(st_.round_stats.size());
+  const auto t = std::chrono::steady_clock::now();
+  // The band pass's keys too, so that the final pass starts from the queue as it is.
+  const std::vector<EdgeKey> carried =
+      carry_keys_ ? keys_->current_keys(whole) : std::vector<EdgeKey>{};
+  keys_->reset(carried);
+  const uint64_t reused_before = keys_->reused();
+  std::unique_ptr<PriorityModule> continued = without_initialize(*master_queue_);
+  Simplifier pass(whole, *continued, standard_constraints(locked_, whole_components()));
+  SimplifierLimits limits;
+  limits.target_faces = target_;
+  if (options_.defer_recosting) limits.defer_above_faces = defer_line_;
+  // The jobs' deferred edges that no key answers (sorted: a subsequence of a sorted list).
+  std::erase_if(deferred_, [&](const DeferredEdge& d) { return has_key(carried, d.a, d.b); });
+  limits.first_deferred = &deferred_;
+  const uint64_t done_before = input_faces_ - whole.live_faces();
+  const double setup_seconds = seconds_since(t);
+  std::vector<CollapseRecord> final_records;
+  auto progress = [&](uint64_t done, uint64_t) {
+    if (progress_) progress_(done_before + done, input_faces_ - target_);
+  };
+  // The last round's records go into records_ beside it (append_pending).
+  const Beside timed =
+      run_beside(parallel_.threads, [&] { final_records = pass.run(limits, progress, cancel_); },
+                 {[this] { append_pending(); }});
+  final_work_seconds_ = timed.work_seconds;
+  st_.final_pass_collapses = final_records.size();
+  st_.final_pass_seconds = setup_seconds + timed.work_seconds;
+  st_.final_append_seconds = timed.side_seconds[0];
+  subsets_cpu_ += timed.side_cpu_elsewhere;
+  st_.stop_reason = pass.stats().stop_reason;
+  const SimplifierStats& fs = pass.stats();
+  spdlog::debug(
+      "final pass: {} keys carried in, {} answered from them; {} evaluations, {} vetoed, {} "
+      "screened, {} requeued, {} stale",
+      carried.size(), keys_->reused() - reused_before, fs.evaluations, fs.rejected, fs.screened,
+      fs.requeued, fs.stale);
+  if (events_.final_pass_done)
+    events_.final_pass_done(st_.final_pass_collapses, st_.final_pass_seconds);
+  records_.insert(records_.end(), std::make_move_iterator(final_records.begin()),
+                  std::make_move_iterator(final_records.end()));
+}
+
+ProgressiveMesh ParallelBuilder::progressive_mesh() {
+  const auto t = std::chrono::steady_clock::now();
+  PmBuildOptions build_options;
+  build_options.keep_order = options_.keep_order;
+  ProgressiveMesh pm = build_pm_from_collapses(repaired_, *whole_, records_, build_options);
+  pm.info.metric = master_->name();
+  st_.pm_build_seconds = seconds_since(t);
+  st_.collapses = records_.size();
+  st_.critical_path_seconds += st_.final_pass_seconds +
+                               std::max(0.0, st_.final_append_seconds - final_work_seconds_) +
+                               st_.pm_build_seconds;
+  st_.seconds = seconds_since(start_);
+  st_.cpu_seconds = subsets_cpu_ + (thread_cpu_seconds() - master_cpu_start_);
+  // The master's: band passes and final pass.
+  const uint64_t master_costings = master_->costings() - master_sample_costings_;
+  st_.costings = job_costings_ + sample_costings_ + master_costings;
+  pm.info.seconds = st_.seconds;
+  spdlog::debug(
+      "parallel build p={} rounds={}: {} -> {} faces in {:.3f} s ({:.3f} s CPU; costings: {} "
+      "by the jobs, {} by their samples, {} by the band passes and final pass), final pass {} "
+      "collapses in {:.3f} s ({})",
+      parallel_.subsets, st_.rounds, input_faces_, pm.base.face_count(), st_.seconds,
+      st_.cpu_seconds, job_costings_, sample_costings_, master_costings, st_.final_pass_collapses,
+      st_.final_pass_seconds, st_.stop_reason);
+  return pm;
+}
+
+}  // namespace parapm

@@ -1,0 +1,175 @@
+// The parallel build's steps (build_progressive_mesh_parallel, parallel_build.h, is their
+// plan): the set-up, the rounds, the final pass and the PM. Internal to the engine.
+//
+// A round: plan it (how many subsets, what goal), partition the live mesh (or take the
+// partition drawn ahead), bound the goal by the border band, extract one job per subset with
+// the master's state and keys, run the jobs, merge their records and states into the whole
+// mesh and the master, then the band pass along the borders of two rounds. Work that does not
+// change what the master step at hand reads runs beside it (the next partition, the append of
+// the last round's records), and the critical path counts only what outlasts it.
+//
+// Not thread-safe: one builder per build, driven by one thread (it runs its pool itself).
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "parallel/collapse_merge.h"
+#include "parallel/edge_keys.h"
+#include "parallel/parallel_build.h"
+#include "simplify/collapse_mesh.h"
+
+namespace parapm {
+
+class ParallelBuilder {
+ public:
+  // Checks the options (Error(kInvalidInput)); `stats` (null: kept here) is reset.
+  ParallelBuilder(const RepairedMesh& repaired, const SimplifyOptions& options,
+                  const ParallelOptions& requested, ParallelStats* stats,
+                  const ProgressCallback& progress, const CancelToken* cancel, SubsetRunner* runner,
+                  const ParallelEvents& events);
+  ParallelBuilder(const ParallelBuilder&) = delete;
+  ParallelBuilder& operator=(const ParallelBuilder&) = delete;
+
+  // The whole mesh and the master's metric, initialised on it beside the first partition.
+  void set_up();
+  // One round, if the plan has one; false when the rounds are over.
+  bool round();
+  // The borders and whatever remains down to the target, sequentially.
+  void final_pass();
+  // The PM of every collapse, in order; the stats completed.
+  ProgressiveMesh progressive_mesh();
+
+ private:
+  // What a round does, from the mesh's live faces and vertices, the scheduled rounds left and
+  // the last round's figures: whether there is one, with how many subsets, whether it is
+  // scheduled, its goal.
+  struct RoundPlan {
+    bool go = false;
+    uint32_t subsets = 0;
+    bool scheduled = false;
+    uint64_t goal = 0;
+  };
+  RoundPlan plan_round(uint64_t faces, size_t vertices, uint32_t scheduled_rounds_left,
+                       const RoundStats* last) const;
+  // Whether a scheduled round counts against the rounds: unless its border band shortened it
+  // and it did half of what it was asked.
+  static bool counts(const RoundStats& r);
+
+  // A round at work: its figures, its partition, its jobs and what came back.
+  struct Round {
+    RoundStats rs;
+    uint32_t subsets = 0;
+    bool scheduled = false;
+    std::vector<uint32_t> vertex_subset;
+    std::vector<uint8_t> bound;  // its partition's bound vertices
+    std::vector<SubsetJob> jobs;
+    std::vector<SubsetResult> results;
+    std::vector<std::vector<CollapseRecord>> lists;  // the jobs' records
+    double ceiling = 0;  // its water level: 95% of its collapses cost less
+    ReplayReport replay;
+  };
+  void partition(Round& r);
+  void bound_goal_by_border(Round& r);
+  void extract_jobs(Round& r);
+  void run_subsets(Round& r);
+  void merge(Round& r);
+  // The jobs' states into the master, the round's water level, the keys and deferred edges
+  // they return; beside the replay of their records. Returns its seconds on the critical path.
+  double take_results(Round& r);
+  void band_pass(Round& r);
+  void finish_round(Round& r);
+  // A partition foreseen but not taken: the critical path counts what of the append beside the
+  // band pass outlasted it.
+  void forgo_foreseen();
+  void append_pending();
+  std::shared_ptr<const std::vector<uint32_t>> whole_components();
+
+  // The build's inputs.
+  const RepairedMesh& repaired_;
+  const Mesh& mesh_;
+  const SimplifyOptions& options_;
+  const ParallelOptions& requested_;
+  ParallelStats local_stats_;
+  ParallelStats& st_;
+  const ProgressCallback& progress_;
+  const CancelToken* cancel_;
+  ThreadPoolRunner pool_;
+  SubsetRunner* runner_;
+  const ParallelEvents& events_;
+  const std::chrono::steady_clock::time_point start_;
+  const double master_cpu_start_;
+
+  // Its targets.
+  uint32_t rounds_ = 0;  // scheduled
+  uint64_t input_faces_ = 0, target_ = 0, handover_ = 0;
+  uint64_t defer_line_ = 0;  // above it, edges are costed when they reach the top
+  std::vector<uint8_t> locked_;
+  // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three
+  // rounds' if that is gentler.
+  double step_ = 1;
+
+  // The whole mesh and the master's metric, initialised once on the whole mesh (so that the
+  // sample points are the sequential build's); every round's jobs take their part of its
+  // state and give back what they own, so that the final pass continues from the state a
+  // sequential run would have after the same collapses.
+  std::optional<CollapseMesh> whole_;
+  std::unique_ptr<PriorityModule> master_;
+  ParallelOptions parallel_;  // requested_, with the metric's subset floor
+  // The master's queue keys: the water level's sample, the jobs' keys after a round, the band
+  // pass's; carried into the next round's jobs and the final pass (edge_keys.h).
+  std::optional<KeyMemo> keys_;
+  // Keys are worth carrying only where a costing costs more than remembering it (costly()).
+  bool carry_keys_ = false, carry_deferred_ = false;
+  // What the band passes and the final pass cost with: the memo with carried keys, else the
+  // master (the memo would answer nothing, and its lookups only cost time).
+  PriorityModule* master_queue_ = nullptr;
+  SubsetOptions subset_options_;
+  bool first_round_ = false;  // round 0's partition is drawn during the set-up
+  std::vector<uint32_t> first_partition_;
+  double first_partition_seconds_ = 0;
+  double initialize_seconds_ = 0;  // the slowest part of the master's initialisation
+
+  uint64_t job_costings_ = 0, sample_costings_ = 0;  // (ParallelStats::costings)
+  uint64_t master_sample_costings_ = 0;  // of those, the master's own (sample_on_master)
+  // The edges jobs left deferred (global ids, sorted), kept until a collapse changes an end:
+  // the next round's jobs and the final pass queue them deferred (SubsetJob::deferred).
+  std::vector<DeferredEdge> deferred_;
+  // The whole mesh's connected components, found once, at the first band pass or the final
+  // pass, for the size rule of each one after it (collapses neither merge nor split them).
+  std::shared_ptr<const std::vector<uint32_t>> components_;
+
+  // Every collapse so far, in the PM's order. At most one per vertex: reserved once, so no
+  // round's records move the earlier ones.
+  std::vector<CollapseRecord> records_;
+  // A round's subsets' lists wait for the next step of the master to go into records_, k-way
+  // merged by cost (the band pass's records follow them). Nothing reads records_ before the PM
+  // is assembled, so the merge by cost runs beside the band pass, the next round's partition,
+  // or the final pass, off the critical path.
+  std::vector<std::vector<CollapseRecord>> pending_lists_;
+  std::vector<uint8_t> bound_before_;  // the previous round's bound vertices (subset_rule.h)
+  std::vector<uint8_t> early_bound_;   // round 1's, found while checking its early partition
+  std::vector<uint32_t> face_subset_;  // the round's: per face, the job owning its corners
+  double subsets_cpu_ = 0;             // CPU spent off the master's thread
+  uint32_t round_index_ = 0;
+  // Scheduled rounds still to come: geometric steps to the handover; a round shortened by its
+  // border band does not count, unless its jobs did not do half of it.
+  uint32_t scheduled_left_ = 0;
+  // The next round's partition, drawn ahead: beside round 0's jobs (round 1's), or beside the
+  // band pass on a copy of the mesh before it (the band pass moves a few hundred vertices
+  // along old borders). Used if the round has as many subsets as foreseen.
+  struct Foreseen {
+    bool beside_band = false;  // the last round's lists were appended beside its band pass
+    bool drawn = false;        // and the next round's partition drawn
+    uint32_t subsets = 0;
+    std::vector<uint32_t> vertex_subset;
+    double copy_seconds = 0, partition_seconds = 0, append_seconds = 0, band_seconds = 0;
+  } foreseen_;
+
+  // The final pass's figures, for the PM's critical path.
+  double final_work_seconds_ = 0;
+};
+
+}  // namespace parapm
