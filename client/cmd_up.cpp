@@ -31,7 +31,15 @@ struct UpArgs {
   uint32_t parallelism = 4;
   std::string token_file;
   std::string log_level = "info";
+  std::string http = kDefaultViewer;  // the viewer's address; "" : no viewer
 };
+
+// The port a daemon wrote to `file` once listening; 0 while it has not.
+int port_in(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  int port = 0;
+  return in >> port ? port : 0;
+}
 
 std::filesystem::path sibling_program(const std::string& name) {
   const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
@@ -168,7 +176,9 @@ int run_up(const UpArgs& args) {
 
   std::filesystem::create_directories(args.data);
   const std::filesystem::path port_file = std::filesystem::path(args.data) / "coordinator.port";
+  const std::filesystem::path http_port_file = std::filesystem::path(args.data) / "viewer.port";
   std::filesystem::remove(port_file);
+  std::filesystem::remove(http_port_file);
   const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
   const unsigned threads = args.worker_threads
                                ? args.worker_threads
@@ -186,21 +196,25 @@ int run_up(const UpArgs& args) {
     coordinator_args.push_back("--token-file");
     coordinator_args.push_back(args.token_file);
   }
+  if (!args.http.empty())
+    coordinator_args.insert(coordinator_args.end(),
+                            {"--http", args.http, "--http-port-file", http_port_file.string()});
   std::vector<pid_t> children;
   children.push_back(spawn(sibling_program("parapm-coordinator"), coordinator_args));
 
-  // Serving once the port file appears; a coordinator that exits first failed to start.
-  int port = 0;
+  // Serving once the port files appear; a coordinator that exits first failed to start.
+  int port = 0, http_port = 0;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (port == 0) {
+  while (port == 0 || (!args.http.empty() && http_port == 0)) {
     int status = 0;
     if (waitpid(children[0], &status, WNOHANG) == children[0]) {
       std::fprintf(stderr, "parapm up: the coordinator exited at start (status %d); see above\n",
                    WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status));
       return 2;
     }
-    std::ifstream in(port_file);
-    if (in >> port) break;
+    port = port_in(port_file);
+    http_port = port_in(http_port_file);
+    if (port != 0 && (args.http.empty() || http_port != 0)) break;
     if (std::chrono::steady_clock::now() > deadline) {
       stop_all(children, std::chrono::seconds(2));
       throw Error(ErrorCode::kIo, "the coordinator did not start listening within 30 s");
@@ -211,6 +225,12 @@ int run_up(const UpArgs& args) {
   const std::string address =
       (host == "0.0.0.0" || host.empty() ? std::string("127.0.0.1") : host) + ":" +
       std::to_string(port);
+  if (!args.http.empty()) {
+    const std::string http_host = args.http.substr(0, args.http.rfind(':'));
+    std::fprintf(stderr, "viewer: http://%s:%d/\n",
+                 http_host == "0.0.0.0" || http_host.empty() ? "127.0.0.1" : http_host.c_str(),
+                 http_port);
+  }
   std::vector<WorkerProcess> workers(args.workers);
   for (unsigned i = 0; i < args.workers; ++i) {
     WorkerProcess& worker = workers[i];
@@ -259,6 +279,10 @@ void add_up_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   up->add_option("--token-file", args->token_file,
                  "bearer token file for the coordinator and workers (else PARAPM_TOKEN)");
+  up->add_option("--http", args->http,
+                 "the viewer's address, host:port (port 0: any free; \"\": no viewer); its URL "
+                 "is printed once serving")
+      ->capture_default_str();
   up->add_option("--log-level", args->log_level, "the daemons' log level")->capture_default_str();
   up->callback([args, &exit_code] { exit_code = run_up(*args); });
 }

@@ -17,5 +17,6 @@ void add_submit_command(CLI::App& app, int& exit_code);
 void add_jobs_commands(CLI::App& app, int& exit_code);   // jobs, watch, cancel, delete
 void add_fetch_commands(CLI::App& app, int& exit_code);  // get, level
 void add_stream_command(CLI::App& app, int& exit_code);
+void add_view_command(CLI::App& app, int& exit_code);
 
 }  // namespace parapm::cli

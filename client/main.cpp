@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   parapm::cli::add_jobs_commands(app, exit_code);
   parapm::cli::add_fetch_commands(app, exit_code);
   parapm::cli::add_stream_command(app, exit_code);
+  parapm::cli::add_view_command(app, exit_code);
 #endif
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
 

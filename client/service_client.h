@@ -23,8 +23,9 @@ struct ConnectionArgs {
   std::string tls_ca;
 };
 
-// The address `parapm up` serves on by default.
+// The address `parapm up` serves on by default, and its viewer's.
 constexpr const char* kDefaultServer = "127.0.0.1:50051";
+constexpr const char* kDefaultViewer = "127.0.0.1:50052";
 
 void add_connection_options(CLI::App* command, ConnectionArgs& args);
 
@@ -33,6 +34,7 @@ class ServiceClient {
   explicit ServiceClient(const ConnectionArgs& args);
   parapm::v1::MeshService::Stub& stub() { return *stub_; }
   const std::string& server() const { return server_; }
+  const std::string& token() const { return token_; }
   // A context carrying the token; `timeout_s` 0: no deadline (streams that last a job).
   std::unique_ptr<grpc::ClientContext> context(double timeout_s = 60) const;
 

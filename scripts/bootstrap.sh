@@ -9,7 +9,12 @@ build="${PARAPM_BUILD_DIR:-$root/build}"
 
 pkgs=(cmake ninja-build g++ ccache libeigen3-dev libspdlog-dev libfmt-dev libcli11-dev
       nlohmann-json3-dev zlib1g-dev libgrpc++-dev libprotobuf-dev protobuf-compiler
-      protobuf-compiler-grpc libsqlite3-dev libssl-dev libgtest-dev libgmock-dev)
+      protobuf-compiler-grpc libsqlite3-dev libssl-dev libgtest-dev libgmock-dev
+      pkg-config libcpp-httplib-dev chromium)
+# Node.js runs the viewer's tests (a machine may have its own Node.js, with npm, installed
+# outside Debian's packages: then nothing is added).
+if ! command -v node > /dev/null; then pkgs+=(nodejs npm)
+elif ! command -v npm > /dev/null; then pkgs+=(npm); fi
 # The fuzz targets (scripts/fuzz.sh) need clang and its libFuzzer runtime.
 if [[ -n "${PARAPM_WITH_FUZZ:-}" ]]; then pkgs+=(clang libclang-rt-14-dev); fi
 missing=()
@@ -24,6 +29,12 @@ if [[ ${#missing[@]} -gt 0 ]]; then
   "${sudo[@]}" apt-get update -qq > /dev/null
   "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
     "${missing[@]}" > /dev/null
+fi
+
+# The viewer's test dependencies, as the committed lockfile pins them.
+if [[ ! -d "$root/viewer/node_modules" || "$root/viewer/package-lock.json" -nt "$root/viewer/node_modules" ]]; then
+  echo "[bootstrap] npm ci in viewer/" >&2
+  (cd "$root/viewer" && npm ci --no-audit --no-fund > /dev/null)
 fi
 
 if [[ ! -f "$build/CMakeCache.txt" ]]; then

@@ -25,7 +25,7 @@ port="${PARAPM_DEMO_PORT:-50051}"
 server=(--server "127.0.0.1:$port")
 rm -f "$out/service-data/coordinator.port"
 "$bin" up --workers "${PARAPM_DEMO_WORKERS:-2}" --data "$out/service-data" \
-  --listen "127.0.0.1:$port" --log-level warn 2> "$out/service.log" &
+  --listen "127.0.0.1:$port" --http 127.0.0.1:0 --log-level warn 2> "$out/service.log" &
 up_pid=$!
 trap 'kill -INT $up_pid 2> /dev/null; wait $up_pid 2> /dev/null || true' EXIT
 for _ in $(seq 100); do

@@ -4,6 +4,7 @@
 // vsplit stream. Stops cleanly on SIGINT / SIGTERM; a restart resumes unfinished jobs.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <optional>
 #include <thread>
 
 #include <spdlog/spdlog.h>
@@ -15,6 +16,7 @@
 #include "mesh_service.h"
 #include "rpc_server.h"
 #include "storage/blob_store.h"
+#include "viewer_http.h"
 
 namespace {
 
@@ -31,6 +33,9 @@ struct CoordinatorArgs {
   parapm::rpc::TlsFiles tls;
   bool worker_tls = false;
   std::string port_file;
+  std::string http;  // the viewer's address; "" : no viewer
+  std::string http_port_file;
+  unsigned http_threads = 8;
   std::string log_level = "info";
   bool verify = false;
   parapm::rpc::CallLimits streams;
@@ -54,6 +59,16 @@ int verify_store(const CoordinatorArgs& args) {
               report.corrupt.size());
   for (const std::string& name : report.corrupt) std::printf("corrupt: %s\n", name.c_str());
   return report.corrupt.empty() ? 0 : 1;
+}
+
+// Written once listening, atomically: a script polling for the file gets a usable port.
+void write_port_file(const std::string& path, int port) {
+  const std::string temp = path + ".tmp";
+  if (FILE* f = std::fopen(temp.c_str(), "w")) {
+    std::fprintf(f, "%d\n", port);
+    std::fclose(f);
+    std::filesystem::rename(temp, path);
+  }
 }
 
 int run(CoordinatorArgs args) {
@@ -83,6 +98,16 @@ int run(CoordinatorArgs args) {
   rpc::CallAdmission unary(args.unary);
   service::MeshService mesh_service(coordinator, rpc::TokenCheck(token), streams, unary);
   service::CoordinationService coordination(coordinator.workers(), rpc::TokenCheck(token));
+  // The viewer's options are checked before anything listens.
+  std::optional<service::ViewerServer> viewer;
+  if (!args.http.empty()) {
+    service::ViewerConfig viewer_config;
+    viewer_config.listen = args.http;
+    viewer_config.token = token;
+    viewer_config.tls = args.tls;
+    viewer_config.threads = args.http_threads;
+    viewer.emplace(coordinator, viewer_config);
+  }
   rpc::ServerSetup setup;
   setup.listen = args.listen;
   setup.tls = args.tls;
@@ -95,17 +120,14 @@ int run(CoordinatorArgs args) {
   spdlog::info("listening on {} (data in {}, default p = {}, {} jobs at once{})", address,
                args.data, args.parallelism, args.max_running_jobs,
                token.empty() ? "" : ", token required");
-  if (!args.port_file.empty()) {
-    // Written once listening, atomically: a script polling for the file gets a usable port.
-    const std::string temp = args.port_file + ".tmp";
-    if (FILE* f = std::fopen(temp.c_str(), "w")) {
-      std::fprintf(f, "%d\n", server.port);
-      std::fclose(f);
-      std::filesystem::rename(temp, args.port_file);
-    }
+  if (!args.port_file.empty()) write_port_file(args.port_file, server.port);
+  if (viewer) {
+    const int http_port = viewer->start();
+    if (!args.http_port_file.empty()) write_port_file(args.http_port_file, http_port);
   }
   const std::string signal = rpc::wait_for_shutdown_signal();
   spdlog::info("{}: stopping (running jobs re-run at the next start)", signal);
+  if (viewer) viewer->stop();
   coordinator.stop();  // before the calls drain, so that running jobs stop now
   server.server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
   return 0;  // ~Coordinator waits for the schedulers
@@ -198,6 +220,15 @@ int main(int argc, char** argv) {
   app.add_flag("--worker-tls", args.worker_tls, "call workers over TLS");
   app.add_option("--tls-ca", args.tls.ca_file,
                  "PEM roots that sign the workers' certificates (default: the system's)");
+  app.add_option("--http", args.http,
+                 "serve the viewer (a web page showing the jobs' PMs as they stream) on this "
+                 "address, host:port (port 0: any free); beyond loopback the token is required, "
+                 "and --tls-cert serves it over HTTPS");
+  app.add_option("--http-threads", args.http_threads, "viewer connections served at once")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  app.add_option("--http-port-file", args.http_port_file,
+                 "write the viewer's port to this file once serving (for scripts, with port 0)");
   app.add_option("--port-file", args.port_file,
                  "write the port listened on to this file once serving (for scripts, with port 0)");
   app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")

@@ -1,0 +1,227 @@
+#include "viewer_http.h"
+
+#include <httplib.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include <google/protobuf/util/json_util.h>
+#include <spdlog/spdlog.h>
+
+#include "coordinator.h"
+#include "rpc_server.h"
+#include "util/error.h"
+#include "viewer_assets.h"
+
+namespace parapm::service {
+namespace {
+
+// Bytes handed to the socket per write of a streamed .pm: the page decodes as they arrive.
+constexpr size_t kStreamChunkBytes = 64 << 10;
+// Requests served on one keep-alive connection before it is closed.
+constexpr int kRequestsPerConnection = 100;
+
+int http_status_of(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kInvalidInput:
+      return 400;
+    case ErrorCode::kNotFound:
+      return 404;
+    case ErrorCode::kFailedPrecondition:
+      return 409;
+    case ErrorCode::kResourceExhausted:
+      return 429;
+    case ErrorCode::kCancelled:
+    case ErrorCode::kDeadlineExceeded:
+      return 503;
+    default:
+      return 500;
+  }
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (const unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += char(c);
+    } else if (c < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += char(c);
+    }
+  }
+  return out + "\"";
+}
+
+void send_error(httplib::Response& response, int status, const std::string& message) {
+  response.status = status;
+  response.set_content("{\"error\": " + json_string(message) + "}\n", "application/json");
+}
+
+std::string job_json(const parapm::v1::Job& job) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.preserve_proto_field_names = true;
+  options.always_print_primitive_fields = true;
+  std::string out;
+  if (!google::protobuf::util::MessageToJsonString(job, &out, options).ok())
+    throw_internal("a job does not print as JSON");
+  return out;
+}
+
+// A job id as the API makes them: short, of letters, digits and '-'. Anything else is refused
+// before it reaches the store.
+bool plausible_id(const std::string& id) {
+  return !id.empty() && id.size() <= 64 && std::all_of(id.begin(), id.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
+  });
+}
+
+// Splits "host:port" (host may be [v6]); throws Error(kInvalidInput).
+std::pair<std::string, int> host_and_port(const std::string& listen) {
+  const size_t colon = listen.rfind(':');
+  if (colon == std::string::npos || colon + 1 == listen.size())
+    throw_invalid("--http wants host:port, got '" + listen + "'");
+  std::string host = listen.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
+    host = host.substr(1, host.size() - 2);
+  int port = -1;
+  try {
+    port = std::stoi(listen.substr(colon + 1));
+  } catch (const std::exception&) {
+  }
+  if (port < 0 || port > 65535) throw_invalid("--http: bad port in '" + listen + "'");
+  return {host.empty() ? "0.0.0.0" : host, port};
+}
+
+}  // namespace
+
+ViewerServer::ViewerServer(Coordinator& coordinator, ViewerConfig config)
+    : coordinator_(coordinator), config_(std::move(config)) {
+  host_and_port(config_.listen);  // checked now
+  if (config_.token.empty() && !rpc::is_loopback_address(config_.listen))
+    throw_invalid("refusing to serve the viewer on " + config_.listen +
+                  " without a token: beyond loopback every request needs one (--token-file FILE "
+                  "or PARAPM_TOKEN)");
+  if (config_.tls.server_enabled()) {
+    server_ = std::make_unique<httplib::SSLServer>(config_.tls.cert_file.c_str(),
+                                                   config_.tls.key_file.c_str());
+    if (!server_->is_valid())
+      throw Error(ErrorCode::kInvalidInput, "--tls-cert / --tls-key: the viewer cannot use them");
+  } else {
+    server_ = std::make_unique<httplib::Server>();
+  }
+  const unsigned threads = std::max(1u, config_.threads);
+  server_->new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  server_->set_read_timeout(std::chrono::seconds(config_.read_timeout_s));
+  server_->set_write_timeout(std::chrono::seconds(config_.write_timeout_s));
+  server_->set_keep_alive_max_count(kRequestsPerConnection);
+  server_->set_payload_max_length(4096);  // every route is a GET
+  add_routes();
+}
+
+ViewerServer::~ViewerServer() { stop(); }
+
+int ViewerServer::start() {
+  const auto [host, port] = host_and_port(config_.listen);
+  port_ = port == 0 ? server_->bind_to_any_port(host.c_str())
+                    : (server_->bind_to_port(host.c_str(), port) ? port : -1);
+  if (port_ <= 0) throw Error(ErrorCode::kIo, "the viewer cannot listen on " + config_.listen);
+  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  spdlog::info("viewer: {}{}", url(), config_.token.empty() ? "" : " (token required)");
+  return port_;
+}
+
+void ViewerServer::stop() {
+  if (!thread_.joinable()) return;
+  server_->stop();
+  thread_.join();
+}
+
+std::string ViewerServer::url() const {
+  return std::string(config_.tls.server_enabled() ? "https" : "http") + "://" +
+         rpc::reachable_address(config_.listen, port_) + "/";
+}
+
+void ViewerServer::add_routes() {
+  // Every response: no sniffing, scripts only from here.
+  server_->set_post_routing_handler([](const httplib::Request&, httplib::Response& response) {
+    response.set_header("X-Content-Type-Options", "nosniff");
+    response.set_header("Content-Security-Policy",
+                        "default-src 'self'; style-src 'self' 'unsafe-inline'");
+    response.set_header("Cache-Control", "no-store");
+  });
+  // The API's errors as JSON with their status; the authorisation first.
+  auto api = [this](auto handler) {
+    return [this, handler](const httplib::Request& request, httplib::Response& response) {
+      if (!config_.token.empty()) {
+        const std::string given = request.has_param("token")
+                                      ? request.get_param_value("token")
+                                      : request.get_header_value("Authorization");
+        if (given != config_.token && given != "Bearer " + config_.token)
+          return send_error(response, 401,
+                            given.empty() ? "this viewer needs a token: open the page with "
+                                            "#token=TOKEN, or send Authorization: Bearer TOKEN"
+                                          : "the token is not this coordinator's");
+      }
+      try {
+        handler(request, response);
+      } catch (const Error& e) {
+        send_error(response, http_status_of(e.code()), e.what());
+      } catch (const std::exception& e) {
+        spdlog::error("viewer: {} {}: {}", request.method, request.path, e.what());
+        send_error(response, 500, "internal error; the coordinator's log has the details");
+      }
+    };
+  };
+  auto job_id_of = [](const httplib::Request& request) {
+    const std::string id = request.matches[1];
+    if (!plausible_id(id)) throw_invalid("'" + id.substr(0, 64) + "' is not a job id");
+    return id;
+  };
+
+  server_->Get("/api/jobs", api([this](const httplib::Request&, httplib::Response& response) {
+                 std::string out = "{\"jobs\": [";
+                 bool first = true;
+                 for (const parapm::v1::Job& job : coordinator_.jobs(1000)) {
+                   out += first ? "\n" : ",\n";
+                   out += job_json(job);
+                   first = false;
+                 }
+                 response.set_content(out + "\n]}\n", "application/json");
+               }));
+  server_->Get(R"(/api/jobs/([^/]+))",
+               api([this, job_id_of](const httplib::Request& request, httplib::Response& response) {
+                 response.set_content(job_json(coordinator_.job(job_id_of(request))) + "\n",
+                                      "application/json");
+               }));
+  server_->Get(R"(/api/jobs/([^/]+)/pm)",
+               api([this, job_id_of](const httplib::Request& request, httplib::Response& response) {
+                 const std::shared_ptr<const LoadedPm> loaded = coordinator_.pm(job_id_of(request));
+                 response.set_header("X-ParaPM-Vsplits", std::to_string(loaded->pm.splits.size()));
+                 response.set_content_provider(
+                     loaded->bytes.size(), "application/octet-stream",
+                     [loaded](size_t offset, size_t length, httplib::DataSink& sink) {
+                       const size_t n = std::min(length, kStreamChunkBytes);
+                       return sink.write(loaded->bytes.data() + offset, n);
+                     });
+               }));
+  server_->Get(R"(/api/.*)", [](const httplib::Request& request, httplib::Response& response) {
+    send_error(response, 404, "no such route: " + request.path.substr(0, 200));
+  });
+  // The page's files.
+  server_->Get(R"(/([^/]*))", [](const httplib::Request& request, httplib::Response& response) {
+    std::string path = request.matches[1];
+    if (path.empty()) path = "index.html";
+    for (const ViewerAsset& asset : viewer_assets())
+      if (asset.path == path) {
+        response.set_content(std::string(asset.bytes), std::string(asset.content_type));
+        return;
+      }
+    send_error(response, 404, "no such file: " + path.substr(0, 200));
+  });
+}
+
+}  // namespace parapm::service

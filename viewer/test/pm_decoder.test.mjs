@@ -1,0 +1,113 @@
+// The JS decoder and mesh against the C++ writer and reader: every committed test mesh's PM
+// (built by `parapm simplify`), fed to the decoder in uneven pieces as a network would, gives
+// at several face counts, refining and coarsening, the faces `parapm lod` writes.
+// PARAPM_BIN: the parapm program (default: build/bin/parapm of this checkout).
+import {test} from 'node:test';
+import assert from 'node:assert/strict';
+import {execFileSync} from 'node:child_process';
+import {mkdtempSync, readFileSync, readdirSync, rmSync} from 'node:fs';
+import {tmpdir} from 'node:os';
+import {join, dirname} from 'node:path';
+import {fileURLToPath} from 'node:url';
+
+import {PmDecoder, PmFormatError} from '../pm_decoder.js';
+import {PmMesh} from '../pm_mesh.js';
+
+const root = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
+const parapm = process.env.PARAPM_BIN || join(root, 'build', 'bin', 'parapm');
+const meshes = readdirSync(join(root, 'tests', 'data')).filter((f) => /\.(ply|obj|stl|off)(\.gz)?$/.test(f));
+
+// An ASCII PLY written by parapm lod: its vertex count, its faces (a flat array of vertex ids)
+// and each face corner's position as float32 (a mesh with attributes has a PLY vertex per
+// wedge, so its ids are not the PM's vertices; the corners' positions compare either way).
+function readPly(path) {
+  const lines = readFileSync(path, 'utf8').split('\n');
+  let vertices = 0, faces = 0, i = 0;
+  for (; lines[i] !== 'end_header'; i++) {
+    const m = lines[i].match(/^element (vertex|face) (\d+)/);
+    if (m) m[1] === 'vertex' ? (vertices = +m[2]) : (faces = +m[2]);
+  }
+  const position = (v) => lines[i + 1 + v].trim().split(/\s+/).slice(0, 3).map(Math.fround);
+  const ids = [], corners = [];
+  for (let f = 0; f < faces; f++) {
+    const parts = lines[i + 1 + vertices + f].trim().split(/\s+/).map(Number);
+    for (const v of parts.slice(1, 4)) {
+      ids.push(v);
+      corners.push(...position(v));
+    }
+  }
+  return {vertices, faces: ids, corners};
+}
+
+function cornerPositions(mesh) {
+  const out = [];
+  for (let c = 0; c < 3 * mesh.faceCount; c++) {
+    const v = mesh.faces[c];
+    out.push(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
+  }
+  return out;
+}
+
+function decodeInPieces(bytes, seed) {
+  const decoder = new PmDecoder();
+  let state = seed;
+  for (let at = 0; at < bytes.length;) {
+    state = (state * 1103515245 + 12345) % 2147483648;
+    const n = 1 + (state % 4096);
+    decoder.push(bytes.subarray(at, at + n));
+    at += n;
+  }
+  return decoder;
+}
+
+for (const name of meshes) {
+  test(`${name}: the decoded levels are parapm lod's`, () => {
+    const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
+    try {
+      const pm = join(dir, 'x.pm');
+      execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', name), '-o', pm]);
+      const bytes = new Uint8Array(readFileSync(pm));
+      const decoder = decodeInPieces(bytes, name.length);
+      assert.ok(decoder.done, 'every split decoded');
+      const mesh = new PmMesh(decoder);
+      const h = decoder.header;
+      const counts = [h.baseFaces, Math.round(h.fullFaces * 0.1), Math.round(h.fullFaces * 0.5), h.fullFaces,
+        Math.round(h.fullFaces * 0.3), h.baseFaces];  // up, then down again
+      for (const count of counts) {
+        const level = join(dir, `l${count}.ply`);
+        execFileSync(parapm, ['--log-level', 'error', 'lod', pm, '--faces', String(count), '--ascii', '-o', level]);
+        const expected = readPly(level);
+        mesh.setLevel(mesh.levelForFaces(count));
+        assert.equal(mesh.faceCount * 3, expected.faces.length, `${count} faces`);
+        assert.deepEqual(cornerPositions(mesh), expected.corners, `${count} faces: the corners`);
+        if (!h.floatsPerWedge) {
+          assert.equal(mesh.vertexCount, expected.vertices, `${count} faces: vertices`);
+          assert.deepEqual(Array.from(mesh.faces.subarray(0, 3 * mesh.faceCount)), expected.faces);
+        }
+      }
+    } finally {
+      rmSync(dir, {recursive: true, force: true});
+    }
+  });
+}
+
+test('a damaged file is an error naming its byte, not a wrong mesh', () => {
+  const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
+  try {
+    const pm = join(dir, 'x.pm');
+    execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', 'cad-featuretype-3k.stl'), '-o', pm]);
+    const bytes = new Uint8Array(readFileSync(pm));
+    const wrongMagic = bytes.slice();
+    wrongMagic[1] ^= 0xff;
+    assert.throws(() => new PmDecoder().push(wrongMagic), PmFormatError);
+    const flipped = bytes.slice();
+    flipped[200] ^= 0x01;  // inside the base mesh: its CRC
+    assert.throws(() => new PmDecoder().push(flipped), /byte \d+/);
+    // Cut anywhere: what arrived decodes, nothing more, no error.
+    const decoder = new PmDecoder();
+    decoder.push(bytes.subarray(0, Math.floor(bytes.length / 2)));
+    assert.ok(decoder.splitCount > 0 && !decoder.done);
+  } finally {
+    rmSync(dir, {recursive: true, force: true});
+  }
+});

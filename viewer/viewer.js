@@ -1,0 +1,144 @@
+// The viewer page: the coordinator's job list at /, a job's Progressive Mesh at /#job=JOB
+// (with #token=TOKEN where the coordinator needs one). The job's .pm streams in
+// (GET /api/jobs/JOB/pm); its base mesh is drawn as soon as it has arrived, then refined
+// split by split as the records arrive; the slider moves through the levels without
+// re-fetching. For scripts and tests, window.parapmViewer holds the state (docs/VIEWER.md).
+import {PmDecoder} from './pm_decoder.js';
+import {PmMesh} from './pm_mesh.js';
+import {Renderer} from './renderer.js';
+
+const viewer = {
+  state: 'loading', // "loading", "streaming", "done", "error"
+  faces: 0,
+  vsplitsApplied: 0,
+  totalVsplits: 0,
+  bytesReceived: 0,
+  error: '',
+  setFaces: (n) => setFaces(n),
+  coverage: () => (renderer ? renderer.coverage() : 0), // the canvas's fraction the mesh covers
+};
+window.parapmViewer = viewer;
+
+const params = new URLSearchParams(location.hash.slice(1));
+const token = params.get('token') || '';
+const jobId = params.get('job');
+
+function api(path) {
+  return token ? `${path}?token=${encodeURIComponent(token)}` : path;
+}
+
+async function errorOf(response) {
+  try {
+    return (await response.json()).error || `HTTP ${response.status}`;
+  } catch {
+    return `HTTP ${response.status} ${response.statusText}`;
+  }
+}
+
+function fail(message) {
+  viewer.state = 'error';
+  viewer.error = message;
+  document.getElementById(jobId ? 'message' : 'jobs-message').textContent = message;
+}
+
+// --- the job list ----------------------------------------------------------------------------
+async function showJobs() {
+  const response = await fetch(api('/api/jobs'));
+  if (!response.ok) return fail(await errorOf(response));
+  const {jobs} = await response.json();
+  const body = document.querySelector('#job-table tbody');
+  for (const job of jobs) {
+    const row = body.insertRow();
+    const link = document.createElement('a');
+    link.textContent = job.job_id;
+    link.href = `#job=${encodeURIComponent(job.job_id)}${token ? `&token=${encodeURIComponent(token)}` : ''}`;
+    row.insertCell().append(link);
+    for (const value of [job.state, job.input_faces, job.base_faces, job.vsplits, job.options?.metric ?? ''])
+      row.insertCell().textContent = String(value);
+  }
+  if (jobs.length === 0) document.getElementById('jobs-message').textContent = 'No jobs yet: parapm submit MESH';
+  viewer.state = 'done';
+}
+
+// --- a job's PM ------------------------------------------------------------------------------
+let decoder = null, mesh = null, renderer = null;
+let follow = true; // the level follows the stream while the slider is at its end
+let startTime = 0, dirty = false;
+const slider = document.getElementById('level');
+
+function setFaces(n) {
+  if (!mesh) return;
+  follow = false;
+  setLevel(mesh.levelForFaces(n));
+}
+
+function setLevel(level) {
+  mesh.setLevel(level);
+  slider.value = String(mesh.level);
+  dirty = true;
+  report();
+}
+
+function report() {
+  if (!mesh) return;
+  viewer.faces = mesh.faceCount;
+  viewer.vsplitsApplied = mesh.level;
+  const n = decoder.header.splits;
+  const error = mesh.level < decoder.splitCount ? decoder.error[mesh.level] : 0;
+  const seconds = (performance.now() - startTime) / 1000;
+  document.getElementById('stats').textContent =
+    `faces ${mesh.faceCount}  vsplits ${mesh.level} / ${n}  received ${viewer.bytesReceived} bytes` +
+    `  error bound ${error.toPrecision(3)}  ${Math.round(decoder.splitCount / Math.max(seconds, 1e-3))} vsplits/s`;
+}
+
+function frame() {
+  if (dirty && renderer) {
+    renderer.update(mesh);
+    dirty = false;
+  }
+  if (renderer) renderer.draw();
+  requestAnimationFrame(frame);
+}
+
+async function showJob() {
+  document.getElementById('jobs').style.display = 'none';
+  document.getElementById('view').style.display = 'block';
+  document.getElementById('title').textContent = `job ${jobId}`;
+  document.getElementById('back').href = token ? `#token=${encodeURIComponent(token)}` : '#';
+  document.getElementById('back').onclick = () => setTimeout(() => location.reload());
+  slider.oninput = () => {
+    follow = Number(slider.value) === decoder.splitCount;
+    setLevel(Number(slider.value));
+  };
+  document.getElementById('wireframe').onchange = (e) => {
+    if (renderer) renderer.wireframe = e.target.checked;
+    dirty = true;
+  };
+  startTime = performance.now();
+  const response = await fetch(api(`/api/jobs/${encodeURIComponent(jobId)}/pm`));
+  if (!response.ok) return fail(await errorOf(response));
+  const reader = response.body.getReader();
+  decoder = new PmDecoder();
+  requestAnimationFrame(frame);
+  for (;;) {
+    const {done, value} = await reader.read();
+    if (done) break;
+    viewer.bytesReceived += value.length;
+    decoder.push(value);
+    if (!mesh && decoder.base) {
+      mesh = new PmMesh(decoder);
+      viewer.totalVsplits = decoder.header.splits;
+      slider.max = String(decoder.header.splits);
+      renderer = new Renderer(document.getElementById('canvas'), decoder.header);
+      viewer.state = 'streaming';
+      dirty = true;
+    }
+    if (mesh && follow) setLevel(decoder.splitCount);
+    if (mesh) report();
+  }
+  if (!decoder.done) return fail(`the stream ended after ${viewer.bytesReceived} bytes, before the last vsplit`);
+  if (follow) setLevel(decoder.splitCount);
+  viewer.state = 'done';
+}
+
+(jobId ? showJob() : showJobs()).catch((e) => fail(e.message || String(e)));
