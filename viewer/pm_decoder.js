@@ -152,6 +152,7 @@ export class PmDecoder {
     return v;
   }
   #varint32() {
+    if (this.pos < this.length && this.bytes[this.pos] < 0x80) return this.bytes[this.pos++];
     let value = 0, shift = 0;
     for (let i = 0; i < 5; i++) {
       const byte = this.#u8();
@@ -286,15 +287,16 @@ export class PmDecoder {
     if (vl1 === 0 && vr1 === 0) throw new PmFormatError(start, `split ${i}: neither vl nor vr`);
     const error = this.#f32();
     if (!Number.isFinite(error) || error < 0) throw new PmFormatError(this.pos - 4, `split ${i}: bad error bound`);
-    const vsAfter = [0, 0, 0], vtAfter = [0, 0, 0];
-    const cur = this.current;
-    for (const target of [vsAfter, vtAfter])
-      for (let k = 0; k < 3; k++) {
-        const before = cur[3 * vs + k];
-        target[k] = h.float64
-          ? fromOrdinal64(ordinal64(before) + this.#zigzag64())
-          : fromOrdinal32(ordinal32(before) + this.#zigzag32());
-      }
+    // Into the record's slots at once: a record cut short is decoded again from its start.
+    const cur = this.current, after = this.vsAfter, vt = this.vtAfter;
+    for (let k = 0; k < 6; k++) {
+      const before = cur[3 * vs + (k % 3)];
+      const value = h.float64
+        ? fromOrdinal64(ordinal64(before) + this.#zigzag64())
+        : fromOrdinal32(ordinal32(before) + this.#zigzag32());
+      if (k < 3) after[3 * i + k] = value;
+      else vt[3 * i + k - 3] = value;
+    }
     let attributes = null;
     if (h.floatsPerWedge) attributes = this.#parseSplitAttributes(i, vl1 !== 0, vr1 !== 0);
     // The record is whole: commit.
@@ -303,10 +305,8 @@ export class PmDecoder {
     this.vr[i] = vr1 - 1;
     this.error[i] = error;
     for (let k = 0; k < 3; k++) {
-      this.vsAfter[3 * i + k] = vsAfter[k];
-      this.vtAfter[3 * i + k] = vtAfter[k];
-      cur[3 * vs + k] = vsAfter[k];
-      cur[3 * V + k] = vtAfter[k];
+      cur[3 * vs + k] = after[3 * i + k];
+      cur[3 * V + k] = vt[3 * i + k];
     }
     if (attributes) {
       this.attributeRecords[i] = attributes;

@@ -29,8 +29,15 @@ export class PmMesh {
     for (let f = 0; f < h.baseFaces; f++)
       for (let k = 0; k < 3; k++) this.vertexFaces[base.faces[3 * f + k]].push(f);
     // Per split applied: the faces it moved to vt, and where vs was (to undo it).
-    this.fans = new Array(h.splits);
+    // The faces each split moved to vt, for undoing it: split i's are
+    // fanPool[fanStart[i] .. fanStart[i + 1]) (splits apply in order, so the pool grows in order).
+    this.fanStart = new Uint32Array(h.splits + 1);
+    this.fanPool = new Uint32Array(Math.max(16, 6 * h.splits));
     this.vsBefore = new Float32Array(3 * h.splits);
+    // Scratch of #split: the ring of vs (a and b of each face) and the faces taken.
+    this.ringA = new Int32Array(64);
+    this.ringB = new Int32Array(64);
+    this.taken = new Uint8Array(64);
   }
 
   get vertexCount() {
@@ -70,55 +77,86 @@ export class PmMesh {
     return t[3 * f] === v ? 0 : t[3 * f + 1] === v ? 1 : 2;
   }
 
+  // Where the faces of vs (rotated to start at vs: (vs, a, b)) hold `value` as a (b): the
+  // first such face's index in the ring, or -1. A ring has a handful of faces.
+  #findIn(keys, n, value) {
+    for (let j = 0; j < n; j++) if (keys[j] === value) return j;
+    return -1;
+  }
+
   #split(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
-    const t = this.faces, ring = this.vertexFaces[vs];
-    // (a, b) of each face of vs, rotated to start at vs.
-    const a = new Array(ring.length), b = new Array(ring.length);
-    for (let j = 0; j < ring.length; j++) {
-      const f = ring[j], k = this.#corner(f, vs);
-      a[j] = t[3 * f + ((k + 1) % 3)];
-      b[j] = t[3 * f + ((k + 2) % 3)];
+    const t = this.faces, ring = this.vertexFaces[vs], n = ring.length;
+    if (this.ringA.length < n) {
+      this.ringA = new Int32Array(2 * n);
+      this.ringB = new Int32Array(2 * n);
+      this.taken = new Uint8Array(2 * n);
     }
-    const taken = new Uint8Array(ring.length);
+    const a = this.ringA, b = this.ringB, taken = this.taken;
+    for (let j = 0; j < n; j++) {
+      const f = ring[j], k = this.#corner(f, vs);
+      a[j] = t[3 * f + (k === 2 ? 0 : k + 1)];
+      b[j] = t[3 * f + (k === 0 ? 2 : k - 1)];
+      taken[j] = 0;
+    }
     const fan = [];
     let hitBoundary = true;
     if (vr >= 0) {
-      let j = a.indexOf(vr);
+      let j = this.#findIn(a, n, vr);
       hitBoundary = j < 0;
       while (j >= 0) {
         if (taken[j]) throw new Error(`split ${i}: the fan around ${vs} does not close`);
         taken[j] = 1;
         fan.push(ring[j]);
         if (vl >= 0 && b[j] === vl) break;
-        j = a.indexOf(b[j]);
+        j = this.#findIn(a, n, b[j]);
         if (j < 0) hitBoundary = true;
       }
     }
     if (vl >= 0 && hitBoundary) {
-      let j = b.indexOf(vl);
+      let j = this.#findIn(b, n, vl);
       while (j >= 0) {
         if (taken[j]) throw new Error(`split ${i}: the fan around ${vs} never reaches a boundary`);
         taken[j] = 1;
         fan.push(ring[j]);
-        j = b.indexOf(a[j]);
+        j = this.#findIn(b, n, a[j]);
       }
     }
     for (const f of fan) t[3 * f + this.#corner(f, vs)] = vt;
-    this.vertexFaces[vs] = ring.filter((_, j) => !taken[j]);
-    this.vertexFaces[vt] = fan.slice();
-    const addFace = (p, q, r) => {
+    // Kept for undoing (before vt's list, which is `fan`, gains fl and fr).
+    const start = this.fanStart[i];
+    if (start + fan.length > this.fanPool.length) {
+      const grown = new Uint32Array(2 * (start + fan.length));
+      grown.set(this.fanPool);
+      this.fanPool = grown;
+    }
+    for (let j = 0; j < fan.length; j++) this.fanPool[start + j] = fan[j];
+    this.fanStart[i + 1] = start + fan.length;
+
+    // The fan leaves vs (in place, keeping the order of the rest).
+    let kept = 0;
+    for (let j = 0; j < n; j++) if (!taken[j]) ring[kept++] = ring[j];
+    ring.length = kept;
+    this.vertexFaces[vt] = fan;
+    const faceList = this.vertexFaces;
+    if (vl >= 0) {
       const f = this.faceCount++;
-      t[3 * f] = p;
-      t[3 * f + 1] = q;
-      t[3 * f + 2] = r;
-      this.vertexFaces[p].push(f);
-      this.vertexFaces[q].push(f);
-      this.vertexFaces[r].push(f);
-    };
-    if (vl >= 0) addFace(vs, vt, vl);
-    if (vr >= 0) addFace(vt, vs, vr);
-    this.fans[i] = fan;
+      t[3 * f] = vs;
+      t[3 * f + 1] = vt;
+      t[3 * f + 2] = vl;
+      ring.push(f);
+      faceList[vt].push(f);
+      faceList[vl].push(f);
+    }
+    if (vr >= 0) {
+      const f = this.faceCount++;
+      t[3 * f] = vt;
+      t[3 * f + 1] = vs;
+      t[3 * f + 2] = vr;
+      faceList[vt].push(f);
+      ring.push(f);
+      faceList[vr].push(f);
+    }
     const pos = this.positions;
     for (let k = 0; k < 3; k++) {
       this.vsBefore[3 * i + k] = pos[3 * vs + k];
@@ -132,11 +170,16 @@ export class PmMesh {
     const t = this.faces;
     const added = (vl >= 0 ? 1 : 0) + (vr >= 0 ? 1 : 0);
     const firstNew = this.faceCount - added;
-    const notNew = (f) => f < firstNew;
-    this.vertexFaces[vs] = this.vertexFaces[vs].filter(notNew);
-    if (vl >= 0) this.vertexFaces[vl] = this.vertexFaces[vl].filter(notNew);
-    if (vr >= 0) this.vertexFaces[vr] = this.vertexFaces[vr].filter(notNew);
-    for (const f of this.fans[i]) {
+    const dropNew = (list) => {
+      let kept = 0;
+      for (let j = 0; j < list.length; j++) if (list[j] < firstNew) list[kept++] = list[j];
+      list.length = kept;
+    };
+    dropNew(this.vertexFaces[vs]);
+    if (vl >= 0) dropNew(this.vertexFaces[vl]);
+    if (vr >= 0) dropNew(this.vertexFaces[vr]);
+    for (let j = this.fanStart[i]; j < this.fanStart[i + 1]; j++) {
+      const f = this.fanPool[j];
       t[3 * f + this.#corner(f, vt)] = vs;
       this.vertexFaces[vs].push(f);
     }

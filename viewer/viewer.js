@@ -16,6 +16,9 @@ const viewer = {
   error: '',
   setFaces: (n) => setFaces(n),
   coverage: () => (renderer ? renderer.coverage() : 0), // the canvas's fraction the mesh covers
+  // Milliseconds since the page's start (performance.now()) of the first frame with the base
+  // mesh and of the stream's end, and the seconds spent decoding and applying vsplits.
+  timings: {firstFrame: 0, done: 0, decodeSeconds: 0, applySeconds: 0},
 };
 window.parapmViewer = viewer;
 
@@ -73,7 +76,9 @@ function setFaces(n) {
 }
 
 function setLevel(level) {
+  const start = performance.now();
   mesh.setLevel(level);
+  viewer.timings.applySeconds += (performance.now() - start) / 1000;
   slider.value = String(mesh.level);
   dirty = true;
   report();
@@ -96,7 +101,10 @@ function frame() {
     renderer.update(mesh);
     dirty = false;
   }
-  if (renderer) renderer.draw();
+  if (renderer) {
+    renderer.draw();
+    if (!viewer.timings.firstFrame) viewer.timings.firstFrame = performance.now();
+  }
   requestAnimationFrame(frame);
 }
 
@@ -124,7 +132,9 @@ async function showJob() {
     const {done, value} = await reader.read();
     if (done) break;
     viewer.bytesReceived += value.length;
+    const start = performance.now();
     decoder.push(value);
+    viewer.timings.decodeSeconds += (performance.now() - start) / 1000;
     if (!mesh && decoder.base) {
       mesh = new PmMesh(decoder);
       viewer.totalVsplits = decoder.header.splits;
@@ -138,6 +148,7 @@ async function showJob() {
   }
   if (!decoder.done) return fail(`the stream ended after ${viewer.bytesReceived} bytes, before the last vsplit`);
   if (follow) setLevel(decoder.splitCount);
+  viewer.timings.done = performance.now();
   viewer.state = 'done';
 }
 

@@ -72,7 +72,7 @@ for (const name of meshes) {
       const mesh = new PmMesh(decoder);
       const h = decoder.header;
       const counts = [h.baseFaces, Math.round(h.fullFaces * 0.1), Math.round(h.fullFaces * 0.5), h.fullFaces,
-        Math.round(h.fullFaces * 0.3), h.baseFaces];  // up, then down again
+        Math.round(h.fullFaces * 0.3), h.baseFaces, Math.round(h.fullFaces * 0.7)];  // up, down, up again
       for (const count of counts) {
         const level = join(dir, `l${count}.ply`);
         execFileSync(parapm, ['--log-level', 'error', 'lod', pm, '--faces', String(count), '--ascii', '-o', level]);
