@@ -72,6 +72,35 @@ export class PmMesh {
     while (this.level > level) this.#unsplit(--this.level);
   }
 
+  // A geomorph between the level now and `level` (Hoppe 96, section 5): the mesh is left at
+  // the finer of the two, whose every vertex moves between its own position there
+  // (`finePositions`) and its ancestor's at the coarser level (`coarsePositions`: a vertex
+  // created by a split between the two levels descends from that split's vs), 3 floats per
+  // vertex of the finer level. Faces do not change during the morph: at t = 0 the fine faces
+  // around a split lie on the coarse surface, those a split adds with no area.
+  geomorph(level) {
+    level = Math.max(0, Math.min(level, this.decoder.splitCount));
+    const coarse = Math.min(this.level, level), fine = Math.max(this.level, level);
+    this.setLevel(coarse);
+    const atCoarse = this.positions.slice(0, 3 * (this.n0 + coarse));
+    this.setLevel(fine);
+    const n = this.n0 + fine;
+    const ancestor = new Uint32Array(n);
+    for (let v = 0; v < n; v++) ancestor[v] = v;
+    for (let i = coarse; i < fine; i++) ancestor[this.n0 + i] = ancestor[this.decoder.vs[i]];
+    const coarsePositions = new Float32Array(3 * n);
+    for (let v = 0; v < n; v++)
+      for (let k = 0; k < 3; k++) coarsePositions[3 * v + k] = atCoarse[3 * ancestor[v] + k];
+    return {coarse, fine, coarsePositions, finePositions: this.positions.slice(0, 3 * n)};
+  }
+
+  // The vertices of the level now at (1 - t) from + t to (geomorph()'s arrays).
+  morphPositions(from, to, t) {
+    const pos = this.positions, n = from.length;
+    if (t >= 1) return pos.set(to);  // exactly, not as rounded by the interpolation
+    for (let j = 0; j < n; j++) pos[j] = from[j] + (to[j] - from[j]) * t;
+  }
+
   #corner(f, v) {
     const t = this.faces;
     return t[3 * f] === v ? 0 : t[3 * f + 1] === v ? 1 : 2;

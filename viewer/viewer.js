@@ -14,7 +14,8 @@ const viewer = {
   totalVsplits: 0,
   bytesReceived: 0,
   error: '',
-  setFaces: (n) => setFaces(n),
+  setFaces: (n) => setFaces(n), // with the geomorph toggle on, a geomorph to that level
+  morphing: false,
   coverage: () => (renderer ? renderer.coverage() : 0), // the canvas's fraction the mesh covers
   // Milliseconds since the page's start (performance.now()) of the first frame with the base
   // mesh and of the stream's end, and the seconds spent decoding and applying vsplits.
@@ -72,7 +73,41 @@ const slider = document.getElementById('level');
 function setFaces(n) {
   if (!mesh) return;
   follow = false;
-  setLevel(mesh.levelForFaces(n));
+  moveTo(mesh.levelForFaces(n));
+}
+
+// To `level`: at once, or with the geomorph toggle on, by a geomorph of kGeomorphSeconds
+// (vertices move, faces do not pop). viewer.morphing is true while one runs.
+const kGeomorphSeconds = 0.5;
+let morph = null;
+function moveTo(level) {
+  if (morph) finishMorph();
+  if (!document.getElementById('geomorph').checked || level === mesh.level) return setLevel(level);
+  const refining = level > mesh.level;
+  const g = mesh.geomorph(level);
+  morph = {
+    target: level,
+    from: refining ? g.coarsePositions : g.finePositions,
+    to: refining ? g.finePositions : g.coarsePositions,
+    start: performance.now(),
+  };
+  viewer.morphing = true;
+  report();
+}
+
+function stepMorph() {
+  const t = Math.min(1, (performance.now() - morph.start) / 1000 / kGeomorphSeconds);
+  mesh.morphPositions(morph.from, morph.to, t);
+  dirty = true;
+  if (t >= 1) finishMorph();
+}
+
+function finishMorph() {
+  mesh.morphPositions(morph.from, morph.to, 1);
+  const target = morph.target;
+  morph = null;
+  viewer.morphing = false;
+  setLevel(target);  // a coarsening morph ends by undoing its splits
 }
 
 function setLevel(level) {
@@ -97,6 +132,7 @@ function report() {
 }
 
 function frame() {
+  if (morph) stepMorph();
   if (dirty && renderer) {
     renderer.update(mesh);
     dirty = false;
@@ -116,7 +152,7 @@ async function showJob() {
   document.getElementById('back').onclick = () => setTimeout(() => location.reload());
   slider.oninput = () => {
     follow = Number(slider.value) === decoder.splitCount;
-    setLevel(Number(slider.value));
+    moveTo(Number(slider.value));
   };
   document.getElementById('wireframe').onchange = (e) => {
     if (renderer) renderer.wireframe = e.target.checked;
@@ -143,10 +179,11 @@ async function showJob() {
       viewer.state = 'streaming';
       dirty = true;
     }
-    if (mesh && follow) setLevel(decoder.splitCount);
+    if (mesh && follow && !morph) setLevel(decoder.splitCount);
     if (mesh) report();
   }
   if (!decoder.done) return fail(`the stream ended after ${viewer.bytesReceived} bytes, before the last vsplit`);
+  if (morph) finishMorph();
   if (follow) setLevel(decoder.splitCount);
   viewer.timings.done = performance.now();
   viewer.state = 'done';

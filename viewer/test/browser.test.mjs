@@ -96,6 +96,16 @@ test('a job streams to its full mesh, and the slider gives parapm lod\'s levels'
     }, faces);
     assert.equal(shown, level.faces, `${faces} faces`);
   }
+  // With the geomorph toggle on, a level change animates, then shows that level.
+  await page.locator('#geomorph').check();
+  const level = JSON.parse(execFileSync(parapm, ['lod', join(dir, 'x.pm'), '--faces', '3000', '-o',
+    join(dir, 'l.ply'), '--json']).toString());
+  assert.equal(await page.evaluate(() => {
+    window.parapmViewer.setFaces(3000);
+    return window.parapmViewer.morphing;
+  }), true);
+  await page.waitForFunction(() => !window.parapmViewer.morphing, null, {timeout: 5000});
+  assert.equal(await page.evaluate(() => window.parapmViewer.faces), level.faces);
   // Something is drawn: the canvas is not all background.
   await page.waitForTimeout(200);
   const shot = await page.locator('#canvas').screenshot({path: process.env.VIEWER_SHOT || undefined});

@@ -111,3 +111,36 @@ test('a damaged file is an error naming its byte, not a wrong mesh', () => {
     rmSync(dir, {recursive: true, force: true});
   }
 });
+
+test('a geomorph starts on the coarse level\'s surface and ends on the fine level', () => {
+  const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
+  try {
+    const pm = join(dir, 'x.pm');
+    execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', 'gmsh-aneurysm-20k.stl.gz'), '-o', pm]);
+    const decoder = decodeInPieces(new Uint8Array(readFileSync(pm)), 7);
+    const mesh = new PmMesh(decoder);
+    const coarse = 2000, fine = 6000;
+    mesh.setLevel(coarse);
+    const coarseCorners = cornerPositions(mesh);
+    const g = mesh.geomorph(fine);
+    assert.equal(mesh.level, fine);
+    const fineCorners = cornerPositions(mesh);
+    // At t = 0 every face of the fine level lies on the coarse level: its corners are coarse
+    // vertices' positions, and the faces the splits add have no area.
+    mesh.morphPositions(g.coarsePositions, g.finePositions, 0);
+    const coarseSet = new Set();
+    for (let c = 0; c < coarseCorners.length; c += 3) coarseSet.add(coarseCorners.slice(c, c + 3).join(','));
+    const atStart = cornerPositions(mesh);
+    for (let c = 0; c < atStart.length; c += 3)
+      assert.ok(coarseSet.has(atStart.slice(c, c + 3).join(',')), `corner ${c / 3} is not a coarse vertex's position`);
+    mesh.morphPositions(g.coarsePositions, g.finePositions, 1);
+    assert.deepEqual(cornerPositions(mesh), fineCorners);
+    // Coarsening: the same arrays the other way, then the splits undone.
+    const back = mesh.geomorph(coarse);
+    mesh.morphPositions(back.finePositions, back.coarsePositions, 1);
+    mesh.setLevel(coarse);
+    assert.deepEqual(cornerPositions(mesh), coarseCorners);
+  } finally {
+    rmSync(dir, {recursive: true, force: true});
+  }
+});
