@@ -40,8 +40,9 @@ export class PmMesh {
     this.taken = new Uint8Array(64);
   }
 
+  // Vertices up to the highest id in use (a selective refinement's ids are not contiguous).
   get vertexCount() {
-    return this.n0 + this.level;
+    return this.n0 + (this.selective ? this.decoder.splitCount : this.level);
   }
 
   // Faces after `level` splits (the faces count of each split: 1 or 2).
@@ -70,6 +71,30 @@ export class PmMesh {
     level = Math.max(0, Math.min(level, this.decoder.splitCount));
     while (this.level < level) this.#split(this.level++);
     while (this.level > level) this.#unsplit(--this.level);
+  }
+
+  // Selective refinement (Hoppe 96 section 5, as engine/pm/selective_refinement.h): from the
+  // base mesh, every decoded split in order, applied where `refine(i, vs, x, y, z)` (vs's
+  // position now) says so and the split fits: vs, vl and vr present (a base vertex, or one a
+  // split applied created) and the fan rule finding its faces. A new PmMesh only (it leaves
+  // the sequence of levels: setLevel no longer applies). Returns the splits applied.
+  refineSelectively(refine) {
+    if (this.level !== 0 || this.selective) throw new Error('refineSelectively: on a fresh PmMesh only');
+    this.selective = true;
+    const d = this.decoder, present = new Uint8Array(d.header.fullVertices), pos = this.positions;
+    present.fill(1, 0, this.n0);
+    let applied = 0;
+    for (let i = 0; i < d.splitCount; i++) {
+      const vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
+      if (!present[vs] || (vl >= 0 && !present[vl]) || (vr >= 0 && !present[vr])) continue;
+      if (!refine(i, vs, pos[3 * vs], pos[3 * vs + 1], pos[3 * vs + 2])) continue;
+      const fan = this.#findFan(i);
+      if (typeof fan === 'string') continue;
+      this.#apply(i, fan);
+      present[this.n0 + i] = 1;
+      applied++;
+    }
+    return applied;
   }
 
   // A geomorph between the level now and `level` (Hoppe 96, section 5): the mesh is left at
@@ -113,8 +138,10 @@ export class PmMesh {
     return -1;
   }
 
-  #split(i) {
-    const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
+  // The faces of vs that split i moves to vt (the fan rule), or a string saying why it does not
+  // fit the mesh as it is (in a selective refinement, earlier skips change neighbourhoods).
+  #findFan(i) {
+    const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
     const t = this.faces, ring = this.vertexFaces[vs], n = ring.length;
     if (this.ringA.length < n) {
       this.ringA = new Int32Array(2 * n);
@@ -128,13 +155,16 @@ export class PmMesh {
       b[j] = t[3 * f + (k === 0 ? 2 : k - 1)];
       taken[j] = 0;
     }
+    for (const side of [vl, vr])
+      if (side >= 0 && this.#findIn(a, n, side) < 0 && this.#findIn(b, n, side) < 0)
+        return `${side} is not adjacent to ${vs}`;
     const fan = [];
     let hitBoundary = true;
     if (vr >= 0) {
       let j = this.#findIn(a, n, vr);
       hitBoundary = j < 0;
       while (j >= 0) {
-        if (taken[j]) throw new Error(`split ${i}: the fan around ${vs} does not close`);
+        if (taken[j]) return `the fan around ${vs} does not close`;
         taken[j] = 1;
         fan.push(ring[j]);
         if (vl >= 0 && b[j] === vl) break;
@@ -145,14 +175,24 @@ export class PmMesh {
     if (vl >= 0 && hitBoundary) {
       let j = this.#findIn(b, n, vl);
       while (j >= 0) {
-        if (taken[j]) throw new Error(`split ${i}: the fan around ${vs} never reaches a boundary`);
+        if (taken[j]) return `the fan around ${vs} never reaches a boundary`;
         taken[j] = 1;
         fan.push(ring[j]);
         j = this.#findIn(b, n, a[j]);
       }
     }
-    for (const f of fan) t[3 * f + this.#corner(f, vs)] = vt;
-    // Kept for undoing (before vt's list, which is `fan`, gains fl and fr).
+    return fan;
+  }
+
+  #split(i) {
+    const fan = this.#findFan(i);
+    if (typeof fan === 'string') throw new Error(`split ${i}: ${fan}`);
+    this.#keepFan(i, fan);
+    this.#apply(i, fan);
+  }
+
+  // Kept for undoing (before vt's list, which becomes `fan`, gains fl and fr).
+  #keepFan(i, fan) {
     const start = this.fanStart[i];
     if (start + fan.length > this.fanPool.length) {
       const grown = new Uint32Array(2 * (start + fan.length));
@@ -161,7 +201,13 @@ export class PmMesh {
     }
     for (let j = 0; j < fan.length; j++) this.fanPool[start + j] = fan[j];
     this.fanStart[i + 1] = start + fan.length;
+  }
 
+  // Split i with its fan (#findFan's; this.taken marks its faces in the ring of vs).
+  #apply(i, fan) {
+    const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
+    const t = this.faces, ring = this.vertexFaces[vs], n = ring.length, taken = this.taken;
+    for (const f of fan) t[3 * f + this.#corner(f, vs)] = vt;
     // The fan leaves vs (in place, keeping the order of the rest).
     let kept = 0;
     for (let j = 0; j < n; j++) if (!taken[j]) ring[kept++] = ring[j];

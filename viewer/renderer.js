@@ -130,15 +130,28 @@ export class Renderer {
     }
   }
 
-  // The fraction of the canvas's pixels the mesh covers (drawn now, read back): for tests.
-  coverage() {
+  // The canvas drawn now, read back (RGBA, bottom row first): for tests and benchmarks.
+  snapshot() {
     this.draw();
     const gl = this.gl, w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
     const pixels = new Uint8Array(4 * w * h);
     gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
+    return pixels;
+  }
+
+  // The fraction of the canvas's pixels the mesh covers (not the background's colour).
+  coverage() {
+    const pixels = this.snapshot();
     let covered = 0;
     for (let i = 0; i < pixels.length; i += 4) if (Math.abs(pixels[i] - 28) > 8) covered++;
-    return covered / (w * h);
+    return covered / (pixels.length / 4);
+  }
+
+  // What view-dependent refinement needs of the view: the view-projection matrix (column
+  // major), the projection's scale (1 / tan(fov / 2)) and the canvas's height in pixels.
+  view() {
+    return {viewProjection: this.#viewProjection(), scale: 1 / Math.tan((45 * Math.PI) / 360),
+      height: this.canvas.height || this.canvas.clientHeight * devicePixelRatio};
   }
 
   #viewProjection() {
@@ -179,10 +192,12 @@ export class Renderer {
       c.yaw -= (e.clientX - last[0]) * 0.01;
       c.pitch = Math.max(-1.5, Math.min(1.5, c.pitch + (e.clientY - last[1]) * 0.01));
       last = [e.clientX, e.clientY];
+      if (this.onCameraChange) this.onCameraChange();
     });
     canvas.addEventListener('wheel', (e) => {
       e.preventDefault();
       c.distance = Math.max(c.size * 0.05, c.distance * Math.exp(e.deltaY * 0.001));
+      if (this.onCameraChange) this.onCameraChange();
     }, {passive: false});
   }
 }

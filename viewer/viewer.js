@@ -16,7 +16,14 @@ const viewer = {
   error: '',
   setFaces: (n) => setFaces(n), // with the geomorph toggle on, a geomorph to that level
   morphing: false,
-  coverage: () => (renderer ? renderer.coverage() : 0), // the canvas's fraction the mesh covers
+  // View-dependent refinement (Hoppe 97): refine where a split's error projects to more than
+  // `thresholdPixels` on screen, inside the view; the faces follow the view.
+  viewDependent: false,
+  thresholdPixels: 2,
+  setViewDependent: (on, pixels) => setViewDependent(on, pixels),
+  zoom: (factor) => zoom(factor),
+  coverage: () => (renderer ? (upload(), renderer.coverage()) : 0), // the canvas's fraction the mesh covers
+  snapshot: () => (renderer ? (upload(), renderer.snapshot()) : null), // the canvas drawn now, RGBA
   // Milliseconds since the page's start (performance.now()) of the first frame with the base
   // mesh and of the stream's end, and the seconds spent decoding and applying vsplits.
   timings: {firstFrame: 0, done: 0, decodeSeconds: 0, applySeconds: 0},
@@ -95,6 +102,56 @@ function moveTo(level) {
   report();
 }
 
+// --- view-dependent refinement ----------------------------------------------------------------
+let selective = null, refineTimer = 0;
+
+function setViewDependent(on, pixels) {
+  viewer.viewDependent = on;
+  if (pixels !== undefined) viewer.thresholdPixels = pixels;
+  document.getElementById('view-dependent').checked = on;
+  document.getElementById('threshold').value = String(viewer.thresholdPixels);
+  slider.disabled = on;
+  if (on) refineForView();
+  else if (mesh) {
+    selective = null;
+    dirty = true;
+    report();
+  }
+}
+
+// A selective refinement of what has arrived, for the camera now: split i where vs is inside
+// the view (with a margin) and its level's error bound spans more than the threshold on screen.
+function refineForView() {
+  if (!viewer.viewDependent || !renderer || !decoder) return;
+  const {viewProjection: m, scale, height} = renderer.view();
+  const pixelsPerUnit = (scale * height) / 2, threshold = viewer.thresholdPixels, margin = 1.1;
+  const error = decoder.error;
+  const refined = new PmMesh(decoder);
+  refined.refineSelectively((i, vs, x, y, z) => {
+    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+    if (w <= 0) return false;
+    const cx = m[0] * x + m[4] * y + m[8] * z + m[12], cy = m[1] * x + m[5] * y + m[9] * z + m[13];
+    if (Math.abs(cx) > margin * w || Math.abs(cy) > margin * w) return false;
+    return (error[i] * pixelsPerUnit) / w > threshold;
+  });
+  selective = refined;
+  dirty = true;
+  report();
+}
+
+// Refined again once the camera rests (a refinement walks every split that has arrived).
+function cameraChanged() {
+  if (!viewer.viewDependent) return;
+  clearTimeout(refineTimer);
+  refineTimer = setTimeout(refineForView, 120);
+}
+
+function zoom(factor) {
+  renderer.camera.distance *= factor;
+  cameraChanged();
+  if (viewer.viewDependent) refineForView();
+}
+
 function stepMorph() {
   const t = Math.min(1, (performance.now() - morph.start) / 1000 / kGeomorphSeconds);
   mesh.morphPositions(morph.from, morph.to, t);
@@ -121,22 +178,29 @@ function setLevel(level) {
 
 function report() {
   if (!mesh) return;
-  viewer.faces = mesh.faceCount;
+  const shown = selective || mesh;
+  viewer.faces = shown.faceCount;
   viewer.vsplitsApplied = mesh.level;
   const n = decoder.header.splits;
   const error = mesh.level < decoder.splitCount ? decoder.error[mesh.level] : 0;
   const seconds = (performance.now() - startTime) / 1000;
   document.getElementById('stats').textContent =
-    `faces ${mesh.faceCount}  vsplits ${mesh.level} / ${n}  received ${viewer.bytesReceived} bytes` +
+    `faces ${shown.faceCount}${selective ? ' (view-dependent)' : ''}  vsplits ${mesh.level} / ${n}` +
+    `  received ${viewer.bytesReceived} bytes` +
     `  error bound ${error.toPrecision(3)}  ${Math.round(decoder.splitCount / Math.max(seconds, 1e-3))} vsplits/s`;
+}
+
+// The level shown into the renderer's buffers, when it changed.
+function upload() {
+  if (dirty && renderer) {
+    renderer.update(selective || mesh);
+    dirty = false;
+  }
 }
 
 function frame() {
   if (morph) stepMorph();
-  if (dirty && renderer) {
-    renderer.update(mesh);
-    dirty = false;
-  }
+  upload();
   if (renderer) {
     renderer.draw();
     if (!viewer.timings.firstFrame) viewer.timings.firstFrame = performance.now();
@@ -153,6 +217,11 @@ async function showJob() {
   slider.oninput = () => {
     follow = Number(slider.value) === decoder.splitCount;
     moveTo(Number(slider.value));
+  };
+  document.getElementById('view-dependent').onchange = (e) => setViewDependent(e.target.checked);
+  document.getElementById('threshold').oninput = (e) => {
+    viewer.thresholdPixels = Number(e.target.value);
+    cameraChanged();
   };
   document.getElementById('wireframe').onchange = (e) => {
     if (renderer) renderer.wireframe = e.target.checked;
@@ -176,6 +245,7 @@ async function showJob() {
       viewer.totalVsplits = decoder.header.splits;
       slider.max = String(decoder.header.splits);
       renderer = new Renderer(document.getElementById('canvas'), decoder.header);
+      renderer.onCameraChange = cameraChanged;
       viewer.state = 'streaming';
       dirty = true;
     }
@@ -185,6 +255,7 @@ async function showJob() {
   if (!decoder.done) return fail(`the stream ended after ${viewer.bytesReceived} bytes, before the last vsplit`);
   if (morph) finishMorph();
   if (follow) setLevel(decoder.splitCount);
+  if (viewer.viewDependent) refineForView();  // with every split
   viewer.timings.done = performance.now();
   viewer.state = 'done';
 }

@@ -106,6 +106,25 @@ test('a job streams to its full mesh, and the slider gives parapm lod\'s levels'
   }), true);
   await page.waitForFunction(() => !window.parapmViewer.morphing, null, {timeout: 5000});
   assert.equal(await page.evaluate(() => window.parapmViewer.faces), level.faces);
+  // View-dependent: fewer faces than the full mesh where the view needs no more, and the face
+  // count follows the view; the slider's levels come back when it is off.
+  await page.locator('#geomorph').uncheck();
+  const seen = await page.evaluate(() => {
+    const viewer = window.parapmViewer;
+    viewer.setFaces(1e9);
+    viewer.setViewDependent(true, 2);
+    const far = viewer.faces;
+    viewer.setViewDependent(true, 50);
+    const coarse = viewer.faces;
+    viewer.setViewDependent(true, 0.5);
+    const fine = viewer.faces;
+    viewer.setViewDependent(false);
+    return {far, coarse, fine, off: viewer.faces};
+  });
+  console.log('view-dependent faces at 2, 50 and 0.5 px, and off:', JSON.stringify(seen));
+  assert.ok(seen.coarse < seen.far && seen.far < seen.fine, JSON.stringify(seen));
+  assert.ok(seen.far < 8660 && seen.coarse >= 498, JSON.stringify(seen));
+  assert.equal(seen.off, 8660);
   // Something is drawn: the canvas is not all background.
   await page.waitForTimeout(200);
   const shot = await page.locator('#canvas').screenshot({path: process.env.VIEWER_SHOT || undefined});

@@ -144,3 +144,35 @@ test('a geomorph starts on the coarse level\'s surface and ends on the fine leve
     rmSync(dir, {recursive: true, force: true});
   }
 });
+
+test('selective refinement: everything is the full mesh, nothing the base, a region stays a valid mesh', () => {
+  const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
+  try {
+    const pm = join(dir, 'x.pm');
+    execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', 'stratocaster-9k.ply'), '-o', pm]);
+    const decoder = decodeInPieces(new Uint8Array(readFileSync(pm)), 3);
+    const full = new PmMesh(decoder);
+    full.setLevel(decoder.splitCount);
+    const all = new PmMesh(decoder);
+    assert.equal(all.refineSelectively(() => true), decoder.splitCount);
+    assert.deepEqual(cornerPositions(all), cornerPositions(full));
+    const none = new PmMesh(decoder);
+    assert.equal(none.refineSelectively(() => false), 0);
+    assert.equal(none.faceCount, decoder.header.baseFaces);
+    // Refined where x < 0 only: fewer faces than the full mesh, more than the base, and every
+    // edge of the result has at most two faces (no split applied out of its neighbourhood).
+    const half = new PmMesh(decoder);
+    half.refineSelectively((i, vs, x) => x < 0);
+    assert.ok(half.faceCount > decoder.header.baseFaces && half.faceCount < decoder.header.fullFaces);
+    const edges = new Map();
+    for (let f = 0; f < half.faceCount; f++)
+      for (let k = 0; k < 3; k++) {
+        const a = half.faces[3 * f + k], b = half.faces[3 * f + ((k + 1) % 3)];
+        const key = a < b ? `${a},${b}` : `${b},${a}`;
+        edges.set(key, (edges.get(key) || 0) + 1);
+      }
+    for (const [edge, count] of edges) assert.ok(count <= 2, `edge ${edge} has ${count} faces`);
+  } finally {
+    rmSync(dir, {recursive: true, force: true});
+  }
+});
