@@ -211,6 +211,9 @@ void ViewerServer::add_routes() {
   server_->Get(R"(/api/.*)", [](const httplib::Request& request, httplib::Response& response) {
     send_error(response, 404, "no such route: " + request.path.substr(0, 200));
   });
+  // Browsers ask for an icon on their own: none, without an error in the page's console.
+  server_->Get("/favicon.ico",
+               [](const httplib::Request&, httplib::Response& response) { response.status = 204; });
   // The page's files.
   server_->Get(R"(/([^/]*))", [](const httplib::Request& request, httplib::Response& response) {
     std::string path = request.matches[1];

@@ -11,8 +11,10 @@
 //            wedgeValues: Float32Array | null}
 //   splits (growing): vs, vl, vr (Int32Array, -1 for an absent vl / vr), error
 //            (Float32Array), vsAfter, vtAfter (Float64Array, 3 per split),
-//            with attributes: corner wedges (Int32Array, 6 per split, -1 absent), the new
-//            wedges' values and the changed wedges' values (attributeRecords).
+//            with attributes, attributeRecords[i]: {corners (6 corner wedges of fl (vs, vt,
+//            vl) then fr (vt, vs, vr), -1 absent), firstWedge and newWedges (the ids it
+//            introduces), newValues, changed (wedge ids), deltas (float32 ordinal deltas, fine
+//            - coarse) and fine (the changed wedges' values after the split)}.
 // Every check the C++ reader makes that the viewer's correctness needs is made here too:
 // magic, version, flags, counts, ids in range, the base CRC and the varints' lengths. A bad
 // byte throws PmFormatError naming its offset.
@@ -275,6 +277,12 @@ export class PmDecoder {
     this.current = new Float64Array(3 * h.fullVertices);
     this.current.set(positions);
     this.wedgeCount = w0;
+    // Every wedge's values as of the last decoded split (the coarse values the next split's
+    // changes are deltas from).
+    if (F) {
+      this.currentWedges = new Float32Array(F * Math.max(h.fullWedges, w0));
+      this.currentWedges.set(wedgeValues);
+    }
   }
 
   #parseSplit() {
@@ -309,6 +317,16 @@ export class PmDecoder {
       cur[3 * V + k] = vt[3 * i + k];
     }
     if (attributes) {
+      const F = h.floatsPerWedge, values = this.currentWedges;
+      if (F * (this.wedgeCount + attributes.newWedges) > values.length)
+        throw new PmFormatError(start, `split ${i}: more wedges than the header's ${h.fullWedges}`);
+      values.set(attributes.newValues, F * this.wedgeCount);
+      attributes.firstWedge = this.wedgeCount;
+      for (let c = 0; c < attributes.changed.length; c++)
+        for (let k = 0; k < F; k++) {
+          const at = F * attributes.changed[c] + k;
+          values[at] = attributes.fine[F * c + k] = fromOrdinal32(ordinal32(values[at]) + attributes.deltas[F * c + k]);
+        }
       this.attributeRecords[i] = attributes;
       this.wedgeCount += attributes.newWedges;
     }
@@ -344,7 +362,9 @@ export class PmDecoder {
       changed[c] = w;
       for (let k = 0; k < F; k++) deltas[c * F + k] = this.#zigzag32();
     }
-    return {corners, newWedges: introduced, newValues: Float32Array.from(newValues), changed, deltas};
+    // fine: the changed wedges' values after the split (filled when the record is committed).
+    return {corners, newWedges: introduced, newValues: Float32Array.from(newValues), changed, deltas,
+      fine: new Float32Array(changes * F), firstWedge: 0};
   }
 }
 

@@ -10,7 +10,9 @@
 // Positions: vs takes vsAfter, the new vertex vt = n0 + i vtAfter; undoing restores vs.
 //
 // Buffers for drawing: `positions` (Float32Array, 3 per vertex, every vertex the decoder has
-// reached), `faces` (Uint32Array, 3 per face; the first faceCount are the level's).
+// reached), `faces` (Uint32Array, 3 per face; the first faceCount are the level's), and with
+// attributes `cornerWedges` (3 per face) and `wedgeValues` (floatsPerWedge per wedge).
+import {fromOrdinal32, ordinal32} from './pm_decoder.js';
 
 export class PmMesh {
   constructor(decoder) {
@@ -23,6 +25,15 @@ export class PmMesh {
     this.faces = new Uint32Array(3 * h.fullFaces);
     this.faces.set(base.faces);
     this.faceCount = h.baseFaces;
+    // With attributes (F floats per wedge: normal, texture coordinate, colour, as present):
+    // each face corner's wedge, and every wedge's values at the level shown.
+    this.floatsPerWedge = h.floatsPerWedge;
+    if (h.floatsPerWedge) {
+      this.cornerWedges = new Uint32Array(3 * h.fullFaces);
+      this.cornerWedges.set(base.cornerWedges);
+      this.wedgeValues = new Float32Array(h.floatsPerWedge * Math.max(h.fullWedges, h.baseWedges));
+      this.wedgeValues.set(base.wedgeValues);
+    }
     // Per vertex, its faces (ids), as plain arrays: a vertex has a handful.
     this.vertexFaces = new Array(h.fullVertices);
     for (let v = 0; v < h.fullVertices; v++) this.vertexFaces[v] = [];
@@ -214,6 +225,7 @@ export class PmMesh {
     ring.length = kept;
     this.vertexFaces[vt] = fan;
     const faceList = this.vertexFaces;
+    if (this.floatsPerWedge) this.#applyWedges(i, vl >= 0, vr >= 0);
     if (vl >= 0) {
       const f = this.faceCount++;
       t[3 * f] = vs;
@@ -240,6 +252,21 @@ export class PmMesh {
     }
   }
 
+  // Split i's wedges: its new faces' corners (the faces are appended next, fl then fr), its
+  // new wedges' values, the changed wedges' fine values.
+  #applyWedges(i, hasFl, hasFr) {
+    const r = this.decoder.attributeRecords[i], F = this.floatsPerWedge, values = this.wedgeValues;
+    let f = this.faceCount;
+    for (const [present, first] of [[hasFl, 0], [hasFr, 3]]) {
+      if (!present) continue;
+      for (let k = 0; k < 3; k++) this.cornerWedges[3 * f + k] = r.corners[first + k];
+      f++;
+    }
+    values.set(r.newValues, F * r.firstWedge);
+    for (let c = 0; c < r.changed.length; c++)
+      for (let k = 0; k < F; k++) values[F * r.changed[c] + k] = r.fine[F * c + k];
+  }
+
   #unsplit(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
     const t = this.faces;
@@ -260,6 +287,15 @@ export class PmMesh {
     }
     this.vertexFaces[vt] = [];
     this.faceCount = firstNew;
+    if (this.floatsPerWedge) {
+      // The changed wedges back to their coarse values (exact: ordinal deltas).
+      const r = d.attributeRecords[i], F = this.floatsPerWedge, values = this.wedgeValues;
+      for (let c = 0; c < r.changed.length; c++)
+        for (let k = 0; k < F; k++) {
+          const at = F * r.changed[c] + k;
+          values[at] = fromOrdinal32(ordinal32(values[at]) - r.deltas[F * c + k]);
+        }
+    }
     const pos = this.positions;
     for (let k = 0; k < 3; k++) pos[3 * vs + k] = this.vsBefore[3 * i + k];
   }

@@ -1,25 +1,48 @@
-// Draws a PmMesh with WebGL2: flat-shaded faces (normals from the screen-space derivatives
-// of the position), an optional wireframe, an orbit camera (drag to turn, wheel to zoom)
-// framed on the PM's bounding box, which the header gives before any split arrives.
+// Draws a PmMesh with WebGL2: faces shaded by their normals (the PM's where it has them, else
+// flat from the screen-space derivatives of the position), coloured by the PM's colours or a
+// checker of its texture coordinates where it has them; an optional wireframe; an orbit camera
+// (drag to turn, wheel to zoom) framed on the PM's bounding box, which the header gives before
+// any split arrives. A PM without attributes is drawn indexed (a vertex per PM vertex), one
+// with attributes corner by corner (a corner's wedge holds its values).
 
 const VERTEX = `#version 300 es
 uniform mat4 viewProjection;
 in vec3 position;
+in vec3 normal;
+in vec2 uv;
+in vec4 color;
 out vec3 world;
-void main() { world = position; gl_Position = viewProjection * vec4(position, 1.0); }`;
+out vec3 vNormal;
+out vec2 vUv;
+out vec4 vColor;
+void main() {
+  world = position;
+  vNormal = normal;
+  vUv = uv;
+  vColor = color;
+  gl_Position = viewProjection * vec4(position, 1.0);
+}`;
 
 const FRAGMENT = `#version 300 es
 precision highp float;
 uniform vec3 light;
 uniform vec4 colour;
-uniform bool lines;
+uniform bool lines, hasNormal, hasUv, hasColor;
 in vec3 world;
+in vec3 vNormal;
+in vec2 vUv;
+in vec4 vColor;
 out vec4 outColour;
 void main() {
   if (lines) { outColour = colour; return; }
-  vec3 n = normalize(cross(dFdx(world), dFdy(world)));
+  vec3 n = hasNormal && dot(vNormal, vNormal) > 0.0 ? normalize(vNormal)
+                                                   : normalize(cross(dFdx(world), dFdy(world)));
+  vec3 base = colour.rgb;
+  if (hasColor) base = vColor.rgb;
+  else if (hasUv) base = mod(floor(vUv.x * 16.0) + floor(vUv.y * 16.0), 2.0) < 1.0
+                             ? vec3(0.92, 0.9, 0.85) : vec3(0.35, 0.45, 0.8);
   float lit = 0.25 + 0.75 * abs(dot(n, light));
-  outColour = vec4(colour.rgb * lit, 1.0);
+  outColour = vec4(base * lit, 1.0);
 }`;
 
 function compile(gl, type, source) {
@@ -54,16 +77,40 @@ export class Renderer {
     if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
     this.program = program;
     this.uniforms = {};
-    for (const name of ['viewProjection', 'light', 'colour', 'lines'])
+    for (const name of ['viewProjection', 'light', 'colour', 'lines', 'hasNormal', 'hasUv', 'hasColor'])
       this.uniforms[name] = gl.getUniformLocation(program, name);
     this.vao = gl.createVertexArray();
     gl.bindVertexArray(this.vao);
+    // With attributes, a GPU vertex per face corner.
+    this.layout = header.floatsPerWedge ? header.layout : null;
+    this.floatsPerWedge = header.floatsPerWedge;
+    const vertices = this.layout ? 3 * header.fullFaces : header.fullVertices;
     this.positionBuffer = gl.createBuffer();
     gl.bindBuffer(gl.ARRAY_BUFFER, this.positionBuffer);
-    gl.bufferData(gl.ARRAY_BUFFER, 4 * 3 * header.fullVertices, gl.DYNAMIC_DRAW);
+    gl.bufferData(gl.ARRAY_BUFFER, 4 * 3 * vertices, gl.DYNAMIC_DRAW);
     const location = gl.getAttribLocation(program, 'position');
     gl.enableVertexAttribArray(location);
     gl.vertexAttribPointer(location, 3, gl.FLOAT, false, 0, 0);
+    // The wedge values of each corner, interleaved as the PM keeps them: normal, uv, colour.
+    const F = this.floatsPerWedge;
+    let offset = 0;
+    if (this.layout) {
+      this.valueBuffer = gl.createBuffer();
+      gl.bindBuffer(gl.ARRAY_BUFFER, this.valueBuffer);
+      gl.bufferData(gl.ARRAY_BUFFER, 4 * F * vertices, gl.DYNAMIC_DRAW);
+    }
+    for (const [name, size, present] of [['normal', 3, this.layout?.normal], ['uv', 2, this.layout?.texcoord],
+      ['color', 4, this.layout?.color]]) {
+      const at = gl.getAttribLocation(program, name);
+      if (at < 0) continue;
+      if (present) {
+        gl.enableVertexAttribArray(at);
+        gl.vertexAttribPointer(at, size, gl.FLOAT, false, 4 * F, 4 * offset);
+        offset += size;
+      } else {
+        gl.disableVertexAttribArray(at);
+      }
+    }
     this.indexBuffer = gl.createBuffer();
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.indexBuffer);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, 4 * 3 * header.fullFaces, gl.DYNAMIC_DRAW);
@@ -79,6 +126,7 @@ export class Renderer {
 
   // The mesh's level into the buffers (the positions of every vertex reached, the level's faces).
   update(mesh) {
+    if (this.layout) return this.#updateCorners(mesh);
     const gl = this.gl;
     gl.bindVertexArray(this.vao);
     gl.bindBuffer(gl.ARRAY_BUFFER, this.positionBuffer);
@@ -93,6 +141,36 @@ export class Renderer {
           lines[6 * f + 2 * k] = mesh.faces[3 * f + k];
           lines[6 * f + 2 * k + 1] = mesh.faces[3 * f + ((k + 1) % 3)];
         }
+      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.lineBuffer);
+      gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, lines, gl.DYNAMIC_DRAW);
+      this.lineCount = lines.length;
+      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.indexBuffer);
+    }
+  }
+
+  // A PM with attributes: each corner's position and its wedge's values.
+  #updateCorners(mesh) {
+    const gl = this.gl, n = 3 * mesh.faceCount, F = this.floatsPerWedge;
+    const positions = new Float32Array(3 * n), values = new Float32Array(F * n);
+    for (let c = 0; c < n; c++) {
+      const v = mesh.faces[c], w = mesh.cornerWedges[c];
+      positions[3 * c] = mesh.positions[3 * v];
+      positions[3 * c + 1] = mesh.positions[3 * v + 1];
+      positions[3 * c + 2] = mesh.positions[3 * v + 2];
+      for (let k = 0; k < F; k++) values[F * c + k] = mesh.wedgeValues[F * w + k];
+    }
+    gl.bindVertexArray(this.vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.positionBuffer);
+    gl.bufferSubData(gl.ARRAY_BUFFER, 0, positions);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.valueBuffer);
+    gl.bufferSubData(gl.ARRAY_BUFFER, 0, values);
+    this.cornerCount = n;
+    if (this.wireframe) {
+      const lines = new Uint32Array(2 * n);
+      for (let c = 0; c < n; c++) {
+        lines[2 * c] = c;
+        lines[2 * c + 1] = c % 3 === 2 ? c - 2 : c + 1;
+      }
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.lineBuffer);
       gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, lines, gl.DYNAMIC_DRAW);
       this.lineCount = lines.length;
@@ -120,7 +198,11 @@ export class Renderer {
     gl.uniform4f(this.uniforms.colour, 0.85, 0.8, 0.7, 1);
     gl.enable(gl.POLYGON_OFFSET_FILL);
     gl.polygonOffset(1, 1);
-    gl.drawElements(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_INT, 0);
+    gl.uniform1i(this.uniforms.hasNormal, this.layout?.normal ? 1 : 0);
+    gl.uniform1i(this.uniforms.hasUv, this.layout?.texcoord ? 1 : 0);
+    gl.uniform1i(this.uniforms.hasColor, this.layout?.color ? 1 : 0);
+    if (this.layout) gl.drawArrays(gl.TRIANGLES, 0, this.cornerCount || 0);
+    else gl.drawElements(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_INT, 0);
     if (this.wireframe && this.lineCount) {
       gl.uniform1i(this.uniforms.lines, 1);
       gl.uniform4f(this.uniforms.colour, 0.1, 0.1, 0.1, 1);

@@ -1,6 +1,7 @@
 // The JS decoder and mesh against the C++ writer and reader: every committed test mesh's PM
-// (built by `parapm simplify`), fed to the decoder in uneven pieces as a network would, gives
-// at several face counts, refining and coarsening, the faces `parapm lod` writes.
+// (built by `parapm simplify --metric energy`), fed to the decoder in uneven pieces as a
+// network would, gives at several face counts, refining, coarsening and refining again, the
+// faces `parapm lod` writes, with their corners' attributes.
 // PARAPM_BIN: the parapm program (default: build/bin/parapm of this checkout).
 import {test} from 'node:test';
 import assert from 'node:assert/strict';
@@ -22,21 +23,60 @@ const meshes = readdirSync(join(root, 'tests', 'data')).filter((f) => /\.(ply|ob
 // wedge, so its ids are not the PM's vertices; the corners' positions compare either way).
 function readPly(path) {
   const lines = readFileSync(path, 'utf8').split('\n');
-  let vertices = 0, faces = 0, i = 0;
+  let vertices = 0, faces = 0, i = 0, element = '';
+  const properties = [];  // of a vertex, in order
   for (; lines[i] !== 'end_header'; i++) {
     const m = lines[i].match(/^element (vertex|face) (\d+)/);
-    if (m) m[1] === 'vertex' ? (vertices = +m[2]) : (faces = +m[2]);
+    if (m) {
+      element = m[1];
+      m[1] === 'vertex' ? (vertices = +m[2]) : (faces = +m[2]);
+    }
+    const p = lines[i].match(/^property (\w+) (\w+)$/);
+    if (p && element === 'vertex') properties.push(p[2]);
   }
-  const position = (v) => lines[i + 1 + v].trim().split(/\s+/).slice(0, 3).map(Math.fround);
-  const ids = [], corners = [];
+  const vertex = (v) => lines[i + 1 + v].trim().split(/\s+/).map(Number);
+  const position = (v) => vertex(v).slice(0, 3).map(Math.fround);
+  const ids = [], corners = [], attributes = [];
   for (let f = 0; f < faces; f++) {
     const parts = lines[i + 1 + vertices + f].trim().split(/\s+/).map(Number);
     for (const v of parts.slice(1, 4)) {
       ids.push(v);
       corners.push(...position(v));
+      const values = vertex(v);
+      const named = {};
+      properties.forEach((name, k) => (named[name] = values[k]));
+      attributes.push(named);
     }
   }
-  return {vertices, faces: ids, corners};
+  return {vertices, faces: ids, corners, attributes};
+}
+
+// The mesh's corners' attributes against the PLY's (normals and texture coordinates as
+// printed, colours as the bytes the writer rounds them to).
+function expectSameAttributes(mesh, layout, expected, what) {
+  const F = mesh.floatsPerWedge;
+  for (let c = 0; c < 3 * mesh.faceCount; c++) {
+    const w = mesh.cornerWedges[c], values = mesh.wedgeValues.subarray(F * w, F * w + F);
+    const ply = expected.attributes[c];
+    let k = 0;
+    const near = (a, b, name) =>
+      assert.ok(Math.abs(a - b) <= 2e-6 * Math.max(1, Math.abs(b)), `${what}: corner ${c} ${name} ${a} != ${b}`);
+    if (layout.normal) {
+      near(values[0], ply.nx, 'nx');
+      near(values[1], ply.ny, 'ny');
+      near(values[2], ply.nz, 'nz');
+      k = 3;
+    }
+    if (layout.texcoord) {
+      near(values[k], ply.s, 's');
+      near(values[k + 1], ply.t, 't');
+      k += 2;
+    }
+    if (layout.color)
+      ['red', 'green', 'blue', 'alpha'].forEach((name, j) =>
+        assert.ok(Math.abs(Math.round(Math.min(1, Math.max(0, values[k + j])) * 255) - ply[name]) <= 1,
+          `${what}: corner ${c} ${name} ${values[k + j]} against ${ply[name]}`));
+  }
 }
 
 function cornerPositions(mesh) {
@@ -65,7 +105,9 @@ for (const name of meshes) {
     const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
     try {
       const pm = join(dir, 'x.pm');
-      execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', name), '-o', pm]);
+      // The energy: its attributes' values change at splits (E_scalar), the quadric's do not.
+      execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', name), '-o', pm,
+        '--metric', 'energy']);
       const bytes = new Uint8Array(readFileSync(pm));
       const decoder = decodeInPieces(bytes, name.length);
       assert.ok(decoder.done, 'every split decoded');
@@ -83,6 +125,8 @@ for (const name of meshes) {
         if (!h.floatsPerWedge) {
           assert.equal(mesh.vertexCount, expected.vertices, `${count} faces: vertices`);
           assert.deepEqual(Array.from(mesh.faces.subarray(0, 3 * mesh.faceCount)), expected.faces);
+        } else {
+          expectSameAttributes(mesh, h.layout, expected, `${count} faces`);
         }
       }
     } finally {
