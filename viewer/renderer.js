@@ -27,7 +27,7 @@ const FRAGMENT = `#version 300 es
 precision highp float;
 uniform vec3 light;
 uniform vec4 colour;
-uniform bool lines, hasNormal, hasUv, hasColor;
+uniform bool lines, hasNormal, hasUv, hasColor, silhouette;
 in vec3 world;
 in vec3 vNormal;
 in vec2 vUv;
@@ -35,6 +35,7 @@ in vec4 vColor;
 out vec4 outColour;
 void main() {
   if (lines) { outColour = colour; return; }
+  if (silhouette) { outColour = vec4(1.0); return; }
   vec3 n = hasNormal && dot(vNormal, vNormal) > 0.0 ? normalize(vNormal)
                                                    : normalize(cross(dFdx(world), dFdy(world)));
   vec3 base = colour.rgb;
@@ -77,7 +78,7 @@ export class Renderer {
     if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
     this.program = program;
     this.uniforms = {};
-    for (const name of ['viewProjection', 'light', 'colour', 'lines', 'hasNormal', 'hasUv', 'hasColor'])
+    for (const name of ['viewProjection', 'light', 'colour', 'lines', 'hasNormal', 'hasUv', 'hasColor', 'silhouette'])
       this.uniforms[name] = gl.getUniformLocation(program, name);
     this.vao = gl.createVertexArray();
     gl.bindVertexArray(this.vao);
@@ -198,12 +199,13 @@ export class Renderer {
     gl.uniform4f(this.uniforms.colour, 0.85, 0.8, 0.7, 1);
     gl.enable(gl.POLYGON_OFFSET_FILL);
     gl.polygonOffset(1, 1);
+    gl.uniform1i(this.uniforms.silhouette, this.silhouette ? 1 : 0);
     gl.uniform1i(this.uniforms.hasNormal, this.layout?.normal ? 1 : 0);
     gl.uniform1i(this.uniforms.hasUv, this.layout?.texcoord ? 1 : 0);
     gl.uniform1i(this.uniforms.hasColor, this.layout?.color ? 1 : 0);
     if (this.layout) gl.drawArrays(gl.TRIANGLES, 0, this.cornerCount || 0);
     else gl.drawElements(gl.TRIANGLES, this.indexCount, gl.UNSIGNED_INT, 0);
-    if (this.wireframe && this.lineCount) {
+    if (this.wireframe && this.lineCount && !this.silhouette) {
       gl.uniform1i(this.uniforms.lines, 1);
       gl.uniform4f(this.uniforms.colour, 0.1, 0.1, 0.1, 1);
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.lineBuffer);
@@ -212,9 +214,12 @@ export class Renderer {
     }
   }
 
-  // The canvas drawn now, read back (RGBA, bottom row first): for tests and benchmarks.
-  snapshot() {
+  // The canvas drawn now, read back (RGBA, bottom row first): for tests and benchmarks. With
+  // `silhouette`, every face white and unlit, no wireframe.
+  snapshot(silhouette = false) {
+    this.silhouette = silhouette;
     this.draw();
+    this.silhouette = false;
     const gl = this.gl, w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
     const pixels = new Uint8Array(4 * w * h);
     gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, pixels);

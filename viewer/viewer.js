@@ -23,7 +23,13 @@ const viewer = {
   setViewDependent: (on, pixels) => setViewDependent(on, pixels),
   zoom: (factor) => zoom(factor),
   coverage: () => (renderer ? (upload(), renderer.coverage()) : 0), // the canvas's fraction the mesh covers
-  snapshot: () => (renderer ? (upload(), renderer.snapshot()) : null), // the canvas drawn now, RGBA
+  // The canvas drawn now, RGBA, bottom row first (silhouette: every face white, unlit).
+  snapshot: (silhouette = false) => (renderer ? (upload(), renderer.snapshot(silhouette)) : null),
+  // The camera: its view-projection matrix (column major) and the canvas's size in pixels.
+  view: () => {
+    const v = renderer.view();
+    return {viewProjection: Array.from(v.viewProjection), width: renderer.canvas.width, height: renderer.canvas.height};
+  },
   // Milliseconds since the page's start (performance.now()) of the first frame with the base
   // mesh and of the stream's end, and the seconds spent decoding and applying vsplits.
   timings: {firstFrame: 0, done: 0, decodeSeconds: 0, applySeconds: 0},

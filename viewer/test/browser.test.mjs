@@ -1,14 +1,14 @@
 // The viewer in a real browser against a real service: `parapm up` (a coordinator with its
 // viewer and a worker, on loopback, with a token), a real mesh submitted, its page opened in
 // headless Chromium (Debian's, WebGL through SwiftShader) with playwright-core. The page
-// streams the PM to the full mesh, its slider's levels are `parapm lod`'s, it draws something,
-// and a wrong job or token shows an error, not a blank page.
+// streams the PM to the full mesh, its slider's levels are `parapm lod`'s, the silhouette it
+// draws is that level's, and a wrong job or token shows an error, not a blank page.
 // PARAPM_BIN: the parapm program (default: build/bin/parapm); CHROMIUM: the browser (default
 // /usr/bin/chromium). Skipped, saying so, when the browser is missing.
 import {test, before, after} from 'node:test';
 import assert from 'node:assert/strict';
 import {spawn, execFileSync} from 'node:child_process';
-import {existsSync, mkdtempSync, rmSync, writeFileSync} from 'node:fs';
+import {existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync} from 'node:fs';
 import {tmpdir} from 'node:os';
 import {join, dirname} from 'node:path';
 import {fileURLToPath} from 'node:url';
@@ -69,6 +69,48 @@ after(async () => {
   if (dir) rmSync(dir, {recursive: true, force: true});
 });
 
+// The level `parapm lod ARGS OUT` writes, read back: its positions and faces (ASCII PLY).
+function readPly(path, name, args) {
+  execFileSync(parapm, [...args, path]);
+  const lines = readFileSync(path, 'utf8').split('\n');
+  let vertices = 0, faces = 0, i = 0;
+  for (; lines[i] !== 'end_header'; i++) {
+    const m = lines[i].match(/^element (vertex|face) (\d+)/);
+    if (m) m[1] === 'vertex' ? (vertices = +m[2]) : (faces = +m[2]);
+  }
+  const positions = [], triangles = [];
+  for (let v = 0; v < vertices; v++) positions.push(lines[i + 1 + v].trim().split(/\s+/).slice(0, 3).map(Number));
+  for (let f = 0; f < faces; f++) triangles.push(lines[i + 1 + vertices + f].trim().split(/\s+/).slice(1, 4).map(Number));
+  return {positions, triangles};
+}
+
+// A mask of the pixels (bottom row first, as WebGL reads them) whose centres lie inside a
+// face of `mesh` projected by the column-major matrix `m`.
+function rasterise(mesh, m, width, height) {
+  const mask = new Uint8Array(width * height);
+  const screen = mesh.positions.map(([x, y, z]) => {
+    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+    return [((m[0] * x + m[4] * y + m[8] * z + m[12]) / w + 1) * width / 2,
+      ((m[1] * x + m[5] * y + m[9] * z + m[13]) / w + 1) * height / 2];
+  });
+  for (const [a, b, c] of mesh.triangles) {
+    const p = screen[a], q = screen[b], r = screen[c];
+    const area = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+    if (area === 0) continue;
+    const x0 = Math.max(0, Math.floor(Math.min(p[0], q[0], r[0]))), x1 = Math.min(width - 1, Math.ceil(Math.max(p[0], q[0], r[0])));
+    const y0 = Math.max(0, Math.floor(Math.min(p[1], q[1], r[1]))), y1 = Math.min(height - 1, Math.ceil(Math.max(p[1], q[1], r[1])));
+    for (let y = y0; y <= y1; y++)
+      for (let x = x0; x <= x1; x++) {
+        const px = x + 0.5, py = y + 0.5;
+        const e0 = (q[0] - p[0]) * (py - p[1]) - (q[1] - p[1]) * (px - p[0]);
+        const e1 = (r[0] - q[0]) * (py - q[1]) - (r[1] - q[1]) * (px - q[0]);
+        const e2 = (p[0] - r[0]) * (py - r[1]) - (p[1] - r[1]) * (px - r[0]);
+        if (area > 0 ? e0 >= 0 && e1 >= 0 && e2 >= 0 : e0 <= 0 && e1 <= 0 && e2 <= 0) mask[y * width + x] = 1;
+      }
+  }
+  return mask;
+}
+
 async function open(fragment) {
   const page = await browser.newPage({viewport: {width: 640, height: 480}});
   const errors = [];
@@ -125,6 +167,29 @@ test('a job streams to its full mesh, and the slider gives parapm lod\'s levels'
   assert.ok(seen.coarse < seen.far && seen.far < seen.fine, JSON.stringify(seen));
   assert.ok(seen.far < 8660 && seen.coarse >= 498, JSON.stringify(seen));
   assert.equal(seen.off, 8660);
+  // The silhouette drawn is the level's: the page's pixels against the faces `parapm lod`
+  // writes for that level, rasterised here with the page's camera (pixel centres inside a
+  // projected face), as intersection over union.
+  const lod = readPly(join(dir, 'l.ply'), 'l5000', ['lod', join(dir, 'x.pm'), '--faces', '5000', '--ascii', '-o']);
+  const drawn = await page.evaluate(() => {
+    const viewer = window.parapmViewer;
+    viewer.setFaces(5000);
+    viewer.zoom(0.6);
+    const pixels = viewer.snapshot(true), view = viewer.view();
+    const mask = new Array(pixels.length / 4);
+    // Covered: more than half white (antialiased edges blend with the background).
+    for (let i = 0; i < mask.length; i++) mask[i] = pixels[4 * i] > 141 ? 1 : 0;
+    return {mask, ...view};
+  });
+  const reference = rasterise(lod, drawn.viewProjection, drawn.width, drawn.height);
+  let both = 0, either = 0;
+  for (let i = 0; i < reference.length; i++) {
+    both += reference[i] & drawn.mask[i];
+    either += reference[i] | drawn.mask[i];
+  }
+  console.log(`silhouette at 5000 faces: IoU ${(both / either).toFixed(4)} over ${either} pixels`);
+  assert.ok(either > 5000, 'a silhouette of some size');
+  assert.ok(both / either >= 0.98, `silhouette IoU ${both / either}`);
   // Something is drawn: the canvas is not all background.
   await page.waitForTimeout(200);
   const shot = await page.locator('#canvas').screenshot({path: process.env.VIEWER_SHOT || undefined});
