@@ -166,9 +166,8 @@ export class PmMesh {
       b[j] = t[3 * f + (k === 0 ? 2 : k - 1)];
       taken[j] = 0;
     }
-    for (const side of [vl, vr])
-      if (side >= 0 && this.#findIn(a, n, side) < 0 && this.#findIn(b, n, side) < 0)
-        return `${side} is not adjacent to ${vs}`;
+    if (vl >= 0 && this.#findIn(a, n, vl) < 0 && this.#findIn(b, n, vl) < 0) return `${vl} is not adjacent to ${vs}`;
+    if (vr >= 0 && this.#findIn(a, n, vr) < 0 && this.#findIn(b, n, vr) < 0) return `${vr} is not adjacent to ${vs}`;
     const fan = [];
     let hitBoundary = true;
     if (vr >= 0) {
@@ -267,19 +266,21 @@ export class PmMesh {
       for (let k = 0; k < F; k++) values[F * r.changed[c] + k] = r.fine[F * c + k];
   }
 
+  // Drops the faces numbered `first` and above from a vertex's list, in place.
+  static #dropFrom(list, first) {
+    let kept = 0;
+    for (let j = 0; j < list.length; j++) if (list[j] < first) list[kept++] = list[j];
+    list.length = kept;
+  }
+
   #unsplit(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
     const t = this.faces;
     const added = (vl >= 0 ? 1 : 0) + (vr >= 0 ? 1 : 0);
     const firstNew = this.faceCount - added;
-    const dropNew = (list) => {
-      let kept = 0;
-      for (let j = 0; j < list.length; j++) if (list[j] < firstNew) list[kept++] = list[j];
-      list.length = kept;
-    };
-    dropNew(this.vertexFaces[vs]);
-    if (vl >= 0) dropNew(this.vertexFaces[vl]);
-    if (vr >= 0) dropNew(this.vertexFaces[vr]);
+    PmMesh.#dropFrom(this.vertexFaces[vs], firstNew);
+    if (vl >= 0) PmMesh.#dropFrom(this.vertexFaces[vl], firstNew);
+    if (vr >= 0) PmMesh.#dropFrom(this.vertexFaces[vr], firstNew);
     for (let j = this.fanStart[i]; j < this.fanStart[i + 1]; j++) {
       const f = this.fanPool[j];
       t[3 * f + this.#corner(f, vt)] = vs;
