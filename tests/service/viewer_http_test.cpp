@@ -136,6 +136,33 @@ TEST_F(ViewerHttp, ParapmViewPrintsTheJobsAddress) {
   EXPECT_NE(unknown.output.find("no job"), std::string::npos) << unknown.output;
 }
 
+// With the coordinator's certificate the viewer is HTTPS, verified against it; plain HTTP to it
+// gets nothing.
+TEST_F(ViewerHttp, ServesHttpsWithTheCoordinatorsCertificate) {
+  const std::string cert = testing::test_data("tls/cert.pem");
+  const std::string key = testing::test_data("tls/key.pem");
+  service().start_coordinator({"--tls-cert", cert, "--tls-key", key, "--local-threads", "2",
+                               "--http", "127.0.0.1:0", "--http-port-file",
+                               (dir() / "viewer.port").string()});
+  int port = 0;
+  for (int i = 0; i < 200 && port == 0; ++i) {
+    std::ifstream in(dir() / "viewer.port");
+    if (!(in >> port)) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GT(port, 0);
+  httplib::SSLClient secure("localhost", port);
+  secure.set_ca_cert_path(cert.c_str());
+  secure.enable_server_certificate_verification(true);
+  const auto jobs = secure.Get("/api/jobs");
+  ASSERT_TRUE(jobs) << httplib::to_string(jobs.error());
+  EXPECT_EQ(jobs->status, 200);
+  EXPECT_NE(jobs->body.find("\"jobs\""), std::string::npos);
+  httplib::Client plain("127.0.0.1", port);
+  plain.set_read_timeout(std::chrono::seconds(5));
+  const auto refused = plain.Get("/api/jobs");
+  EXPECT_TRUE(!refused || refused->status >= 400);
+}
+
 TEST_F(ViewerHttp, BeyondLoopbackTheViewerNeedsAToken) {
   ChildProcess coordinator(
       "coordinator",
