@@ -4,7 +4,8 @@
 // whole PM (from the page's start), the seconds decoding and applying vsplits and the
 // vsplits applied per second of applying, and the time of slider moves of 100k vsplits down
 // and up again; view-dependent refinement at the default threshold against the full mesh in the
-// same view: its faces over the full mesh's, the fraction of pixels that differ, its time.
+// same view (THRESHOLD: another threshold in pixels): its faces over the full mesh's, the
+// fraction of pixels that differ, its time.
 // bench/viewer.sh drives it.
 import {chromium} from 'playwright-core';
 
@@ -28,12 +29,12 @@ try {
   });
   // View-dependent at the default threshold against the full mesh, same view: faces, and the
   // pixels whose colour differs by more than a few levels (antialiasing), over all pixels.
-  const view = await page.evaluate(() => {
+  const view = await page.evaluate((pixels) => {
     const viewer = window.parapmViewer;
     viewer.setFaces(1e12);
     const full = viewer.snapshot(), fullFaces = viewer.faces;
     const start = performance.now();
-    viewer.setViewDependent(true);
+    viewer.setViewDependent(true, pixels ?? undefined);
     const refineMs = performance.now() - start;
     const shown = viewer.snapshot();
     let differ = 0;
@@ -42,7 +43,7 @@ try {
     const faces = viewer.faces;
     viewer.setViewDependent(false);
     return {faces: faces / fullFaces, differ: differ / (full.length / 4), refineMs};
-  });
+  }, process.env.THRESHOLD ? Number(process.env.THRESHOLD) : null);
   const t = v.timings;
   console.log(['faces', 'vsplits', 'bytes', 'first_frame_s', 'done_s', 'decode_s', 'apply_s', 'vsplits_per_s',
     'slider_down_100k_ms', 'slider_up_100k_ms', 'view_dependent_faces', 'view_dependent_pixels_differing',
