@@ -12,6 +12,7 @@
 // Buffers for drawing: `positions` (Float32Array, 3 per vertex, every vertex the decoder has
 // reached), `faces` (Uint32Array, 3 per face; the first faceCount are the level's), and with
 // attributes `cornerWedges` (3 per face) and `wedgeValues` (floatsPerWedge per wedge).
+import {FaceLists} from './face_lists.js';
 import {fromOrdinal32, ordinal32} from './pm_decoder.js';
 
 export class PmMesh {
@@ -34,11 +35,10 @@ export class PmMesh {
       this.wedgeValues = new Float32Array(h.floatsPerWedge * Math.max(h.fullWedges, h.baseWedges));
       this.wedgeValues.set(base.wedgeValues);
     }
-    // Per vertex, its faces (ids), as plain arrays: a vertex has a handful.
-    this.vertexFaces = new Array(h.fullVertices);
-    for (let v = 0; v < h.fullVertices; v++) this.vertexFaces[v] = [];
+    // Per vertex, its faces (ids).
+    this.vertexFaces = new FaceLists(h.fullVertices, 3 * h.fullFaces);
     for (let f = 0; f < h.baseFaces; f++)
-      for (let k = 0; k < 3; k++) this.vertexFaces[base.faces[3 * f + k]].push(f);
+      for (let k = 0; k < 3; k++) this.vertexFaces.push(base.faces[3 * f + k], f);
     // Per split applied: the faces it moved to vt, and where vs was (to undo it).
     // The faces each split moved to vt, for undoing it: split i's are
     // fanPool[fanStart[i] .. fanStart[i + 1]) (splits apply in order, so the pool grows in order).
@@ -49,6 +49,7 @@ export class PmMesh {
     this.ringA = new Int32Array(64);
     this.ringB = new Int32Array(64);
     this.taken = new Uint8Array(64);
+    this.fan = new Int32Array(64);
   }
 
   // Vertices up to the highest id in use (a selective refinement's ids are not contiguous).
@@ -99,9 +100,9 @@ export class PmMesh {
       const vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
       if (!present[vs] || (vl >= 0 && !present[vl]) || (vr >= 0 && !present[vr])) continue;
       if (!refine(i, vs, pos[3 * vs], pos[3 * vs + 1], pos[3 * vs + 2])) continue;
-      const fan = this.#findFan(i);
-      if (typeof fan === 'string') continue;
-      this.#apply(i, fan);
+      const size = this.#findFan(i);
+      if (typeof size === 'string') continue;
+      this.#apply(i, size);
       present[this.n0 + i] = 1;
       applied++;
     }
@@ -149,34 +150,36 @@ export class PmMesh {
     return -1;
   }
 
-  // The faces of vs that split i moves to vt (the fan rule), or a string saying why it does not
-  // fit the mesh as it is (in a selective refinement, earlier skips change neighbourhoods).
+  // How many faces of vs split i moves to vt (the fan rule; the faces in this.fan, and marked in
+  // this.taken by their place in vs's list), or a string saying why it does not fit the mesh as
+  // it is (in a selective refinement, earlier skips change neighbourhoods).
   #findFan(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
-    const t = this.faces, ring = this.vertexFaces[vs], n = ring.length;
+    const t = this.faces, lists = this.vertexFaces, n = lists.count[vs];
     if (this.ringA.length < n) {
       this.ringA = new Int32Array(2 * n);
       this.ringB = new Int32Array(2 * n);
       this.taken = new Uint8Array(2 * n);
+      this.fan = new Int32Array(2 * n);
     }
-    const a = this.ringA, b = this.ringB, taken = this.taken;
+    const a = this.ringA, b = this.ringB, taken = this.taken, ring = lists.pool, s = lists.start[vs];
     for (let j = 0; j < n; j++) {
-      const f = ring[j], k = this.#corner(f, vs);
+      const f = ring[s + j], k = this.#corner(f, vs);
       a[j] = t[3 * f + (k === 2 ? 0 : k + 1)];
       b[j] = t[3 * f + (k === 0 ? 2 : k - 1)];
       taken[j] = 0;
     }
     if (vl >= 0 && this.#findIn(a, n, vl) < 0 && this.#findIn(b, n, vl) < 0) return `${vl} is not adjacent to ${vs}`;
     if (vr >= 0 && this.#findIn(a, n, vr) < 0 && this.#findIn(b, n, vr) < 0) return `${vr} is not adjacent to ${vs}`;
-    const fan = [];
-    let hitBoundary = true;
+    const fan = this.fan;
+    let size = 0, hitBoundary = true;
     if (vr >= 0) {
       let j = this.#findIn(a, n, vr);
       hitBoundary = j < 0;
       while (j >= 0) {
         if (taken[j]) return `the fan around ${vs} does not close`;
         taken[j] = 1;
-        fan.push(ring[j]);
+        fan[size++] = ring[s + j];
         if (vl >= 0 && b[j] === vl) break;
         j = this.#findIn(a, n, b[j]);
         if (j < 0) hitBoundary = true;
@@ -187,61 +190,61 @@ export class PmMesh {
       while (j >= 0) {
         if (taken[j]) return `the fan around ${vs} never reaches a boundary`;
         taken[j] = 1;
-        fan.push(ring[j]);
+        fan[size++] = ring[s + j];
         j = this.#findIn(b, n, a[j]);
       }
     }
-    return fan;
+    return size;
   }
 
   #split(i) {
-    const fan = this.#findFan(i);
-    if (typeof fan === 'string') throw new Error(`split ${i}: ${fan}`);
-    this.#keepFan(i, fan);
-    this.#apply(i, fan);
+    const size = this.#findFan(i);
+    if (typeof size === 'string') throw new Error(`split ${i}: ${size}`);
+    this.#keepFan(i, size);
+    this.#apply(i, size);
   }
 
-  // Kept for undoing (before vt's list, which becomes `fan`, gains fl and fr).
-  #keepFan(i, fan) {
+  // Kept for undoing.
+  #keepFan(i, size) {
     const start = this.fanStart[i];
-    if (start + fan.length > this.fanPool.length) {
-      const grown = new Uint32Array(2 * (start + fan.length));
+    if (start + size > this.fanPool.length) {
+      const grown = new Uint32Array(2 * (start + size));
       grown.set(this.fanPool);
       this.fanPool = grown;
     }
-    for (let j = 0; j < fan.length; j++) this.fanPool[start + j] = fan[j];
-    this.fanStart[i + 1] = start + fan.length;
+    this.fanPool.set(this.fan.subarray(0, size), start);
+    this.fanStart[i + 1] = start + size;
   }
 
-  // Split i with its fan (#findFan's; this.taken marks its faces in the ring of vs).
-  #apply(i, fan) {
+  // Split i with its fan (#findFan's: this.fan[0 .. size), marked in this.taken).
+  #apply(i, size) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
-    const t = this.faces, ring = this.vertexFaces[vs], n = ring.length, taken = this.taken;
-    for (const f of fan) t[3 * f + this.#corner(f, vs)] = vt;
-    // The fan leaves vs (in place, keeping the order of the rest).
-    let kept = 0;
-    for (let j = 0; j < n; j++) if (!taken[j]) ring[kept++] = ring[j];
-    ring.length = kept;
-    this.vertexFaces[vt] = fan;
-    const faceList = this.vertexFaces;
+    const t = this.faces, fan = this.fan, faceList = this.vertexFaces;
+    for (let j = 0; j < size; j++) {
+      const f = fan[j];
+      t[3 * f + this.#corner(f, vs)] = vt;
+    }
+    // The fan leaves vs (keeping the order of the rest) for vt.
+    faceList.compact(vs, this.taken);
+    faceList.assign(vt, fan, size);
     if (this.floatsPerWedge) this.#applyWedges(i, vl >= 0, vr >= 0);
     if (vl >= 0) {
       const f = this.faceCount++;
       t[3 * f] = vs;
       t[3 * f + 1] = vt;
       t[3 * f + 2] = vl;
-      ring.push(f);
-      faceList[vt].push(f);
-      faceList[vl].push(f);
+      faceList.push(vs, f);
+      faceList.push(vt, f);
+      faceList.push(vl, f);
     }
     if (vr >= 0) {
       const f = this.faceCount++;
       t[3 * f] = vt;
       t[3 * f + 1] = vs;
       t[3 * f + 2] = vr;
-      faceList[vt].push(f);
-      ring.push(f);
-      faceList[vr].push(f);
+      faceList.push(vt, f);
+      faceList.push(vs, f);
+      faceList.push(vr, f);
     }
     const pos = this.positions;
     for (let k = 0; k < 3; k++) {
@@ -266,27 +269,21 @@ export class PmMesh {
       for (let k = 0; k < F; k++) values[F * r.changed[c] + k] = r.fine[F * c + k];
   }
 
-  // Drops the faces numbered `first` and above from a vertex's list, in place.
-  static #dropFrom(list, first) {
-    let kept = 0;
-    for (let j = 0; j < list.length; j++) if (list[j] < first) list[kept++] = list[j];
-    list.length = kept;
-  }
-
   #unsplit(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
     const t = this.faces;
     const added = (vl >= 0 ? 1 : 0) + (vr >= 0 ? 1 : 0);
     const firstNew = this.faceCount - added;
-    PmMesh.#dropFrom(this.vertexFaces[vs], firstNew);
-    if (vl >= 0) PmMesh.#dropFrom(this.vertexFaces[vl], firstNew);
-    if (vr >= 0) PmMesh.#dropFrom(this.vertexFaces[vr], firstNew);
+    const lists = this.vertexFaces;
+    lists.dropFrom(vs, firstNew);
+    if (vl >= 0) lists.dropFrom(vl, firstNew);
+    if (vr >= 0) lists.dropFrom(vr, firstNew);
     for (let j = this.fanStart[i]; j < this.fanStart[i + 1]; j++) {
       const f = this.fanPool[j];
       t[3 * f + this.#corner(f, vt)] = vs;
-      this.vertexFaces[vs].push(f);
+      lists.push(vs, f);
     }
-    this.vertexFaces[vt] = [];
+    lists.count[vt] = 0;
     this.faceCount = firstNew;
     if (this.floatsPerWedge) {
       // The changed wedges back to their coarse values (exact: ordinal deltas).
