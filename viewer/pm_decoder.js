@@ -154,7 +154,32 @@ export class PmDecoder {
     return v;
   }
   #varint32() {
-    if (this.pos < this.length && this.bytes[this.pos] < 0x80) return this.bytes[this.pos++];
+    const b = this.bytes;
+    let p = this.pos;
+    if (p + 5 <= this.length) {
+      // The whole varint is here: no check per byte.
+      let byte = b[p++];
+      let value = byte & 0x7f;
+      if (byte & 0x80) {
+        byte = b[p++];
+        value |= (byte & 0x7f) << 7;
+        if (byte & 0x80) {
+          byte = b[p++];
+          value |= (byte & 0x7f) << 14;
+          if (byte & 0x80) {
+            byte = b[p++];
+            value |= (byte & 0x7f) << 21;
+            if (byte & 0x80) {
+              byte = b[p++];
+              if (byte >= 0x10) throw new PmFormatError(p - 1, 'varint overflows 32 bits');
+              value += byte * 268435456;
+            }
+          }
+        }
+      }
+      this.pos = p;
+      return value;
+    }
     let value = 0, shift = 0;
     for (let i = 0; i < 5; i++) {
       const byte = this.#u8();
