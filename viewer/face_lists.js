@@ -14,13 +14,13 @@ export class FaceLists {
   // Room for `need` faces at v (keeping its faces).
   reserve(v, need) {
     if (this.capacity[v] >= need) return;
-    const room = Math.max(need, 2 * this.capacity[v], 4);
+    const room = Math.max(need, 2 * this.capacity[v], 8);
     if (this.end + room > this.pool.length) {
       const grown = new Int32Array(Math.max(2 * this.pool.length, this.end + room));
       grown.set(this.pool.subarray(0, this.end));
       this.pool = grown;
     }
-    this.pool.copyWithin(this.end, this.start[v], this.start[v] + this.count[v]);
+    if (this.count[v]) this.pool.copyWithin(this.end, this.start[v], this.start[v] + this.count[v]);
     this.start[v] = this.end;
     this.capacity[v] = room;
     this.end += room;
@@ -34,8 +34,9 @@ export class FaceLists {
   // v's faces become `faces[0 .. n)`.
   assign(v, faces, n) {
     this.count[v] = 0;
-    this.reserve(v, n + 2);
-    this.pool.set(faces.subarray(0, n), this.start[v]);
+    this.reserve(v, n + 4);  // (a new vertex gains fl and fr at once, and more as its neighbours split)
+    const pool = this.pool, s = this.start[v];
+    for (let j = 0; j < n; j++) pool[s + j] = faces[j];
     this.count[v] = n;
   }
 

@@ -43,6 +43,7 @@ export class PmMesh {
     // The faces each split moved to vt, for undoing it: split i's are
     // fanPool[fanStart[i] .. fanStart[i + 1]) (splits apply in order, so the pool grows in order).
     this.fanStart = new Uint32Array(h.splits + 1);
+    this.fansKnown = 0;  // splits below this have their fans kept
     this.fanPool = new Uint32Array(Math.max(16, 6 * h.splits));
     this.vsBefore = new Float32Array(3 * h.splits);
     // Scratch of #split: the ring of vs (a and b of each face) and the faces taken.
@@ -198,9 +199,33 @@ export class PmMesh {
   }
 
   #split(i) {
+    if (i < this.fansKnown) return this.#redo(i);
     const size = this.#findFan(i);
     if (typeof size === 'string') throw new Error(`split ${i}: ${size}`);
     this.#keepFan(i, size);
+    this.fansKnown = i + 1;
+    this.#apply(i, size);
+  }
+
+  // Split i again after it was undone: the mesh is the level it was split at, so its fan is the
+  // one kept, not searched for again.
+  #redo(i) {
+    const d = this.decoder, vs = d.vs[i], lists = this.vertexFaces, pool = this.fanPool;
+    const first = this.fanStart[i], size = this.fanStart[i + 1] - first, n = lists.count[vs];
+    if (this.taken.length < n) {
+      this.ringA = new Int32Array(2 * n);
+      this.ringB = new Int32Array(2 * n);
+      this.taken = new Uint8Array(2 * n);
+      this.fan = new Int32Array(2 * n);
+    }
+    const taken = this.taken, fan = this.fan, ring = lists.pool, s = lists.start[vs];
+    for (let j = 0; j < size; j++) fan[j] = pool[first + j];
+    for (let j = 0; j < n; j++) {
+      const f = ring[s + j];
+      let inFan = 0;
+      for (let k = 0; k < size; k++) if (fan[k] === f) inFan = 1;
+      taken[j] = inFan;
+    }
     this.#apply(i, size);
   }
 
@@ -212,7 +237,8 @@ export class PmMesh {
       grown.set(this.fanPool);
       this.fanPool = grown;
     }
-    this.fanPool.set(this.fan.subarray(0, size), start);
+    const pool = this.fanPool, fan = this.fan;
+    for (let j = 0; j < size; j++) pool[start + j] = fan[j];
     this.fanStart[i + 1] = start + size;
   }
 
