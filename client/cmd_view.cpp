@@ -1,9 +1,11 @@
 // parapm view JOB: the address of the job's page in the coordinator's viewer (parapm-coordinator
 // --http; parapm up serves it at 127.0.0.1:50052), after checking that the job exists; opened
 // in the desktop's browser where there is one.
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 
 #include <unistd.h>
 

@@ -16,8 +16,8 @@ const viewer = {
   error: '',
   setFaces: (n) => setFaces(n), // with the geomorph toggle on, a geomorph to that level
   morphing: false,
-  // View-dependent refinement (Hoppe 97): refine where a split's error projects to more than
-  // `thresholdPixels` on screen, inside the view; the faces follow the view.
+  // View-dependent refinement (a selective refinement with view criteria): refine where a
+  // split's error bound projects to more than `thresholdPixels` on screen, inside the view.
   viewDependent: false,
   thresholdPixels: 2,
   setViewDependent: (on, pixels) => setViewDependent(on, pixels),
