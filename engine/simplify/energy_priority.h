@@ -136,7 +136,7 @@ class EnergyPriority : public PriorityModule {
   // that on average waits behind it.
   static constexpr double kTopologyPrice = 0.003;
 
-  static constexpr uint32_t kNoPoint = 0xffffffffu;
+  static constexpr uint32_t kNoPoint = 0xffffffffu;  // no point (a vertex without a parked sample)
 
   EnergyPriority(std::vector<uint8_t> locked, EnergyOptions options,
                  WedgeAttributes attributes = {})
