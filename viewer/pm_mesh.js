@@ -58,14 +58,6 @@ export class PmMesh {
     return this.n0 + (this.selective ? this.decoder.splitCount : this.level);
   }
 
-  // Faces after `level` splits (the faces count of each split: 1 or 2).
-  facesAt(level) {
-    const d = this.decoder;
-    let faces = d.header.baseFaces;
-    for (let i = 0; i < level; i++) faces += (d.vl[i] >= 0 ? 1 : 0) + (d.vr[i] >= 0 ? 1 : 0);
-    return faces;
-  }
-
   // The largest level (at most the splits decoded) with at most `faces` faces.
   levelForFaces(faces) {
     const d = this.decoder;
@@ -139,6 +131,15 @@ export class PmMesh {
     for (let j = 0; j < n; j++) pos[j] = from[j] + (to[j] - from[j]) * t;
   }
 
+  // Room in the split's scratch for a ring of n faces.
+  #scratchFor(n) {
+    if (this.taken.length >= n) return;
+    this.ringA = new Int32Array(2 * n);
+    this.ringB = new Int32Array(2 * n);
+    this.taken = new Uint8Array(2 * n);
+    this.fan = new Int32Array(2 * n);
+  }
+
   #corner(f, v) {
     const t = this.faces;
     return t[3 * f] === v ? 0 : t[3 * f + 1] === v ? 1 : 2;
@@ -157,12 +158,7 @@ export class PmMesh {
   #findFan(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
     const t = this.faces, lists = this.vertexFaces, n = lists.count[vs];
-    if (this.ringA.length < n) {
-      this.ringA = new Int32Array(2 * n);
-      this.ringB = new Int32Array(2 * n);
-      this.taken = new Uint8Array(2 * n);
-      this.fan = new Int32Array(2 * n);
-    }
+    this.#scratchFor(n);
     const a = this.ringA, b = this.ringB, taken = this.taken, ring = lists.pool, s = lists.start[vs];
     for (let j = 0; j < n; j++) {
       const f = ring[s + j], k = this.#corner(f, vs);
@@ -207,17 +203,23 @@ export class PmMesh {
     this.#apply(i, size);
   }
 
+  // Appends face (p, q, r) and lists it at its corners.
+  #addFace(p, q, r) {
+    const t = this.faces, lists = this.vertexFaces, f = this.faceCount++;
+    t[3 * f] = p;
+    t[3 * f + 1] = q;
+    t[3 * f + 2] = r;
+    lists.push(p, f);
+    lists.push(q, f);
+    lists.push(r, f);
+  }
+
   // Split i again after it was undone: the mesh is the level it was split at, so its fan is the
   // one kept, not searched for again.
   #redo(i) {
     const d = this.decoder, vs = d.vs[i], lists = this.vertexFaces, pool = this.fanPool;
     const first = this.fanStart[i], size = this.fanStart[i + 1] - first, n = lists.count[vs];
-    if (this.taken.length < n) {
-      this.ringA = new Int32Array(2 * n);
-      this.ringB = new Int32Array(2 * n);
-      this.taken = new Uint8Array(2 * n);
-      this.fan = new Int32Array(2 * n);
-    }
+    this.#scratchFor(n);
     const taken = this.taken, fan = this.fan, ring = lists.pool, s = lists.start[vs];
     for (let j = 0; j < size; j++) fan[j] = pool[first + j];
     for (let j = 0; j < n; j++) {
@@ -254,24 +256,8 @@ export class PmMesh {
     faceList.compact(vs, this.taken);
     faceList.assign(vt, fan, size);
     if (this.floatsPerWedge) this.#applyWedges(i, vl >= 0, vr >= 0);
-    if (vl >= 0) {
-      const f = this.faceCount++;
-      t[3 * f] = vs;
-      t[3 * f + 1] = vt;
-      t[3 * f + 2] = vl;
-      faceList.push(vs, f);
-      faceList.push(vt, f);
-      faceList.push(vl, f);
-    }
-    if (vr >= 0) {
-      const f = this.faceCount++;
-      t[3 * f] = vt;
-      t[3 * f + 1] = vs;
-      t[3 * f + 2] = vr;
-      faceList.push(vt, f);
-      faceList.push(vs, f);
-      faceList.push(vr, f);
-    }
+    if (vl >= 0) this.#addFace(vs, vt, vl);
+    if (vr >= 0) this.#addFace(vt, vs, vr);
     const pos = this.positions;
     for (let k = 0; k < 3; k++) {
       this.vsBefore[3 * i + k] = pos[3 * vs + k];
