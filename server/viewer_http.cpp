@@ -7,6 +7,7 @@
 
 #include <google/protobuf/util/json_util.h>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include "coordinator.h"
 #include "rpc_server.h"
@@ -39,26 +40,13 @@ int http_status_of(ErrorCode code) {
   }
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const unsigned char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += char(c);
-    } else if (c < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
-      out += escaped;
-    } else {
-      out += char(c);
-    }
-  }
-  return out + "\"";
-}
-
 void send_error(httplib::Response& response, int status, const std::string& message) {
   response.status = status;
-  response.set_content("{\"error\": " + json_string(message) + "}\n", "application/json");
+  // (Bytes of a request's path that are not UTF-8 are replaced, not passed on.)
+  response.set_content(nlohmann::json{{"error", message}}.dump(
+                           2, ' ', false, nlohmann::json::error_handler_t::replace) +
+                           "\n",
+                       "application/json");
 }
 
 std::string job_json(const parapm::v1::Job& job) {
