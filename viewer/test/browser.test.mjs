@@ -8,16 +8,15 @@
 import {test, before, after} from 'node:test';
 import assert from 'node:assert/strict';
 import {spawn, execFileSync} from 'node:child_process';
-import {existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync} from 'node:fs';
+import {existsSync, mkdtempSync, rmSync, writeFileSync} from 'node:fs';
 import {tmpdir} from 'node:os';
-import {join, dirname} from 'node:path';
-import {fileURLToPath} from 'node:url';
+import {join} from 'node:path';
 
-const root = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const parapm = process.env.PARAPM_BIN || join(root, 'build', 'bin', 'parapm');
+import {parapm, readPly, testMesh} from './support.mjs';
+
 const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
 const haveBrowser = existsSync(chromiumPath);
-const mesh = join(root, 'tests', 'data', 'stratocaster-9k.ply');
+const mesh = testMesh('stratocaster-9k.ply');
 const TOKEN = 'viewer-test-token';
 
 let dir, up, server, viewerUrl, browser, jobId;
@@ -68,21 +67,6 @@ after(async () => {
   }
   if (dir) rmSync(dir, {recursive: true, force: true});
 });
-
-// The level `parapm lod ARGS OUT` writes, read back: its positions and faces (ASCII PLY).
-function readPly(path, name, args) {
-  execFileSync(parapm, [...args, path]);
-  const lines = readFileSync(path, 'utf8').split('\n');
-  let vertices = 0, faces = 0, i = 0;
-  for (; lines[i] !== 'end_header'; i++) {
-    const m = lines[i].match(/^element (vertex|face) (\d+)/);
-    if (m) m[1] === 'vertex' ? (vertices = +m[2]) : (faces = +m[2]);
-  }
-  const positions = [], triangles = [];
-  for (let v = 0; v < vertices; v++) positions.push(lines[i + 1 + v].trim().split(/\s+/).slice(0, 3).map(Number));
-  for (let f = 0; f < faces; f++) triangles.push(lines[i + 1 + vertices + f].trim().split(/\s+/).slice(1, 4).map(Number));
-  return {positions, triangles};
-}
 
 // A mask of the pixels (bottom row first, as WebGL reads them) whose centres lie inside a
 // face of `mesh` projected by the column-major matrix `m`.
@@ -170,7 +154,10 @@ test('a job streams to its full mesh, and the slider gives parapm lod\'s levels'
   // The silhouette drawn is the level's: the page's pixels against the faces `parapm lod`
   // writes for that level, rasterised here with the page's camera (pixel centres inside a
   // projected face), as intersection over union.
-  const lod = readPly(join(dir, 'l.ply'), 'l5000', ['lod', join(dir, 'x.pm'), '--faces', '5000', '--ascii', '-o']);
+  execFileSync(parapm, ['lod', join(dir, 'x.pm'), '--faces', '5000', '--ascii', '-o', join(dir, 'l.ply')]);
+  const ply = readPly(join(dir, 'l.ply'));
+  const lod = {positions: ply.vertices.map((values) => values.slice(0, 3)), triangles: []};
+  for (let c = 0; c < ply.faces.length; c += 3) lod.triangles.push(ply.faces.slice(c, c + 3));
   const drawn = await page.evaluate(() => {
     const viewer = window.parapmViewer;
     viewer.setFaces(5000);

@@ -6,49 +6,29 @@
 import {test} from 'node:test';
 import assert from 'node:assert/strict';
 import {execFileSync} from 'node:child_process';
-import {mkdtempSync, readFileSync, readdirSync, rmSync} from 'node:fs';
-import {tmpdir} from 'node:os';
-import {join, dirname} from 'node:path';
-import {fileURLToPath} from 'node:url';
+import {readFileSync, readdirSync} from 'node:fs';
+import {join} from 'node:path';
 
 import {PmDecoder, PmFormatError} from '../pm_decoder.js';
 import {PmMesh} from '../pm_mesh.js';
+import {parapm, readPly, root, simplified, withTempDir} from './support.mjs';
 
-const root = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const parapm = process.env.PARAPM_BIN || join(root, 'build', 'bin', 'parapm');
 const meshes = readdirSync(join(root, 'tests', 'data')).filter((f) => /\.(ply|obj|stl|off)(\.gz)?$/.test(f));
 
-// An ASCII PLY written by parapm lod: its vertex count, its faces (a flat array of vertex ids)
-// and each face corner's position as float32 (a mesh with attributes has a PLY vertex per
+// The level `parapm lod` wrote: its vertex count, its faces, and per face corner its position
+// as float32 and its values by property name (a mesh with attributes has a PLY vertex per
 // wedge, so its ids are not the PM's vertices; the corners' positions compare either way).
-function readPly(path) {
-  const lines = readFileSync(path, 'utf8').split('\n');
-  let vertices = 0, faces = 0, i = 0, element = '';
-  const properties = [];  // of a vertex, in order
-  for (; lines[i] !== 'end_header'; i++) {
-    const m = lines[i].match(/^element (vertex|face) (\d+)/);
-    if (m) {
-      element = m[1];
-      m[1] === 'vertex' ? (vertices = +m[2]) : (faces = +m[2]);
-    }
-    const p = lines[i].match(/^property (\w+) (\w+)$/);
-    if (p && element === 'vertex') properties.push(p[2]);
+function lodLevel(path) {
+  const ply = readPly(path);
+  const corners = [], attributes = [];
+  for (const v of ply.faces) {
+    const values = ply.vertices[v];
+    corners.push(...values.slice(0, 3).map(Math.fround));
+    const named = {};
+    ply.properties.forEach((name, k) => (named[name] = values[k]));
+    attributes.push(named);
   }
-  const vertex = (v) => lines[i + 1 + v].trim().split(/\s+/).map(Number);
-  const position = (v) => vertex(v).slice(0, 3).map(Math.fround);
-  const ids = [], corners = [], attributes = [];
-  for (let f = 0; f < faces; f++) {
-    const parts = lines[i + 1 + vertices + f].trim().split(/\s+/).map(Number);
-    for (const v of parts.slice(1, 4)) {
-      ids.push(v);
-      corners.push(...position(v));
-      const values = vertex(v);
-      const named = {};
-      properties.forEach((name, k) => (named[name] = values[k]));
-      attributes.push(named);
-    }
-  }
-  return {vertices, faces: ids, corners, attributes};
+  return {vertices: ply.vertices.length, faces: ply.faces, corners, attributes};
 }
 
 // The mesh's corners' attributes against the PLY's (normals and texture coordinates as
@@ -101,45 +81,36 @@ function decodeInPieces(bytes, seed) {
 }
 
 for (const name of meshes) {
-  test(`${name}: the decoded levels are parapm lod's`, () => {
-    const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
-    try {
-      const pm = join(dir, 'x.pm');
-      // The energy: its attributes' values change at splits (E_scalar), the quadric's do not.
-      execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', name), '-o', pm,
-        '--metric', 'energy']);
-      const bytes = new Uint8Array(readFileSync(pm));
-      const decoder = decodeInPieces(bytes, name.length);
-      assert.ok(decoder.done, 'every split decoded');
-      const mesh = new PmMesh(decoder);
-      const h = decoder.header;
-      const counts = [h.baseFaces, Math.round(h.fullFaces * 0.1), Math.round(h.fullFaces * 0.5), h.fullFaces,
-        Math.round(h.fullFaces * 0.3), h.baseFaces, Math.round(h.fullFaces * 0.7)];  // up, down, up again
-      for (const count of counts) {
-        const level = join(dir, `l${count}.ply`);
-        execFileSync(parapm, ['--log-level', 'error', 'lod', pm, '--faces', String(count), '--ascii', '-o', level]);
-        const expected = readPly(level);
-        mesh.setLevel(mesh.levelForFaces(count));
-        assert.equal(mesh.faceCount * 3, expected.faces.length, `${count} faces`);
-        assert.deepEqual(cornerPositions(mesh), expected.corners, `${count} faces: the corners`);
-        if (!h.floatsPerWedge) {
-          assert.equal(mesh.vertexCount, expected.vertices, `${count} faces: vertices`);
-          assert.deepEqual(Array.from(mesh.faces.subarray(0, 3 * mesh.faceCount)), expected.faces);
-        } else {
-          expectSameAttributes(mesh, h.layout, expected, `${count} faces`);
-        }
+  test(`${name}: the decoded levels are parapm lod's`, () => withTempDir((dir) => {
+    // The energy: its attributes' values change at splits (E_scalar), the quadric's do not.
+    const pm = simplified(dir, name, '--metric', 'energy');
+    const bytes = new Uint8Array(readFileSync(pm));
+    const decoder = decodeInPieces(bytes, name.length);
+    assert.ok(decoder.done, 'every split decoded');
+    const mesh = new PmMesh(decoder);
+    const h = decoder.header;
+    const counts = [h.baseFaces, Math.round(h.fullFaces * 0.1), Math.round(h.fullFaces * 0.5), h.fullFaces,
+      Math.round(h.fullFaces * 0.3), h.baseFaces, Math.round(h.fullFaces * 0.7)];  // up, down, up again
+    for (const count of counts) {
+      const level = join(dir, `l${count}.ply`);
+      execFileSync(parapm, ['--log-level', 'error', 'lod', pm, '--faces', String(count), '--ascii', '-o', level]);
+      const expected = lodLevel(level);
+      mesh.setLevel(mesh.levelForFaces(count));
+      assert.equal(mesh.faceCount * 3, expected.faces.length, `${count} faces`);
+      assert.deepEqual(cornerPositions(mesh), expected.corners, `${count} faces: the corners`);
+      if (!h.floatsPerWedge) {
+        assert.equal(mesh.vertexCount, expected.vertices, `${count} faces: vertices`);
+        assert.deepEqual(Array.from(mesh.faces.subarray(0, 3 * mesh.faceCount)), expected.faces);
+      } else {
+        expectSameAttributes(mesh, h.layout, expected, `${count} faces`);
       }
-    } finally {
-      rmSync(dir, {recursive: true, force: true});
     }
-  });
+  }));
 }
 
 test('a damaged file is an error naming its byte, not a wrong mesh', () => {
-  const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
-  try {
-    const pm = join(dir, 'x.pm');
-    execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', 'cad-featuretype-3k.stl'), '-o', pm]);
+  withTempDir((dir) => {
+    const pm = simplified(dir, 'cad-featuretype-3k.stl');
     const bytes = new Uint8Array(readFileSync(pm));
     const wrongMagic = bytes.slice();
     wrongMagic[1] ^= 0xff;
@@ -151,16 +122,12 @@ test('a damaged file is an error naming its byte, not a wrong mesh', () => {
     const decoder = new PmDecoder();
     decoder.push(bytes.subarray(0, Math.floor(bytes.length / 2)));
     assert.ok(decoder.splitCount > 0 && !decoder.done);
-  } finally {
-    rmSync(dir, {recursive: true, force: true});
-  }
+  });
 });
 
 test('a geomorph starts on the coarse level\'s surface and ends on the fine level', () => {
-  const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
-  try {
-    const pm = join(dir, 'x.pm');
-    execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', 'gmsh-aneurysm-20k.stl.gz'), '-o', pm]);
+  withTempDir((dir) => {
+    const pm = simplified(dir, 'gmsh-aneurysm-20k.stl.gz');
     const decoder = decodeInPieces(new Uint8Array(readFileSync(pm)), 7);
     const mesh = new PmMesh(decoder);
     const coarse = 2000, fine = 6000;
@@ -184,16 +151,12 @@ test('a geomorph starts on the coarse level\'s surface and ends on the fine leve
     mesh.morphPositions(back.finePositions, back.coarsePositions, 1);
     mesh.setLevel(coarse);
     assert.deepEqual(cornerPositions(mesh), coarseCorners);
-  } finally {
-    rmSync(dir, {recursive: true, force: true});
-  }
+  });
 });
 
 test('selective refinement: everything is the full mesh, nothing the base, a region stays a valid mesh', () => {
-  const dir = mkdtempSync(join(tmpdir(), 'parapm-js-'));
-  try {
-    const pm = join(dir, 'x.pm');
-    execFileSync(parapm, ['--log-level', 'error', 'simplify', join(root, 'tests', 'data', 'stratocaster-9k.ply'), '-o', pm]);
+  withTempDir((dir) => {
+    const pm = simplified(dir, 'stratocaster-9k.ply');
     const decoder = decodeInPieces(new Uint8Array(readFileSync(pm)), 3);
     const full = new PmMesh(decoder);
     full.setLevel(decoder.splitCount);
@@ -216,7 +179,5 @@ test('selective refinement: everything is the full mesh, nothing the base, a reg
         edges.set(key, (edges.get(key) || 0) + 1);
       }
     for (const [edge, count] of edges) assert.ok(count <= 2, `edge ${edge} has ${count} faces`);
-  } finally {
-    rmSync(dir, {recursive: true, force: true});
-  }
+  });
 });
