@@ -718,11 +718,11 @@ void ParallelBuilder::merge(Round& r) {
 double ParallelBuilder::take_results(Round& r) {
   const auto tb = std::chrono::steady_clock::now();
   double import_saved = 0;  // what the imports side by side save with a core per state
+  std::vector<const std::vector<CollapseRecord>*> changes;  // each job's records
+  for (const std::vector<CollapseRecord>& list : r.lists) changes.push_back(&list);
   if (!parallel_.replay_state) {
     std::vector<const MetricState*> states;
     for (const SubsetResult& result : r.results) states.push_back(&result.state);
-    std::vector<const std::vector<CollapseRecord>*> changes;
-    for (const std::vector<CollapseRecord>& list : r.lists) changes.push_back(&list);
     const ImportTimes import = import_result_states(*master_, states, r.vertex_subset, face_subset_,
                                                     parallel_.threads, changes);
     import_saved = std::max(0.0, import.seconds - import.critical_seconds);
@@ -744,8 +744,6 @@ double ParallelBuilder::take_results(Round& r) {
   if (carry_deferred_) {
     // The deferred edges of the jobs' free vertices are the jobs' to report (a job holds
     // them all in its queue); the others stand unless a collapse changed an end.
-    std::vector<const std::vector<CollapseRecord>*> changes;
-    for (const std::vector<CollapseRecord>& list : r.lists) changes.push_back(&list);
     drop_changed(deferred_, whole_->vertex_capacity(), changes);
     // A job reports again what it was given and left as it was: its report first, so
     // that the stable sort keeps it.
