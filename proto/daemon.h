@@ -10,9 +10,12 @@
 namespace parapm::rpc {
 
 // Makes a logger named `program` the default (the engine's lines go there too), at `level`
-// ("trace", "debug", "info", "warn", "error", "off"). Throws Error(kInvalidInput) for an
-// unknown level.
-void set_up_logging(const std::string& program, const std::string& level);
+// ("trace", "debug", "info", "warn", "error", "off"), writing to stderr in `format`: "text"
+// (a line of time, program, level, message) or "json" (one object per line, for log
+// collectors: time in UTC, level, logger, message). Throws Error(kInvalidInput) for an
+// unknown level or format.
+void set_up_logging(const std::string& program, const std::string& level,
+                    const std::string& format = "text");
 
 // The token of a daemon listening on `listen` (rpc::load_token of `token_file`). Throws
 // Error(kInvalidInput) when there is none and `listen` reaches beyond loopback: every call

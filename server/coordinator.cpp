@@ -453,6 +453,21 @@ void Coordinator::scheduler_loop() {
   }
 }
 
+void Coordinator::refresh_metrics() {
+  const std::map<JobStatus, uint64_t> counts = store_.job_counts();
+  for (JobStatus status : {JobStatus::kQueued, JobStatus::kRunning, JobStatus::kDone,
+                           JobStatus::kFailed, JobStatus::kCancelled}) {
+    const auto found = counts.find(status);
+    metrics_.jobs.Add({{"state", to_string(status)}})
+        .Set(found == counts.end() ? 0.0 : double(found->second));
+  }
+  {
+    std::lock_guard lock(mutex_);
+    metrics_.queue_depth.Set(double(queue_.size()));
+  }
+  metrics_.workers_registered.Set(double(registry_.live_count()));
+}
+
 void Coordinator::run_job(const std::string& job_id) {
   JobRecord record = load_job(job_id);
   if (record.status != JobStatus::kQueued) return;  // cancelled meanwhile
@@ -481,6 +496,8 @@ void Coordinator::run_job(const std::string& job_id) {
     done->set_pm_sha256(record.pm_sha256);
     *done->mutable_transport() = transport;
     end_job(record, event);
+    metrics_.jobs_ended.Add({{"state", "done"}}).Increment();
+    metrics_.job_build_seconds.Observe(record.seconds);
     spdlog::info("job {} done: {} -> {} faces, {} vsplits in {:.3f} s", job_id, record.input_faces,
                  record.base_faces, record.vsplits, record.seconds);
   } catch (const Error& e) {
@@ -507,6 +524,7 @@ void Coordinator::run_job(const std::string& job_id) {
       record.seconds = seconds_since(start);
       record.updated_unix_ms = unix_ms_now();
       end_job(record, event);
+      metrics_.jobs_ended.Add({{"state", to_string(record.status)}}).Increment();
     }
   } catch (const std::exception& e) {
     record.status = JobStatus::kFailed;
@@ -515,6 +533,7 @@ void Coordinator::run_job(const std::string& job_id) {
     parapm::v1::JobEvent event;
     event.mutable_failed()->set_reason(record.failure_reason);
     end_job(record, event);
+    metrics_.jobs_ended.Add({{"state", "failed"}}).Increment();
     spdlog::error("job {} failed: {}", job_id, record.failure_reason);
   }
   {
@@ -555,7 +574,9 @@ void Coordinator::execute(JobRecord& record, Running& running,
   remote.local_threads = config_.local_threads;
   RemoteRunner runner(registry_, channels_, remote, [&](const SubsetEvent& e) {
     parapm::v1::JobEvent event;
+    if (e.kind == SubsetEvent::Kind::kRetry) metrics_.subsets_retried.Increment();
     if (e.kind == SubsetEvent::Kind::kStarted) {
+      metrics_.subsets_dispatched.Increment();
       auto* s = event.mutable_subset_started();
       s->set_round(e.round);
       s->set_subset(e.subset);
@@ -575,6 +596,15 @@ void Coordinator::execute(JobRecord& record, Running& running,
     }
     emit(job_id, event);
   });
+  // The bytes moved count whether the build ends well or not.
+  struct CountMoved {
+    const RemoteRunner& runner;
+    CoordinatorMetrics& metrics;
+    ~CountMoved() {
+      metrics.subset_job_bytes.Increment(double(runner.transport().job_bytes));
+      metrics.subset_result_bytes.Increment(double(runner.transport().result_bytes));
+    }
+  } count_moved{runner, metrics_};
   ParallelEvents events;
   events.partitioned = [&](uint32_t round, uint32_t subsets, uint64_t faces) {
     parapm::v1::JobEvent event;

@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "coordinator_metrics.h"
 #include "io/mesh_io.h"
 #include "parapm.pb.h"
 #include "pm_library.h"
@@ -98,6 +99,10 @@ class Coordinator {
   Coordinator& operator=(const Coordinator&) = delete;
 
   WorkerRegistry& workers() { return registry_; }
+  CoordinatorMetrics& metrics() { return metrics_; }
+  // Sets the metrics' gauges of state (jobs by state, queue depth, registered workers) to
+  // what they are now: called before each scrape.
+  void refresh_metrics();
   const CoordinatorConfig& config() const { return config_; }
 
   Upload begin_upload(const std::string& file_name) const;
@@ -151,6 +156,7 @@ class Coordinator {
   JobRecord done_job(const std::string& job_id);  // kFailedPrecondition unless done
 
   CoordinatorConfig config_;
+  CoordinatorMetrics metrics_;
   BlobStore blobs_;
   JobStore store_;
   WorkerRegistry registry_;

@@ -37,6 +37,7 @@ struct CoordinatorArgs {
   std::string http_port_file;
   unsigned http_threads = 8;
   std::string log_level = "info";
+  std::string log_format = "text";
   bool verify = false;
   parapm::rpc::CallLimits streams;
   parapm::rpc::CallLimits unary{"calls", 32, 8};
@@ -51,7 +52,7 @@ constexpr int kMaxChunkMessageBytes = (4 << 20) + (64 << 10);
 // --verify: every blob hashed again; exit status 0 when all match, 1 otherwise.
 int verify_store(const CoordinatorArgs& args) {
   using parapm::service::BlobStore;
-  parapm::rpc::set_up_logging("coordinator", args.log_level);
+  parapm::rpc::set_up_logging("coordinator", args.log_level, args.log_format);
   const BlobStore::VerifyReport report = BlobStore::verify(args.data);
   std::printf("%llu blobs, %llu bytes checked in %s: %zu corrupt\n",
               static_cast<unsigned long long>(report.blobs),
@@ -73,7 +74,7 @@ void write_port_file(const std::string& path, int port) {
 
 int run(CoordinatorArgs args) {
   using namespace parapm;
-  rpc::set_up_logging("coordinator", args.log_level);
+  rpc::set_up_logging("coordinator", args.log_level, args.log_format);
   args.streams.idle = std::chrono::milliseconds(int64_t(args.stream_idle_s * 1000));
   args.streams.total = std::chrono::milliseconds(int64_t(args.stream_total_s * 1000));
   args.unary.idle = args.streams.idle;
@@ -221,9 +222,9 @@ int main(int argc, char** argv) {
   app.add_option("--tls-ca", args.tls.ca_file,
                  "PEM roots that sign the workers' certificates (default: the system's)");
   app.add_option("--http", args.http,
-                 "serve the viewer (a web page showing the jobs' PMs as they stream) on this "
-                 "address, host:port (port 0: any free); beyond loopback the token is required, "
-                 "and --tls-cert serves it over HTTPS");
+                 "serve the viewer (a web page showing the jobs' PMs as they stream) and the "
+                 "Prometheus metrics (/metrics) on this address, host:port (port 0: any free); "
+                 "beyond loopback the token is required, and --tls-cert serves it over HTTPS");
   app.add_option("--http-threads", args.http_threads, "viewer connections served at once")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
@@ -232,6 +233,10 @@ int main(int argc, char** argv) {
   app.add_option("--port-file", args.port_file,
                  "write the port listened on to this file once serving (for scripts, with port 0)");
   app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
+      ->capture_default_str();
+  app.add_option("--log-format", args.log_format,
+                 "text, or json: one object per line (time, level, logger, message)")
+      ->check(CLI::IsMember({"text", "json"}))
       ->capture_default_str();
   app.add_flag("--verify", args.verify,
                "check every stored blob of --data against its hash, print the corrupt ones and "

@@ -51,10 +51,13 @@ bool terminal(const parapm::v1::JobEvent& event) {
 grpc::Status MeshService::Upload(grpc::ServerContext* context,
                                  grpc::ServerReader<parapm::v1::UploadChunk>* reader,
                                  parapm::v1::UploadReply* reply) {
-  return rpc::serve(auth_, context, [&] {
+  bool admitted = false;
+  uint64_t bytes_sent = 0;
+  const grpc::Status status = rpc::serve(auth_, context, [&] {
     grpc::Status refused;
     const auto ticket = streams_.admit(context, "Upload", &refused);
     if (!ticket) return refused;
+    admitted = true;
     parapm::v1::UploadChunk chunk;
     if (!reader->Read(&chunk)) {
       if (auto expired = ticket->expired()) return *expired;
@@ -68,6 +71,7 @@ grpc::Status MeshService::Upload(grpc::ServerContext* context,
     if (auto expired = ticket->expired()) return *expired;
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "upload cut off");
     ticket->working();  // parsing a large mesh may take longer than the idle limit
+    bytes_sent = upload.size();
     const UploadResult result = coordinator_.finish_upload(std::move(upload));
     reply->set_mesh_id(result.mesh.mesh_id);
     reply->set_content_sha256(result.mesh.sha256);
@@ -77,6 +81,36 @@ grpc::Status MeshService::Upload(grpc::ServerContext* context,
     reply->set_repairs(result.repairs);
     return grpc::Status::OK;
   });
+  count_upload(status, admitted, bytes_sent);
+  return status;
+}
+
+void MeshService::count_upload(const grpc::Status& status, bool admitted, uint64_t bytes_sent) {
+  CoordinatorMetrics& metrics = coordinator_.metrics();
+  if (status.ok()) {
+    metrics.uploads_accepted.Increment();
+    metrics.upload_bytes.Increment(double(bytes_sent));
+    return;
+  }
+  const char* reason = "error";
+  switch (status.error_code()) {
+    case grpc::StatusCode::UNAUTHENTICATED:
+      reason = "unauthenticated";
+      break;
+    case grpc::StatusCode::RESOURCE_EXHAUSTED:
+      reason = admitted ? "too_large" : "busy";
+      break;
+    case grpc::StatusCode::INVALID_ARGUMENT:
+      reason = "invalid";
+      break;
+    case grpc::StatusCode::CANCELLED:
+    case grpc::StatusCode::DEADLINE_EXCEEDED:
+      reason = "cut_off";
+      break;
+    default:
+      break;
+  }
+  metrics.uploads_refused.Add({{"reason", reason}}).Increment();
 }
 
 grpc::Status MeshService::Submit(grpc::ServerContext* context,

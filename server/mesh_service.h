@@ -42,6 +42,9 @@ class MeshService final : public parapm::v1::MeshService::Service {
                         grpc::ServerWriter<parapm::v1::PmStreamMessage>* writer) override;
 
  private:
+  // The upload's outcome in the metrics: accepted (with its bytes), or refused and why.
+  void count_upload(const grpc::Status& status, bool admitted, uint64_t bytes_sent);
+
   Coordinator& coordinator_;
   rpc::TokenCheck auth_;
   rpc::CallAdmission& streams_;

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "coordinator.h"
+#include "metrics.h"
 #include "rpc_server.h"
 #include "util/error.h"
 #include "viewer_assets.h"
@@ -68,28 +69,11 @@ bool plausible_id(const std::string& id) {
   });
 }
 
-// Splits "host:port" (host may be [v6]); throws Error(kInvalidInput).
-std::pair<std::string, int> host_and_port(const std::string& listen) {
-  const size_t colon = listen.rfind(':');
-  if (colon == std::string::npos || colon + 1 == listen.size())
-    throw_invalid("--http wants host:port, got '" + listen + "'");
-  std::string host = listen.substr(0, colon);
-  if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
-    host = host.substr(1, host.size() - 2);
-  int port = -1;
-  try {
-    port = std::stoi(listen.substr(colon + 1));
-  } catch (const std::exception&) {
-  }
-  if (port < 0 || port > 65535) throw_invalid("--http: bad port in '" + listen + "'");
-  return {host.empty() ? "0.0.0.0" : host, port};
-}
-
 }  // namespace
 
 ViewerServer::ViewerServer(Coordinator& coordinator, ViewerConfig config)
     : coordinator_(coordinator), config_(std::move(config)) {
-  host_and_port(config_.listen);  // checked now
+  rpc::http_host_and_port(config_.listen, "--http");  // checked now
   if (config_.token.empty() && !rpc::is_loopback_address(config_.listen))
     throw_invalid("refusing to serve the viewer on " + config_.listen +
                   " without a token: beyond loopback every request needs one (--token-file FILE "
@@ -114,7 +98,7 @@ ViewerServer::ViewerServer(Coordinator& coordinator, ViewerConfig config)
 ViewerServer::~ViewerServer() { stop(); }
 
 int ViewerServer::start() {
-  const auto [host, port] = host_and_port(config_.listen);
+  const auto [host, port] = rpc::http_host_and_port(config_.listen, "--http");
   port_ = port == 0 ? server_->bind_to_any_port(host.c_str())
                     : (server_->bind_to_port(host.c_str(), port) ? port : -1);
   if (port_ <= 0) throw Error(ErrorCode::kIo, "the viewer cannot listen on " + config_.listen);
@@ -197,6 +181,14 @@ void ViewerServer::add_routes() {
                        return sink.write(loaded->bytes.data() + offset, n);
                      });
                }));
+  // Prometheus' scrape (docs/OPERATIONS.md): with a token, in the Authorization header.
+  server_->Get("/metrics", [this](const httplib::Request& request, httplib::Response& response) {
+    if (!rpc::scrape_allowed(config_.token, request.get_header_value("Authorization")))
+      return send_error(response, 401, "a scrape needs Authorization: Bearer TOKEN");
+    coordinator_.refresh_metrics();
+    response.set_content(rpc::prometheus_text(*coordinator_.metrics().registry),
+                         rpc::kPrometheusContentType);
+  });
   server_->Get(R"(/api/.*)", [](const httplib::Request& request, httplib::Response& response) {
     send_error(response, 404, "no such route: " + request.path.substr(0, 200));
   });

@@ -4,6 +4,7 @@
 //   GET /api/jobs              {"jobs": [Job, ...]}, newest first, as the API's JSON
 //   GET /api/jobs/JOB          Job
 //   GET /api/jobs/JOB/pm       the job's .pm file, streamed as stored (its hash checked first)
+//   GET /metrics               the coordinator's Prometheus metrics (coordinator_metrics.h)
 // Errors are JSON {"error": message} with the HTTP status of their kind (400, 401, 404, 409,
 // 500). With a token (required beyond loopback, as for gRPC) every /api route needs it, as
 // "Authorization: Bearer TOKEN" or "?token=TOKEN" (a page cannot set headers on a link).

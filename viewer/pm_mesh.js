@@ -12,8 +12,13 @@
 // Buffers for drawing: `positions` (Float32Array, 3 per vertex, every vertex the decoder has
 // reached), `faces` (Uint32Array, 3 per face; the first faceCount are the level's), and with
 // attributes `cornerWedges` (3 per face) and `wedgeValues` (floatsPerWedge per wedge).
-import {FaceLists} from './face_lists.js';
+import {CornerLists} from './corner_lists.js';
 import {fromOrdinal32, ordinal32} from './pm_decoder.js';
+
+// Where corner 4 f + k (CornerLists' id) is in `faces`.
+function cornerIndex(c) {
+  return 3 * (c >> 2) + (c & 3);
+}
 
 export class PmMesh {
   constructor(decoder) {
@@ -35,13 +40,13 @@ export class PmMesh {
       this.wedgeValues = new Float32Array(h.floatsPerWedge * Math.max(h.fullWedges, h.baseWedges));
       this.wedgeValues.set(base.wedgeValues);
     }
-    // Per vertex, its faces (ids).
-    this.vertexFaces = new FaceLists(h.fullVertices, 3 * h.fullFaces);
+    // Per vertex, the face corners at it (corner k of face f is 4 f + k: cornerIndex).
+    this.vertexCorners = new CornerLists(h.fullVertices, 3 * h.fullFaces);
     for (let f = 0; f < h.baseFaces; f++)
-      for (let k = 0; k < 3; k++) this.vertexFaces.push(base.faces[3 * f + k], f);
-    // Per split applied: the faces it moved to vt, and where vs was (to undo it).
-    // The faces each split moved to vt, for undoing it: split i's are
-    // fanPool[fanStart[i] .. fanStart[i + 1]) (splits apply in order, so the pool grows in order).
+      for (let k = 0; k < 3; k++) this.vertexCorners.push(base.faces[3 * f + k], 4 * f + k);
+    // Per split applied, for undoing it: the corners it moved from vs to vt, split i's at
+    // fanPool[fanStart[i] .. fanStart[i + 1]) (splits apply in order, so the pool grows in
+    // order), and where vs was.
     this.fanStart = new Uint32Array(h.splits + 1);
     this.fansKnown = 0;  // splits below this have their fans kept
     this.fanPool = new Uint32Array(Math.max(16, 6 * h.splits));
@@ -78,25 +83,39 @@ export class PmMesh {
     while (this.level > level) this.#unsplit(--this.level);
   }
 
-  // Selective refinement (Hoppe 96 section 5, as engine/pm/selective_refinement.h): from the
-  // base mesh, every decoded split in order, applied where `refine(i, vs, x, y, z)` (vs's
-  // position now) says so and the split fits: vs, vl and vr present (a base vertex, or one a
-  // split applied created) and the fan rule finding its faces. A new PmMesh only (it leaves
-  // the sequence of levels: setLevel no longer applies). Returns the splits applied.
-  refineSelectively(refine) {
+  // Selective refinement (Hoppe 96 section 5, Hoppe 97's dependencies): from the base mesh,
+  // the decoded splits `want(i)` asks for and those they depend on (the splits that create
+  // their vs, vl and vr, and the split of their vs before them, recursively), applied in order
+  // where the fan rule finds their faces. Every vertex is then either where the full sequence
+  // puts it or, when its next split is not applied, where that split finds it. A new PmMesh
+  // only (it leaves the sequence of levels: setLevel no longer applies). Returns the splits
+  // applied.
+  refineSelectively(want) {
     if (this.level !== 0 || this.selective) throw new Error('refineSelectively: on a fresh PmMesh only');
     this.selective = true;
-    const d = this.decoder, present = new Uint8Array(d.header.fullVertices), pos = this.positions;
-    present.fill(1, 0, this.n0);
-    let applied = 0;
-    for (let i = 0; i < d.splitCount; i++) {
+    const d = this.decoder, n = d.splitCount, n0 = this.n0;
+    // Each split's previous split of the same vs (-1: none).
+    const previous = new Int32Array(n), lastSplit = new Int32Array(d.header.fullVertices).fill(-1);
+    for (let i = 0; i < n; i++) {
+      previous[i] = lastSplit[d.vs[i]];
+      lastSplit[d.vs[i]] = i;
+    }
+    const wanted = new Uint8Array(n);
+    for (let i = 0; i < n; i++) wanted[i] = want(i) ? 1 : 0;
+    for (let i = n - 1; i >= 0; i--) {
+      if (!wanted[i]) continue;
+      if (previous[i] >= 0) wanted[previous[i]] = 1;
       const vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
-      if (!present[vs] || (vl >= 0 && !present[vl]) || (vr >= 0 && !present[vr])) continue;
-      if (!refine(i, vs, pos[3 * vs], pos[3 * vs + 1], pos[3 * vs + 2])) continue;
+      if (vs >= n0) wanted[vs - n0] = 1;
+      if (vl >= n0) wanted[vl - n0] = 1;
+      if (vr >= n0) wanted[vr - n0] = 1;
+    }
+    let applied = 0;
+    for (let i = 0; i < n; i++) {
+      if (!wanted[i]) continue;
       const size = this.#findFan(i);
       if (typeof size === 'string') continue;
       this.#apply(i, size);
-      present[this.n0 + i] = 1;
       applied++;
     }
     return applied;
@@ -140,11 +159,6 @@ export class PmMesh {
     this.fan = new Int32Array(2 * n);
   }
 
-  #corner(f, v) {
-    const t = this.faces;
-    return t[3 * f] === v ? 0 : t[3 * f + 1] === v ? 1 : 2;
-  }
-
   // Where the faces of vs (rotated to start at vs: (vs, a, b)) hold `value` as a (b): the
   // first such face's index in the ring, or -1. A ring has a handful of faces.
   #findIn(keys, n, value) {
@@ -152,18 +166,18 @@ export class PmMesh {
     return -1;
   }
 
-  // How many faces of vs split i moves to vt (the fan rule; the faces in this.fan, and marked in
-  // this.taken by their place in vs's list), or a string saying why it does not fit the mesh as
-  // it is (in a selective refinement, earlier skips change neighbourhoods).
+  // How many faces of vs split i moves to vt (the fan rule; their corners at vs in this.fan,
+  // and marked in this.taken by their place in vs's list), or a string saying why it does not
+  // fit the mesh as it is (in a selective refinement, earlier skips change neighbourhoods).
   #findFan(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
-    const t = this.faces, lists = this.vertexFaces, n = lists.count[vs];
+    const t = this.faces, lists = this.vertexCorners, n = lists.count(vs);
     this.#scratchFor(n);
-    const a = this.ringA, b = this.ringB, taken = this.taken, ring = lists.pool, s = lists.start[vs];
+    const a = this.ringA, b = this.ringB, taken = this.taken, ring = lists.pool, s = lists.start(vs);
     for (let j = 0; j < n; j++) {
-      const f = ring[s + j], k = this.#corner(f, vs);
-      a[j] = t[3 * f + (k === 2 ? 0 : k + 1)];
-      b[j] = t[3 * f + (k === 0 ? 2 : k - 1)];
+      const c = ring[s + j], k = c & 3, f3 = 3 * (c >> 2);
+      a[j] = t[f3 + (k === 2 ? 0 : k + 1)];
+      b[j] = t[f3 + (k === 0 ? 2 : k - 1)];
       taken[j] = 0;
     }
     if (vl >= 0 && this.#findIn(a, n, vl) < 0 && this.#findIn(b, n, vl) < 0) return `${vl} is not adjacent to ${vs}`;
@@ -203,29 +217,29 @@ export class PmMesh {
     this.#apply(i, size);
   }
 
-  // Appends face (p, q, r) and lists it at its corners.
+  // Appends face (p, q, r) and lists its corners.
   #addFace(p, q, r) {
-    const t = this.faces, lists = this.vertexFaces, f = this.faceCount++;
+    const t = this.faces, lists = this.vertexCorners, f = this.faceCount++;
     t[3 * f] = p;
     t[3 * f + 1] = q;
     t[3 * f + 2] = r;
-    lists.push(p, f);
-    lists.push(q, f);
-    lists.push(r, f);
+    lists.push(p, 4 * f);
+    lists.push(q, 4 * f + 1);
+    lists.push(r, 4 * f + 2);
   }
 
   // Split i again after it was undone: the mesh is the level it was split at, so its fan is the
   // one kept, not searched for again.
   #redo(i) {
-    const d = this.decoder, vs = d.vs[i], lists = this.vertexFaces, pool = this.fanPool;
-    const first = this.fanStart[i], size = this.fanStart[i + 1] - first, n = lists.count[vs];
+    const d = this.decoder, vs = d.vs[i], lists = this.vertexCorners, pool = this.fanPool;
+    const first = this.fanStart[i], size = this.fanStart[i + 1] - first, n = lists.count(vs);
     this.#scratchFor(n);
-    const taken = this.taken, fan = this.fan, ring = lists.pool, s = lists.start[vs];
+    const taken = this.taken, fan = this.fan, ring = lists.pool, s = lists.start(vs);
     for (let j = 0; j < size; j++) fan[j] = pool[first + j];
     for (let j = 0; j < n; j++) {
-      const f = ring[s + j];
+      const c = ring[s + j];
       let inFan = 0;
-      for (let k = 0; k < size; k++) if (fan[k] === f) inFan = 1;
+      for (let k = 0; k < size; k++) if (fan[k] === c) inFan = 1;
       taken[j] = inFan;
     }
     this.#apply(i, size);
@@ -247,14 +261,11 @@ export class PmMesh {
   // Split i with its fan (#findFan's: this.fan[0 .. size), marked in this.taken).
   #apply(i, size) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i], vt = this.n0 + i;
-    const t = this.faces, fan = this.fan, faceList = this.vertexFaces;
-    for (let j = 0; j < size; j++) {
-      const f = fan[j];
-      t[3 * f + this.#corner(f, vs)] = vt;
-    }
+    const t = this.faces, fan = this.fan, lists = this.vertexCorners;
+    for (let j = 0; j < size; j++) t[cornerIndex(fan[j])] = vt;
     // The fan leaves vs (keeping the order of the rest) for vt.
-    faceList.compact(vs, this.taken);
-    faceList.assign(vt, fan, size);
+    lists.compact(vs, this.taken);
+    lists.assign(vt, fan, size);
     if (this.floatsPerWedge) this.#applyWedges(i, vl >= 0, vr >= 0);
     if (vl >= 0) this.#addFace(vs, vt, vl);
     if (vr >= 0) this.#addFace(vt, vs, vr);
@@ -286,16 +297,16 @@ export class PmMesh {
     const t = this.faces;
     const added = (vl >= 0 ? 1 : 0) + (vr >= 0 ? 1 : 0);
     const firstNew = this.faceCount - added;
-    const lists = this.vertexFaces;
+    const lists = this.vertexCorners;
     lists.dropFrom(vs, firstNew);
     if (vl >= 0) lists.dropFrom(vl, firstNew);
     if (vr >= 0) lists.dropFrom(vr, firstNew);
     for (let j = this.fanStart[i]; j < this.fanStart[i + 1]; j++) {
-      const f = this.fanPool[j];
-      t[3 * f + this.#corner(f, vt)] = vs;
-      lists.push(vs, f);
+      const c = this.fanPool[j];
+      t[cornerIndex(c)] = vs;
+      lists.push(vs, c);
     }
-    lists.count[vt] = 0;
+    lists.clear(vt);
     this.faceCount = firstNew;
     if (this.floatsPerWedge) {
       // The changed wedges back to their coarse values (exact: ordinal deltas).

@@ -6,6 +6,7 @@
 import {PmDecoder} from './pm_decoder.js';
 import {PmMesh} from './pm_mesh.js';
 import {Renderer} from './renderer.js';
+import {SplitRegions} from './split_regions.js';
 
 const viewer = {
   state: 'loading', // "loading", "streaming", "done", "error"
@@ -16,8 +17,9 @@ const viewer = {
   error: '',
   setFaces: (n) => setFaces(n), // with the geomorph toggle on, a geomorph to that level
   morphing: false,
-  // View-dependent refinement (a selective refinement with view criteria): refine where a
-  // split's error bound projects to more than `thresholdPixels` on screen, inside the view.
+  // View-dependent refinement (a selective refinement with view criteria): refine where what a
+  // split changes (its descendants' reach, SplitRegions) projects to more than
+  // `thresholdPixels` on screen, inside the view.
   viewDependent: false,
   thresholdPixels: 2,
   setViewDependent: (on, pixels) => setViewDependent(on, pixels),
@@ -109,7 +111,7 @@ function moveTo(level) {
 }
 
 // --- view-dependent refinement ----------------------------------------------------------------
-let selective = null, refineTimer = 0;
+let selective = null, refineTimer = 0, regions = null;
 
 function setViewDependent(on, pixels) {
   viewer.viewDependent = on;
@@ -125,20 +127,28 @@ function setViewDependent(on, pixels) {
   }
 }
 
-// A selective refinement of what has arrived, for the camera now: split i where vs is inside
-// the view (with a margin) and its level's error bound spans more than the threshold on screen.
+// A selective refinement of what has arrived, for the camera now: split i where the region it
+// refines (SplitRegions' sphere) meets the view and the surface there may be more than the
+// threshold off the finest mesh on screen (its reach, projected at the region's nearest depth).
 function refineForView() {
   if (!viewer.viewDependent || !renderer || !decoder) return;
   const {viewProjection: m, scale, height} = renderer.view();
-  const pixelsPerUnit = (scale * height) / 2, threshold = viewer.thresholdPixels, margin = 1.1;
-  const error = decoder.error;
+  const pixelsPerUnit = (scale * height) / 2, threshold = viewer.thresholdPixels;
+  if (regions?.splits !== decoder.splitCount) regions = new SplitRegions(decoder);
+  const {center: c, radius: r, reach} = regions;
+  // Clip x, y and w per model unit (the rows' lengths): a sphere of radius r spans r times them.
+  const xScale = Math.hypot(m[0], m[4], m[8]), yScale = Math.hypot(m[1], m[5], m[9]);
+  const wScale = Math.hypot(m[3], m[7], m[11]);
   const refined = new PmMesh(decoder);
-  refined.refineSelectively((i, vs, x, y, z) => {
-    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
-    if (w <= 0) return false;
-    const cx = m[0] * x + m[4] * y + m[8] * z + m[12], cy = m[1] * x + m[5] * y + m[9] * z + m[13];
-    if (Math.abs(cx) > margin * w || Math.abs(cy) > margin * w) return false;
-    return (error[i] * pixelsPerUnit) / w > threshold;
+  refined.refineSelectively((i) => {
+    const px = c[3 * i], py = c[3 * i + 1], pz = c[3 * i + 2], ri = r[i];
+    const w = m[3] * px + m[7] * py + m[11] * pz + m[15], wReach = wScale * ri;
+    if (w + wReach <= 0) return false;  // behind the camera
+    // Outside the view (clip x and y run from -w to w inside it).
+    const cx = m[0] * px + m[4] * py + m[8] * pz + m[12], cy = m[1] * px + m[5] * py + m[9] * pz + m[13];
+    if (Math.abs(cx) - xScale * ri > w + wReach || Math.abs(cy) - yScale * ri > w + wReach) return false;
+    const nearest = Math.max(w - wReach, 1e-6 * (Math.abs(w) + wReach));
+    return (reach[i] * pixelsPerUnit) / nearest > threshold;
   });
   selective = refined;
   dirty = true;

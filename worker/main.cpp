@@ -1,16 +1,20 @@
 // parapm-worker: a worker daemon. It serves WorkerService (subset jobs from the coordinator,
 // run with the engine's simplify_subset) and registers with the coordinator, beating at the
-// interval the coordinator asks for. Stops cleanly on SIGINT / SIGTERM.
+// interval the coordinator asks for. With --metrics-listen, serves its Prometheus metrics.
+// Stops cleanly on SIGINT / SIGTERM.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <optional>
 #include <thread>
 
 #include <spdlog/spdlog.h>
 
 #include "coordinator_link.h"
 #include "daemon.h"
+#include "metrics.h"
 #include "rpc_server.h"
 #include "subset_service.h"
+#include "worker_metrics.h"
 
 namespace {
 
@@ -24,15 +28,24 @@ struct WorkerArgs {
   std::string token_file;
   parapm::rpc::TlsFiles tls;
   bool coordinator_tls = false;
+  std::string metrics_listen;  // "" : no metrics endpoint
   std::string log_level = "info";
+  std::string log_format = "text";
 };
 
 int run(const WorkerArgs& args) {
   using namespace parapm;
-  rpc::set_up_logging("worker", args.log_level);
+  rpc::set_up_logging("worker", args.log_level, args.log_format);
   const std::string token = rpc::token_for_listening(args.token_file, args.listen);
   const unsigned threads = args.threads ? args.threads : std::thread::hardware_concurrency();
-  worker::SubsetService service(rpc::TokenCheck(token), threads);
+  worker::WorkerMetrics metrics(threads);
+  worker::SubsetService service(rpc::TokenCheck(token), threads, metrics);
+  // The metrics endpoint's options are checked before anything listens.
+  std::optional<rpc::MetricsServer> metrics_server;
+  if (!args.metrics_listen.empty())
+    metrics_server.emplace(metrics.registry,
+                           rpc::MetricsEndpoint{args.metrics_listen, token, args.tls},
+                           [&] { metrics.running.Set(double(service.running())); });
   rpc::ServerSetup setup;
   setup.listen = args.listen;
   setup.tls = args.tls;
@@ -41,6 +54,7 @@ int run(const WorkerArgs& args) {
       args.advertise.empty() ? rpc::reachable_address(args.listen, server.port) : args.advertise;
   spdlog::info("listening on {} ({} subset slots); coordinator {}", address, threads,
                args.coordinator);
+  if (metrics_server) metrics_server->start();
 
   worker::LinkOptions link;
   link.coordinator = args.coordinator;
@@ -55,6 +69,7 @@ int run(const WorkerArgs& args) {
     const std::string signal = rpc::wait_for_shutdown_signal();
     spdlog::info("{}: stopping (running subsets are cancelled)", signal);
   }
+  if (metrics_server) metrics_server->stop();
   // Calls in flight see their context cancelled; the engine stops at its next check.
   server.server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
   spdlog::info("stopped");
@@ -93,7 +108,14 @@ int main(int argc, char** argv) {
   app.add_flag("--coordinator-tls", args.coordinator_tls, "reach the coordinator over TLS");
   app.add_option("--tls-ca", args.tls.ca_file,
                  "PEM roots that sign the coordinator's certificate (default: the system's)");
+  app.add_option("--metrics-listen", args.metrics_listen,
+                 "serve Prometheus metrics at http://ADDR/metrics, host:port (beyond loopback "
+                 "the token is required as Authorization: Bearer TOKEN; HTTPS with --tls-cert)");
   app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
+      ->capture_default_str();
+  app.add_option("--log-format", args.log_format,
+                 "text, or json: one object per line (time, level, logger, message)")
+      ->check(CLI::IsMember({"text", "json"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {

@@ -24,8 +24,21 @@ constexpr auto kCancelPoll = std::chrono::milliseconds(20);
 
 }  // namespace
 
-SubsetService::SubsetService(rpc::TokenCheck auth, unsigned slots)
-    : auth_(std::move(auth)), slots_(std::max(1u, slots)) {}
+SubsetService::SubsetService(rpc::TokenCheck auth, unsigned slots, WorkerMetrics& metrics)
+    : auth_(std::move(auth)), slots_(std::max(1u, slots)), metrics_(metrics) {}
+
+void SubsetService::record_outcome(const grpc::Status& status, double seconds,
+                                   uint64_t bytes_sent) {
+  metrics_.result_bytes.Increment(double(bytes_sent));
+  const grpc::StatusCode code = status.error_code();
+  const char* outcome =
+      status.ok() ? "done"
+      : code == grpc::StatusCode::CANCELLED || code == grpc::StatusCode::DEADLINE_EXCEEDED
+          ? "cancelled"
+          : "failed";
+  metrics_.subsets.Add({{"outcome", outcome}}).Increment();
+  if (status.ok()) metrics_.subset_seconds.Observe(seconds);
+}
 
 bool SubsetService::acquire_slot(grpc::ServerContext* context) {
   std::unique_lock lock(mutex_);
@@ -50,8 +63,10 @@ void SubsetService::release_slot() {
 grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
                                            const parapm::v1::SubsetRequest* request,
                                            grpc::ServerWriter<parapm::v1::SubsetProgress>* writer) {
-  return rpc::serve(auth_, context, [&]() -> grpc::Status {
-    const auto start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
+  uint64_t bytes_sent = 0;
+  const grpc::Status status = rpc::serve(auth_, context, [&]() -> grpc::Status {
+    metrics_.job_bytes.Increment(double(request->job().size()));
     const SubsetJob job = decode_subset_job(request->job());
     const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +
                              " subset " + std::to_string(job.subset);
@@ -120,16 +135,20 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
     for (size_t i = 0; i < result.records.size(); i += kRecordsPerBatch) {
       const size_t count = std::min(kRecordsPerBatch, result.records.size() - i);
       message.set_record_batch(encode_collapse_records(result.records.data() + i, count));
+      bytes_sent += message.ByteSizeLong();
       if (!writer->Write(message))
         return grpc::Status(grpc::StatusCode::CANCELLED, "the coordinator went away");
     }
     message.set_summary(encode_subset_summary(result));
+    bytes_sent += message.ByteSizeLong();
     if (!writer->Write(message))
       return grpc::Status(grpc::StatusCode::CANCELLED, "the coordinator went away");
     spdlog::info("{}: {} collapses in {:.3f} s ({:.3f} s CPU), {}", name, result.records.size(),
                  seconds_since(start), result.cpu_seconds, result.stats.stop_reason);
     return grpc::Status::OK;
   });
+  record_outcome(status, seconds_since(start), bytes_sent);
+  return status;
 }
 
 }  // namespace parapm::worker

@@ -10,13 +10,15 @@
 
 #include "parapm.grpc.pb.h"
 #include "rpc_security.h"
+#include "worker_metrics.h"
 
 namespace parapm::worker {
 
 class SubsetService final : public parapm::v1::WorkerService::Service {
  public:
-  // At most `slots` subsets run at once; further calls wait for a slot (cancellable).
-  SubsetService(rpc::TokenCheck auth, unsigned slots);
+  // At most `slots` subsets run at once; further calls wait for a slot (cancellable). Each
+  // call's outcome, time and bytes go to `metrics` (which outlives the service).
+  SubsetService(rpc::TokenCheck auth, unsigned slots, WorkerMetrics& metrics);
 
   grpc::Status SimplifySubset(grpc::ServerContext* context,
                               const parapm::v1::SubsetRequest* request,
@@ -25,12 +27,15 @@ class SubsetService final : public parapm::v1::WorkerService::Service {
   unsigned running() const { return running_.load(); }
 
  private:
+  // The call's outcome in the metrics.
+  void record_outcome(const grpc::Status& status, double seconds, uint64_t bytes_sent);
   // Waits for a free slot; false when the call was cancelled meanwhile.
   bool acquire_slot(grpc::ServerContext* context);
   void release_slot();
 
   rpc::TokenCheck auth_;
   unsigned slots_;
+  WorkerMetrics& metrics_;
   std::atomic<unsigned> running_{0};
   std::mutex mutex_;
   std::condition_variable slot_freed_;

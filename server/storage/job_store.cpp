@@ -372,6 +372,17 @@ size_t JobStore::jobs_of_mesh(const std::string& mesh_id) const {
   return query.step() ? size_t(query.column_uint64(0)) : 0;
 }
 
+std::map<JobStatus, uint64_t> JobStore::job_counts() const {
+  std::lock_guard lock(mutex_);
+  sqlite::Statement query(*db_, "SELECT status, COUNT(*) FROM jobs GROUP BY status",
+                          "counting the jobs by state");
+  std::map<JobStatus, uint64_t> counts;
+  while (query.step())
+    if (const auto status = parse_job_status(query.column_text(0)))
+      counts[*status] = query.column_uint64(1);
+  return counts;
+}
+
 std::set<std::string> JobStore::referenced_blobs() const {
   std::lock_guard lock(mutex_);
   sqlite::Statement query(

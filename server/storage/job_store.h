@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <initializer_list>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -78,6 +79,8 @@ class JobStore {
   // Jobs that ended (done, failed or cancelled), oldest first by updated_unix_ms.
   std::vector<JobRecord> ended_jobs() const;
   size_t jobs_of_mesh(const std::string& mesh_id) const;
+  // How many jobs are stored in each state (states without a job are absent).
+  std::map<JobStatus, uint64_t> job_counts() const;
   // The blob hashes the rows name: every mesh's sha256 and every job's pm_sha256.
   std::set<std::string> referenced_blobs() const;
 

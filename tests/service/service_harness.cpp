@@ -350,12 +350,14 @@ void Service::kill_coordinator() {
   if (coordinator_) coordinator_->kill_now();
 }
 
-ChildProcess& Service::start_worker(const std::string& name, unsigned threads) {
+ChildProcess& Service::start_worker(const std::string& name, unsigned threads,
+                                    const std::vector<std::string>& extra) {
   if (port_ == 0) throw ServiceError("start_worker before start_coordinator");
   std::vector<std::string> argv = {
       binary("parapm-worker"), "--coordinator", address(), "--listen", "127.0.0.1:0", "--threads",
       std::to_string(threads), "--name",        name};
   if (!token_file_.empty()) argv.insert(argv.end(), {"--token-file", token_file_.string()});
+  argv.insert(argv.end(), extra.begin(), extra.end());
   workers_.push_back(
       std::make_unique<ChildProcess>("worker " + name, argv, dir_ / ("worker-" + name + ".log")));
   return *workers_.back();

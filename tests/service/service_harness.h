@@ -123,8 +123,9 @@ class Service {
   int port() const { return port_; }
   std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
 
-  // Starts a worker named `name` with --threads `threads`.
-  ChildProcess& start_worker(const std::string& name, unsigned threads = 1);
+  // Starts a worker named `name` with --threads `threads`. `extra`: more flags.
+  ChildProcess& start_worker(const std::string& name, unsigned threads = 1,
+                             const std::vector<std::string>& extra = {});
   ChildProcess* worker(const std::string& name);  // nullptr when unknown
   std::vector<ChildProcess*> workers();
   // Waits until the running coordinator's log shows `count` worker registrations.

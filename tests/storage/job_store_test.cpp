@@ -190,5 +190,20 @@ TEST_F(JobStoreTest, RestartQueueIsOldestFirstAndOnlyTheAskedStatuses) {
   EXPECT_TRUE(store_.jobs_with_status({}).empty());
 }
 
+TEST_F(JobStoreTest, JobCountsAreByStateAndFollowUpdates) {
+  EXPECT_TRUE(store_.job_counts().empty());
+  store_.add_mesh(a_mesh("mesh-1", std::string(64, 'a')));
+  store_.add_job(a_job("job-1", "mesh-1", 1000, JobStatus::kQueued));
+  store_.add_job(a_job("job-2", "mesh-1", 2000, JobStatus::kQueued));
+  store_.add_job(a_job("job-3", "mesh-1", 3000, JobStatus::kDone));
+  JobRecord running = a_job("job-2", "mesh-1", 2000, JobStatus::kRunning);
+  store_.update_job(running);
+  EXPECT_EQ(store_.job_counts(),
+            (std::map<JobStatus, uint64_t>{
+                {JobStatus::kQueued, 1}, {JobStatus::kRunning, 1}, {JobStatus::kDone, 1}}));
+  store_.delete_job("job-3");
+  EXPECT_EQ(store_.job_counts().count(JobStatus::kDone), 0u);
+}
+
 }  // namespace
 }  // namespace parapm::service

@@ -11,6 +11,7 @@ import {join} from 'node:path';
 
 import {PmDecoder, PmFormatError} from '../pm_decoder.js';
 import {PmMesh} from '../pm_mesh.js';
+import {SplitRegions} from '../split_regions.js';
 import {parapm, readPly, root, simplified, withTempDir} from './support.mjs';
 
 const meshes = readdirSync(join(root, 'tests', 'data')).filter((f) => /\.(ply|obj|stl|off)(\.gz)?$/.test(f));
@@ -166,10 +167,10 @@ test('selective refinement: everything is the full mesh, nothing the base, a reg
     const none = new PmMesh(decoder);
     assert.equal(none.refineSelectively(() => false), 0);
     assert.equal(none.faceCount, decoder.header.baseFaces);
-    // Refined where x < 0 only: fewer faces than the full mesh, more than the base, and every
+    // Refined where vs goes to x < 0 only: fewer faces than the full mesh, more than the base, and every
     // edge of the result has at most two faces (no split applied out of its neighbourhood).
     const half = new PmMesh(decoder);
-    half.refineSelectively((i, vs, x) => x < 0);
+    half.refineSelectively((i) => decoder.vsAfter[3 * i] < 0);
     assert.ok(half.faceCount > decoder.header.baseFaces && half.faceCount < decoder.header.fullFaces);
     const edges = new Map();
     for (let f = 0; f < half.faceCount; f++)
@@ -179,5 +180,41 @@ test('selective refinement: everything is the full mesh, nothing the base, a reg
         edges.set(key, (edges.get(key) || 0) + 1);
       }
     for (const [edge, count] of edges) assert.ok(count <= 2, `edge ${edge} has ${count} faces`);
+  });
+});
+
+test('a split\'s region holds every vertex it refines into, and a view\'s refinement stays within reach', () => {
+  withTempDir((dir) => {
+    const pm = simplified(dir, 'stratocaster-9k.ply');
+    const decoder = decodeInPieces(new Uint8Array(readFileSync(pm)), 5);
+    const regions = new SplitRegions(decoder), n0 = decoder.header.baseVertices, n = decoder.splitCount;
+    const full = new PmMesh(decoder);
+    full.setLevel(n);
+    const at = (p, v) => [p[3 * v], p[3 * v + 1], p[3 * v + 2]];
+    const distance = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    // Split i's descendants, by brute force: vs, and every vt of a later split of one of them.
+    for (let i = 0; i < n; i += 13) {
+      const family = new Set([decoder.vs[i]]);
+      for (let j = i; j < n; j++) if (family.has(decoder.vs[j])) family.add(n0 + j);
+      const center = Array.from(regions.center.subarray(3 * i, 3 * i + 3));
+      for (const v of family)
+        assert.ok(distance(at(full.positions, v), center) <= regions.radius[i] * (1 + 1e-9) + 1e-12,
+          `split ${i}: vertex ${v} lies outside its region`);
+    }
+    // A refinement that skips the splits whose reach is below a tolerance: every vertex of the
+    // full mesh is within the tolerance of its ancestor in it (the geomorph's correspondence).
+    const box = decoder.header.boxMax.map((x, k) => x - decoder.header.boxMin[k]);
+    const tolerance = 0.01 * Math.hypot(...box);
+    const cut = new PmMesh(decoder);
+    cut.refineSelectively((i) => regions.reach[i] > tolerance);
+    assert.ok(cut.faceCount > decoder.header.baseFaces && cut.faceCount < decoder.header.fullFaces);
+    const present = new Uint8Array(n0 + n), ancestor = new Int32Array(n0 + n);
+    present.fill(1, 0, n0);
+    for (let v = 0; v < n0 + n; v++) ancestor[v] = v;
+    for (let f = 0; f < cut.faceCount; f++) for (let k = 0; k < 3; k++) present[cut.faces[3 * f + k]] = 1;
+    for (let j = 0; j < n; j++) if (!present[n0 + j]) ancestor[n0 + j] = ancestor[decoder.vs[j]];
+    for (let v = 0; v < n0 + n; v++)
+      assert.ok(distance(at(full.positions, v), at(cut.positions, ancestor[v])) <= tolerance * (1 + 1e-6),
+        `vertex ${v} is farther than the tolerance from its ancestor ${ancestor[v]}`);
   });
 });
