@@ -8,6 +8,7 @@ namespace parapm::cli {
 
 void add_simplify_command(CLI::App& app, int& exit_code);
 void add_lod_command(CLI::App& app, int& exit_code);
+void add_lods_command(CLI::App& app, int& exit_code);
 void add_info_command(CLI::App& app, int& exit_code);
 void add_check_command(CLI::App& app, int& exit_code);
 void add_partition_command(CLI::App& app, int& exit_code);

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   parapm::cli::add_simplify_command(app, exit_code);
   parapm::cli::add_lod_command(app, exit_code);
+  parapm::cli::add_lods_command(app, exit_code);
   parapm::cli::add_info_command(app, exit_code);
   parapm::cli::add_check_command(app, exit_code);
   parapm::cli::add_partition_command(app, exit_code);

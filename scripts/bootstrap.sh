@@ -31,11 +31,14 @@ if [[ ${#missing[@]} -gt 0 ]]; then
     "${missing[@]}" > /dev/null
 fi
 
-# The viewer's test dependencies, as the committed lockfile pins them.
-if [[ ! -d "$root/viewer/node_modules" || "$root/viewer/package-lock.json" -nt "$root/viewer/node_modules" ]]; then
-  echo "[bootstrap] npm ci in viewer/" >&2
-  (cd "$root/viewer" && npm ci --no-audit --no-fund > /dev/null)
-fi
+# The JavaScript test dependencies (the viewer's, the glTF validator), as the committed
+# lockfiles pin them.
+for js in viewer tests/gltf; do
+  if [[ ! -d "$root/$js/node_modules" || "$root/$js/package-lock.json" -nt "$root/$js/node_modules" ]]; then
+    echo "[bootstrap] npm ci in $js/" >&2
+    (cd "$root/$js" && npm ci --no-audit --no-fund > /dev/null)
+  fi
+done
 
 if [[ ! -f "$build/CMakeCache.txt" ]]; then
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
