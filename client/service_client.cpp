@@ -1,4 +1,4 @@
-#include "service_client.h"
+#include <parapm/client.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -10,23 +10,12 @@
 #include "rpc_status.h"
 #include "util/error.h"
 
-namespace parapm::cli {
+namespace parapm::client {
 namespace {
 
 constexpr size_t kUploadChunkBytes = 1 << 20;
 
 }  // namespace
-
-void add_connection_options(CLI::App* command, ConnectionArgs& args) {
-  command->add_option("--server", args.server,
-                      std::string("coordinator address host:port (default: PARAPM_SERVER, else ") +
-                          kDefaultServer + ", where 'parapm up' listens)");
-  command->add_option("--token-file", args.token_file,
-                      "file holding the bearer token (default: PARAPM_TOKEN)");
-  command->add_flag("--tls", args.tls, "connect over TLS");
-  command->add_option("--tls-ca", args.tls_ca,
-                      "PEM roots that sign the server's certificate (default: the system's)");
-}
 
 void check_status(const grpc::Status& status, const std::string& what, const std::string& server) {
   if (status.ok()) return;
@@ -37,7 +26,7 @@ void check_status(const grpc::Status& status, const std::string& what, const std
   throw Error(rpc::error_code_of(status.error_code()), message);
 }
 
-ServiceClient::ServiceClient(const ConnectionArgs& args) {
+ServiceClient::ServiceClient(const ConnectionOptions& args) {
   server_ = args.server;
   if (server_.empty()) {
     const char* env = std::getenv("PARAPM_SERVER");
@@ -144,6 +133,32 @@ uint64_t ServiceClient::receive_file(grpc::ClientReader<parapm::v1::Chunk>& read
   return written;
 }
 
+parapm::v1::Job ServiceClient::submit(const std::string& mesh_id,
+                                      const parapm::v1::JobOptions& options) {
+  auto context = this->context();
+  parapm::v1::SubmitRequest request;
+  request.set_mesh_id(mesh_id);
+  *request.mutable_options() = options;
+  parapm::v1::Job job;
+  check_status(stub_->Submit(context.get(), request, &job), "submit " + mesh_id, server_);
+  return job;
+}
+
+uint64_t ServiceClient::stream(
+    const parapm::v1::StreamRequest& request,
+    const std::function<void(const parapm::v1::PmStreamMessage&)>& on_message) {
+  auto context = this->context(0);
+  auto reader = stub_->StreamPM(context.get(), request);
+  parapm::v1::PmStreamMessage message;
+  uint64_t received = 0;
+  while (reader->Read(&message)) {
+    ++received;
+    if (on_message) on_message(message);
+  }
+  check_status(reader->Finish(), "stream " + request.job_id(), server_);
+  return received;
+}
+
 uint64_t ServiceClient::download(const std::string& job_id, const std::filesystem::path& out) {
   auto context = this->context(0);
   parapm::v1::JobRef ref;
@@ -209,4 +224,4 @@ std::string describe_event(const parapm::v1::JobEvent& e) {
   }
 }
 
-}  // namespace parapm::cli
+}  // namespace parapm::client
