@@ -1,5 +1,7 @@
 #include "cli_common.h"
 
+#include <parapm/openmesh.h>
+
 #include <unistd.h>
 
 #include <chrono>
@@ -41,7 +43,10 @@ void ProgressBar::finish() {
 LoadedMesh load_and_repair(const std::string& path, const RepairOptions& options) {
   LoadedMesh loaded;
   auto start = std::chrono::steady_clock::now();
-  Mesh mesh = read_mesh(path, &loaded.read);
+  // .om: OpenMesh's own format, through its reader (ParaPM's readers do the others).
+  const bool openmesh_file = path.size() > 3 && (path.compare(path.size() - 3, 3, ".om") == 0 ||
+                                                 path.compare(path.size() - 3, 3, ".OM") == 0);
+  Mesh mesh = openmesh_file ? openmesh::read_openmesh(path) : read_mesh(path, &loaded.read);
   loaded.read_seconds = seconds_since(start);
   loaded.input_vertices = mesh.vertex_count();
   loaded.input_faces = mesh.face_count();
@@ -50,7 +55,9 @@ LoadedMesh load_and_repair(const std::string& path, const RepairOptions& options
   loaded.repair_seconds = seconds_since(start);
   const RepairReport& r = loaded.repaired.report;
   spdlog::info("read {}: {} vertices, {} faces ({}) in {:.3f} s", path, loaded.input_vertices,
-               loaded.input_faces, format_name(loaded.read.format), loaded.read_seconds);
+               loaded.input_faces,
+               openmesh_file ? "om, OpenMesh's reader" : format_name(loaded.read.format),
+               loaded.read_seconds);
   if (r.changed())
     spdlog::info(
         "repaired {}: removed {} degenerate and {} duplicate faces, {} unreferenced vertices; "

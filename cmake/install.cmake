@@ -3,7 +3,8 @@
 # include/parapm/engine/, which the targets add to the include path), the static libraries and
 # lib/cmake/ParaPM/, so that another project writes
 #   find_package(ParaPM REQUIRED)
-#   target_link_libraries(app PRIVATE ParaPM::engine)   # and ParaPM::client for the gRPC client
+#   target_link_libraries(app PRIVATE ParaPM::engine)   # ParaPM::openmesh for the OpenMesh
+#                                                         # adapters, ParaPM::client for gRPC
 # tests/package/ builds examples/cpp against a fresh prefix.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -17,9 +18,10 @@ set(PARAPM_ENGINE_HEADERS io/gltf_writer.h io/mesh_io.h mesh/mesh.h mesh/repair.
   simplify/modules.h simplify/quad_heap.h simplify/quadric.h simplify/simplifier.h
   simplify/simplify.h util/error.h util/progress.h)
 
-install(TARGETS ${PARAPM_ENGINE_LIBRARIES} EXPORT ParaPMTargets
+install(TARGETS ${PARAPM_ENGINE_LIBRARIES} parapm_openmesh EXPORT ParaPMTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-install(FILES include/parapm/engine.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/parapm)
+install(FILES include/parapm/engine.h include/parapm/openmesh.h
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/parapm)
 foreach(header ${PARAPM_ENGINE_HEADERS})
   get_filename_component(folder ${header} DIRECTORY)
   install(FILES engine/${header} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/parapm/engine/${folder})

@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
     for (double ratio : {0.5, 0.1, 0.02}) {
       const size_t level = parapm::level_for_faces(pm, size_t(ratio * double(faces)));
       meshes.push_back(parapm::level_of_detail(pm, level));
-      chain.push_back({&meshes.back(), level, level < pm.splits.size() ? pm.splits[level].error : 0});
+      chain.push_back(
+          {&meshes.back(), level, level < pm.splits.size() ? pm.splits[level].error : 0});
     }
     parapm::write_gltf(chain, (out / "lods.glb").string());
     std::printf("%zu faces -> base %zu faces + %zu vertex splits; levels of %zu, %zu, %zu faces\n",

@@ -2,7 +2,8 @@
 # The installed package as another project meets it: `cmake --install BUILD` into a fresh
 # prefix, examples/cpp configured against that prefix alone (find_package(ParaPM)) and built,
 # then run: parapm-example-levels builds a PM of a committed mesh (checked lossless by
-# `parapm check`) and a glTF chain of levels; parapm-example-submit (with the service) sends
+# `parapm check`) and a glTF chain of levels; parapm-example-openmesh does it through OpenMesh
+# and writes a level as .om, which parapm reads; parapm-example-submit (with the service) sends
 # a mesh to a real coordinator on loopback and downloads its PM, checked the same way.
 # Usage: installed_package_test.sh BUILD_DIR
 set -euo pipefail
@@ -30,6 +31,9 @@ mesh="$root/tests/data/stratocaster-9k.ply"
 "$build/bin/parapm" --log-level warn check "$work/out/mesh.pm" --against "$mesh" \
   || fail "the example's PM does not rebuild its input"
 [[ -s "$work/out/lods.glb" ]] || fail "no lods.glb"
+"$work/examples/parapm-example-openmesh" "$mesh" "$work/out/level.om"
+"$build/bin/parapm" --log-level warn simplify "$work/out/level.om" -o "$work/out/level.pm" \
+  > /dev/null || fail "parapm does not read the .om the example wrote"
 
 if [[ -x "$work/examples/parapm-example-submit" ]]; then
   "$build/bin/parapm-coordinator" --listen 127.0.0.1:0 --port-file "$work/port" \
