@@ -10,7 +10,8 @@ build="${PARAPM_BUILD_DIR:-$root/build}"
 pkgs=(cmake ninja-build g++ ccache libeigen3-dev libspdlog-dev libfmt-dev libcli11-dev
       nlohmann-json3-dev zlib1g-dev libgrpc++-dev libprotobuf-dev protobuf-compiler
       protobuf-compiler-grpc libsqlite3-dev libssl-dev libgtest-dev libgmock-dev
-      pkg-config libcpp-httplib-dev prometheus-cpp-dev libopenmesh-dev chromium)
+      pkg-config libcpp-httplib-dev prometheus-cpp-dev libopenmesh-dev python3 python3-grpcio
+      python3-protobuf chromium)
 # Node.js runs the viewer's tests (a machine may have its own Node.js, with npm, installed
 # outside Debian's packages: then nothing is added).
 if ! command -v node > /dev/null; then pkgs+=(nodejs npm)

@@ -81,11 +81,12 @@ EOF
 fi
 [[ -n "$base_only" ]] && exit 0
 
-# The build stage's -dev packages must cover scripts/bootstrap.sh's (less the test-only ones),
+# The build stage's -dev packages must cover scripts/bootstrap.sh's (less the test-only ones:
+# the browser, GoogleTest, Node.js, the Python client's interpreter and its gRPC),
 # so that the image builds whatever the project's own build needs.
 bootstrap_pkgs="$(sed -n '/^pkgs=(/,/)/p' "$root/scripts/bootstrap.sh" | tr -d '()' | sed 's/pkgs=//' | tr -s ' \n' '\n' | grep -v '^$')"
 image_pkgs=" $(sed -nE 's/^ +([a-z0-9][a-z0-9.+-]*) \\$/\1/p' "$here/Containerfile" | tr '\n' ' ') "
-not_in_image=" chromium libgtest-dev libgmock-dev nodejs npm "
+not_in_image=" chromium libgtest-dev libgmock-dev nodejs npm python3 python3-grpcio python3-protobuf "
 for p in $bootstrap_pkgs; do
   [[ "$not_in_image" == *" $p "* || "$image_pkgs" == *" $p "* ]] && continue
   echo "image: scripts/bootstrap.sh installs $p but the Containerfile's build stage does not: add it there" >&2
