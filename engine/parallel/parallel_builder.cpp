@@ -846,7 +846,10 @@ void ParallelBuilder::finish_round(Round& r) {
   if (events_.merged) events_.merged(rs);
   if (r.scheduled && counts(rs)) --scheduled_left_;
   st_.round_stats.push_back(std::move(rs));
-  if (progress_) progress_(input_faces_ - whole_->live_faces(), input_faces_ - target_);
+  if (progress_) {
+    const uint64_t total = input_faces_ - target_;
+    progress_(std::min<uint64_t>(input_faces_ - whole_->live_faces(), total), total);
+  }
 }
 
 void ParallelBuilder::final_pass() {
@@ -870,7 +873,8 @@ void ParallelBuilder::final_pass() {
   const double setup_seconds = seconds_since(t);
   std::vector<CollapseRecord> final_records;
   auto progress = [&](uint64_t done, uint64_t) {
-    if (progress_) progress_(done_before + done, input_faces_ - target_);
+    const uint64_t total = input_faces_ - target_;
+    if (progress_) progress_(std::min<uint64_t>(done_before + done, total), total);
   };
   // The last round's records go into records_ beside it (append_pending).
   const Beside timed =

@@ -401,12 +401,12 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
 
     if ((records.size() & 1023) == 0) {
       // Progress first: a caller may cancel from its callback (a worker polling its call).
-      if (progress) progress(start_faces - mesh_.live_faces(), total);
+      if (progress) progress(std::min<uint64_t>(start_faces - mesh_.live_faces(), total), total);
       if (cancel) cancel->check();
     }
   }
   stats_.collapses = records.size();
-  if (progress) progress(start_faces - mesh_.live_faces(), total);
+  if (progress) progress(std::min<uint64_t>(start_faces - mesh_.live_faces(), total), total);
   return records;
 }
 

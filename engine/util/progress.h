@@ -33,7 +33,8 @@ class CancelToken {
   std::atomic<int64_t> deadline_ns_{0};
 };
 
-// Called with the work done so far and the total (same unit, e.g. collapses); may be empty.
+// Called with the work done so far and the total (same unit, e.g. faces removed; done <= total:
+// a last collapse that removes one face more than asked counts as the total); may be empty.
 using ProgressCallback = std::function<void(uint64_t done, uint64_t total)>;
 
 }  // namespace parapm

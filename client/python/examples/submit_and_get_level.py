@@ -43,7 +43,6 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
 
 def progress_bar(label: str, done: int, total: int) -> str:
     """One line: LABEL [#####.....]  NN% done/total."""
-    # The coordinator's done can pass its total by a face or so: the bar stops at 100%.
     fraction = min(done / total, 1.0) if total else 0.0
     filled = int(round(fraction * BAR_WIDTH))
     bar = "#" * filled + "." * (BAR_WIDTH - filled)

@@ -211,6 +211,8 @@ class AgainstARealCoordinator(unittest.TestCase):
                 for e in events_named(self.events, "progress")]
         self.assertTrue(seen, "the build reported no progress")
         self.assertEqual(calls, seen)
+        for done, total in seen:
+            self.assertLessEqual(done, total)
 
     def test_the_pm_is_the_cpp_clients_and_lossless(self) -> None:
         data = self.pm.read_bytes()
