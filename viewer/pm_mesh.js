@@ -127,11 +127,17 @@ export class PmMesh {
   // created by a split between the two levels descends from that split's vs), 3 floats per
   // vertex of the finer level. Faces do not change during the morph: at t = 0 the fine faces
   // around a split lie on the coarse surface, those a split adds with no area.
+  // With attributes, the wedge values likewise (engine/pm/geomorph.h's rule): a wedge that
+  // exists at the coarser level moves from its value there (`coarseWedgeValues`) to its value
+  // at the finer one (`fineWedgeValues`); a wedge introduced between them keeps its value (only
+  // faces the splits add use it, and they start with no area). Null without attributes.
   geomorph(level) {
     level = Math.max(0, Math.min(level, this.decoder.splitCount));
     const coarse = Math.min(this.level, level), fine = Math.max(this.level, level);
+    const F = this.floatsPerWedge;
     this.setLevel(coarse);
     const atCoarse = this.positions.slice(0, 3 * (this.n0 + coarse));
+    const wedgesAtCoarse = F ? this.wedgeValues.slice(0, F * this.#wedgesAt(coarse)) : null;
     this.setLevel(fine);
     const n = this.n0 + fine;
     const ancestor = new Uint32Array(n);
@@ -140,7 +146,28 @@ export class PmMesh {
     const coarsePositions = new Float32Array(3 * n);
     for (let v = 0; v < n; v++)
       for (let k = 0; k < 3; k++) coarsePositions[3 * v + k] = atCoarse[3 * ancestor[v] + k];
-    return {coarse, fine, coarsePositions, finePositions: this.positions.slice(0, 3 * n)};
+    let coarseWedgeValues = null, fineWedgeValues = null;
+    if (F) {
+      fineWedgeValues = this.wedgeValues.slice(0, F * this.#wedgesAt(fine));
+      coarseWedgeValues = fineWedgeValues.slice();
+      coarseWedgeValues.set(wedgesAtCoarse);
+    }
+    return {coarse, fine, coarsePositions, finePositions: this.positions.slice(0, 3 * n),
+      coarseWedgeValues, fineWedgeValues};
+  }
+
+  // Wedges in use at `level`: the base's and those the splits before it introduced.
+  #wedgesAt(level) {
+    const d = this.decoder;
+    return level < d.splitCount ? d.attributeRecords[level].firstWedge : d.wedgeCount;
+  }
+
+  // The wedge values of the level now at (1 - t) from + t to (geomorph()'s arrays); at t = 1
+  // exactly `to`.
+  morphWedgeValues(from, to, t) {
+    const values = this.wedgeValues, n = from.length;
+    if (t >= 1) return values.set(to);
+    for (let j = 0; j < n; j++) values[j] = from[j] + (to[j] - from[j]) * t;
   }
 
   // The vertices of the level now at (1 - t) from + t to (geomorph()'s arrays).

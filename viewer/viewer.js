@@ -104,6 +104,10 @@ function moveTo(level) {
     target: level,
     from: refining ? g.coarsePositions : g.finePositions,
     to: refining ? g.finePositions : g.coarsePositions,
+    // Attributes (null without): their values glide the same way.
+    fromWedges: refining ? g.coarseWedgeValues : g.fineWedgeValues,
+    toWedges: refining ? g.fineWedgeValues : g.coarseWedgeValues,
+    fineWedges: g.fineWedgeValues,
     start: performance.now(),
   };
   viewer.morphing = true;
@@ -171,12 +175,16 @@ function zoom(factor) {
 function stepMorph() {
   const t = Math.min(1, (performance.now() - morph.start) / 1000 / kGeomorphSeconds);
   mesh.morphPositions(morph.from, morph.to, t);
+  if (morph.fromWedges) mesh.morphWedgeValues(morph.fromWedges, morph.toWedges, t);
   dirty = true;
   if (t >= 1) finishMorph();
 }
 
 function finishMorph() {
   mesh.morphPositions(morph.from, morph.to, 1);
+  // The fine level's own values back before any split is undone (undoing a split's wedge
+  // changes subtracts its exact deltas from the fine values).
+  if (morph.fineWedges) mesh.wedgeValues.set(morph.fineWedges);
   const target = morph.target;
   morph = null;
   viewer.morphing = false;

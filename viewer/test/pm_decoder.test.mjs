@@ -155,6 +155,49 @@ test('a geomorph starts on the coarse level\'s surface and ends on the fine leve
   });
 });
 
+test('a geomorph of a textured PM moves the wedge values too: the coarse level\'s at the start, the fine level\'s at the end', () => {
+  withTempDir((dir) => {
+    const pm = simplified(dir, 'pymeshlab-bunny-textured-10k.obj', '--metric', 'energy');
+    const decoder = decodeInPieces(new Uint8Array(readFileSync(pm)), 11);
+    const mesh = new PmMesh(decoder), F = mesh.floatsPerWedge;
+    assert.ok(F > 0);
+    // Each face corner: position and values, as text.
+    const corners = () => {
+      const out = [];
+      for (let c = 0; c < 3 * mesh.faceCount; c++) {
+        const v = mesh.faces[c], w = mesh.cornerWedges[c];
+        out.push([...mesh.positions.subarray(3 * v, 3 * v + 3), ...mesh.wedgeValues.subarray(F * w, F * w + F)].join(','));
+      }
+      return out;
+    };
+    const coarse = 800, fine = 3000;
+    mesh.setLevel(coarse);
+    const coarseCorners = new Set(corners());
+    const g = mesh.geomorph(fine);
+    const fineCorners = corners();
+    // At t = 0 every face with area is a coarse face: its corners, values included, are the
+    // coarse level's (faces the splits added have two corners on one vertex: no area).
+    mesh.morphPositions(g.coarsePositions, g.finePositions, 0);
+    mesh.morphWedgeValues(g.coarseWedgeValues, g.fineWedgeValues, 0);
+    const atStart = corners();
+    let faces = 0;
+    for (let f = 0; f < mesh.faceCount; f++) {
+      const [a, b, c] = [0, 1, 2].map((k) => mesh.faces[3 * f + k]);
+      const p = (v) => Array.from(mesh.positions.subarray(3 * v, 3 * v + 3)).join(',');
+      if (p(a) === p(b) || p(b) === p(c) || p(a) === p(c)) continue;
+      faces++;
+      for (let k = 0; k < 3; k++) assert.ok(coarseCorners.has(atStart[3 * f + k]), `face ${f} corner ${k}`);
+    }
+    assert.ok(faces > 0);
+    mesh.morphPositions(g.coarsePositions, g.finePositions, 1);
+    mesh.morphWedgeValues(g.coarseWedgeValues, g.fineWedgeValues, 1);
+    assert.deepEqual(corners(), fineCorners);
+    // Undoing the splits from there gives the coarse level back exactly.
+    mesh.setLevel(coarse);
+    assert.deepEqual(new Set(corners()), coarseCorners);
+  });
+});
+
 test('selective refinement: everything is the full mesh, nothing the base, a region stays a valid mesh', () => {
   withTempDir((dir) => {
     const pm = simplified(dir, 'stratocaster-9k.ply');
