@@ -32,9 +32,10 @@ const viewer = {
     const v = renderer.view();
     return {viewProjection: Array.from(v.viewProjection), width: renderer.canvas.width, height: renderer.canvas.height};
   },
-  // Milliseconds since the page's start (performance.now()) of the first frame with the base
-  // mesh and of the stream's end, and the seconds spent decoding and applying vsplits.
-  timings: {firstFrame: 0, done: 0, decodeSeconds: 0, applySeconds: 0},
+  // Milliseconds since the page's start (performance.now()) of the .pm's request, of its base
+  // mesh decoded, of the first frame with the base mesh and of the stream's end, and the
+  // seconds spent decoding and applying vsplits.
+  timings: {request: 0, base: 0, firstFrame: 0, done: 0, decodeSeconds: 0, applySeconds: 0},
 };
 window.parapmViewer = viewer;
 
@@ -251,8 +252,9 @@ async function showJob() {
     if (renderer) renderer.wireframe = e.target.checked;
     dirty = true;
   };
-  startTime = performance.now();
-  const response = await fetch(api(`/api/jobs/${encodeURIComponent(jobId)}/pm`));
+  // The request early_fetch.js started while the modules loaded, else one now.
+  startTime = viewer.timings.request = window.parapmEarlyPmAt ?? performance.now();
+  const response = await (window.parapmEarlyPm ?? fetch(api(`/api/jobs/${encodeURIComponent(jobId)}/pm`)));
   if (!response.ok) return fail(await errorOf(response));
   const reader = response.body.getReader();
   decoder = new PmDecoder();
@@ -265,6 +267,7 @@ async function showJob() {
     decoder.push(value);
     viewer.timings.decodeSeconds += (performance.now() - start) / 1000;
     if (!mesh && decoder.base) {
+      viewer.timings.base = performance.now();
       mesh = new PmMesh(decoder);
       viewer.totalVsplits = decoder.header.splits;
       slider.max = String(decoder.header.splits);
@@ -272,6 +275,8 @@ async function showJob() {
       renderer.onCameraChange = cameraChanged;
       viewer.state = 'streaming';
       dirty = true;
+      // The base mesh on screen first (the next frame draws it), then the splits.
+      await new Promise((resolve) => requestAnimationFrame(resolve));
     }
     if (mesh && follow && !morph) setLevel(decoder.splitCount);
     if (mesh) report();
