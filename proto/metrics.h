@@ -11,15 +11,11 @@
 #include <functional>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include <prometheus/registry.h>
 
+#include "http_endpoint.h"
 #include "rpc_security.h"
-
-namespace httplib {
-class Server;
-}
 
 namespace parapm::rpc {
 
@@ -46,24 +42,17 @@ class MetricsServer {
   // loopback without a token.
   MetricsServer(std::shared_ptr<prometheus::Registry> registry, MetricsEndpoint endpoint,
                 std::function<void()> before_scrape = {});
-  ~MetricsServer();  // stop()
   MetricsServer(const MetricsServer&) = delete;
   MetricsServer& operator=(const MetricsServer&) = delete;
 
   // Binds and serves on a thread of its own; returns the port. Throws Error(kIo).
   int start();
-  void stop();
+  void stop() { http_.stop(); }
 
  private:
   std::shared_ptr<prometheus::Registry> registry_;
-  MetricsEndpoint endpoint_;
   std::function<void()> before_scrape_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
+  HttpEndpoint http_;
 };
-
-// Splits "host:port" (host may be [v6]; an empty host is every address); throws
-// Error(kInvalidInput) naming `flag`.
-std::pair<std::string, int> http_host_and_port(const std::string& listen, const std::string& flag);
 
 }  // namespace parapm::rpc

@@ -72,55 +72,29 @@ bool plausible_id(const std::string& id) {
 }  // namespace
 
 ViewerServer::ViewerServer(Coordinator& coordinator, ViewerConfig config)
-    : coordinator_(coordinator), config_(std::move(config)) {
-  rpc::http_host_and_port(config_.listen, "--http");  // checked now
-  if (config_.token.empty() && !rpc::is_loopback_address(config_.listen))
-    throw_invalid("refusing to serve the viewer on " + config_.listen +
-                  " without a token: beyond loopback every request needs one (--token-file FILE "
-                  "or PARAPM_TOKEN)");
-  if (config_.tls.server_enabled()) {
-    server_ = std::make_unique<httplib::SSLServer>(config_.tls.cert_file.c_str(),
-                                                   config_.tls.key_file.c_str());
-    if (!server_->is_valid())
-      throw Error(ErrorCode::kInvalidInput, "--tls-cert / --tls-key: the viewer cannot use them");
-  } else {
-    server_ = std::make_unique<httplib::Server>();
-  }
-  const unsigned threads = std::max(1u, config_.threads);
-  server_->new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  server_->set_read_timeout(std::chrono::seconds(config_.read_timeout_s));
-  server_->set_write_timeout(std::chrono::seconds(config_.write_timeout_s));
-  server_->set_keep_alive_max_count(kRequestsPerConnection);
-  server_->set_payload_max_length(4096);  // every route is a GET
+    : coordinator_(coordinator),
+      config_(std::move(config)),
+      http_({.what = "the viewer",
+             .flag = "--http",
+             .listen = config_.listen,
+             .token = config_.token,
+             .tls = config_.tls,
+             .threads = config_.threads,
+             .read_timeout_s = config_.read_timeout_s,
+             .write_timeout_s = config_.write_timeout_s}) {
+  http_.server().set_keep_alive_max_count(kRequestsPerConnection);
   add_routes();
 }
 
-ViewerServer::~ViewerServer() { stop(); }
-
 int ViewerServer::start() {
-  const auto [host, port] = rpc::http_host_and_port(config_.listen, "--http");
-  port_ = port == 0 ? server_->bind_to_any_port(host.c_str())
-                    : (server_->bind_to_port(host.c_str(), port) ? port : -1);
-  if (port_ <= 0) throw Error(ErrorCode::kIo, "the viewer cannot listen on " + config_.listen);
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  const int port = http_.start();
   spdlog::info("viewer: {}{}", url(), config_.token.empty() ? "" : " (token required)");
-  return port_;
-}
-
-void ViewerServer::stop() {
-  if (!thread_.joinable()) return;
-  server_->stop();
-  thread_.join();
-}
-
-std::string ViewerServer::url() const {
-  return std::string(config_.tls.server_enabled() ? "https" : "http") + "://" +
-         rpc::reachable_address(config_.listen, port_) + "/";
+  return port;
 }
 
 void ViewerServer::add_routes() {
   // Every response: no sniffing, scripts only from here.
-  server_->set_post_routing_handler([](const httplib::Request&, httplib::Response& response) {
+  http_.server().set_post_routing_handler([](const httplib::Request&, httplib::Response& response) {
     response.set_header("X-Content-Type-Options", "nosniff");
     response.set_header("Content-Security-Policy",
                         "default-src 'self'; style-src 'self' 'unsafe-inline'");
@@ -155,57 +129,62 @@ void ViewerServer::add_routes() {
     return id;
   };
 
-  server_->Get("/api/jobs", api([this](const httplib::Request&, httplib::Response& response) {
-                 std::string out = "{\"jobs\": [";
-                 bool first = true;
-                 for (const parapm::v1::Job& job : coordinator_.jobs(1000)) {
-                   out += first ? "\n" : ",\n";
-                   out += job_json(job);
-                   first = false;
-                 }
-                 response.set_content(out + "\n]}\n", "application/json");
-               }));
-  server_->Get(R"(/api/jobs/([^/]+))",
-               api([this, job_id_of](const httplib::Request& request, httplib::Response& response) {
-                 response.set_content(job_json(coordinator_.job(job_id_of(request))) + "\n",
-                                      "application/json");
-               }));
-  server_->Get(R"(/api/jobs/([^/]+)/pm)",
-               api([this, job_id_of](const httplib::Request& request, httplib::Response& response) {
-                 const std::shared_ptr<const LoadedPm> loaded = coordinator_.pm(job_id_of(request));
-                 response.set_header("X-ParaPM-Vsplits", std::to_string(loaded->pm.splits.size()));
-                 response.set_content_provider(
-                     loaded->bytes.size(), "application/octet-stream",
-                     [loaded](size_t offset, size_t length, httplib::DataSink& sink) {
-                       const size_t n = std::min(length, kStreamChunkBytes);
-                       return sink.write(loaded->bytes.data() + offset, n);
-                     });
-               }));
+  http_.server().Get("/api/jobs", api([this](const httplib::Request&, httplib::Response& response) {
+                       std::string out = "{\"jobs\": [";
+                       bool first = true;
+                       for (const parapm::v1::Job& job : coordinator_.jobs(1000)) {
+                         out += first ? "\n" : ",\n";
+                         out += job_json(job);
+                         first = false;
+                       }
+                       response.set_content(out + "\n]}\n", "application/json");
+                     }));
+  http_.server().Get(R"(/api/jobs/([^/]+))", api([this, job_id_of](const httplib::Request& request,
+                                                                   httplib::Response& response) {
+                       response.set_content(job_json(coordinator_.job(job_id_of(request))) + "\n",
+                                            "application/json");
+                     }));
+  http_.server().Get(
+      R"(/api/jobs/([^/]+)/pm)",
+      api([this, job_id_of](const httplib::Request& request, httplib::Response& response) {
+        const std::shared_ptr<const LoadedPm> loaded = coordinator_.pm(job_id_of(request));
+        response.set_header("X-ParaPM-Vsplits", std::to_string(loaded->pm.splits.size()));
+        response.set_content_provider(
+            loaded->bytes.size(), "application/octet-stream",
+            [loaded](size_t offset, size_t length, httplib::DataSink& sink) {
+              const size_t n = std::min(length, kStreamChunkBytes);
+              return sink.write(loaded->bytes.data() + offset, n);
+            });
+      }));
   // Prometheus' scrape (docs/OPERATIONS.md): with a token, in the Authorization header.
-  server_->Get("/metrics", [this](const httplib::Request& request, httplib::Response& response) {
-    if (!rpc::scrape_allowed(config_.token, request.get_header_value("Authorization")))
-      return send_error(response, 401, "a scrape needs Authorization: Bearer TOKEN");
-    coordinator_.refresh_metrics();
-    response.set_content(rpc::prometheus_text(*coordinator_.metrics().registry),
-                         rpc::kPrometheusContentType);
-  });
-  server_->Get(R"(/api/.*)", [](const httplib::Request& request, httplib::Response& response) {
-    send_error(response, 404, "no such route: " + request.path.substr(0, 200));
-  });
+  http_.server().Get(
+      "/metrics", [this](const httplib::Request& request, httplib::Response& response) {
+        if (!rpc::scrape_allowed(config_.token, request.get_header_value("Authorization")))
+          return send_error(response, 401, "a scrape needs Authorization: Bearer TOKEN");
+        coordinator_.refresh_metrics();
+        response.set_content(rpc::prometheus_text(*coordinator_.metrics().registry),
+                             rpc::kPrometheusContentType);
+      });
+  http_.server().Get(R"(/api/.*)",
+                     [](const httplib::Request& request, httplib::Response& response) {
+                       send_error(response, 404, "no such route: " + request.path.substr(0, 200));
+                     });
   // Browsers ask for an icon on their own: none, without an error in the page's console.
-  server_->Get("/favicon.ico",
-               [](const httplib::Request&, httplib::Response& response) { response.status = 204; });
-  // The page's files.
-  server_->Get(R"(/([^/]*))", [](const httplib::Request& request, httplib::Response& response) {
-    std::string path = request.matches[1];
-    if (path.empty()) path = "index.html";
-    for (const ViewerAsset& asset : viewer_assets())
-      if (asset.path == path) {
-        response.set_content(std::string(asset.bytes), std::string(asset.content_type));
-        return;
-      }
-    send_error(response, 404, "no such file: " + path.substr(0, 200));
+  http_.server().Get("/favicon.ico", [](const httplib::Request&, httplib::Response& response) {
+    response.status = 204;
   });
+  // The page's files.
+  http_.server().Get(
+      R"(/([^/]*))", [](const httplib::Request& request, httplib::Response& response) {
+        std::string path = request.matches[1];
+        if (path.empty()) path = "index.html";
+        for (const ViewerAsset& asset : viewer_assets())
+          if (asset.path == path) {
+            response.set_content(std::string(asset.bytes), std::string(asset.content_type));
+            return;
+          }
+        send_error(response, 404, "no such file: " + path.substr(0, 200));
+      });
 }
 
 }  // namespace parapm::service

@@ -17,13 +17,9 @@
 
 #include <memory>
 #include <string>
-#include <thread>
 
+#include "http_endpoint.h"
 #include "rpc_security.h"
-
-namespace httplib {
-class Server;
-}
 
 namespace parapm::service {
 
@@ -41,25 +37,22 @@ class ViewerServer {
  public:
   // Throws Error(kInvalidInput) for a bad address, or beyond loopback without a token.
   ViewerServer(Coordinator& coordinator, ViewerConfig config);
-  ~ViewerServer();  // stop()
   ViewerServer(const ViewerServer&) = delete;
   ViewerServer& operator=(const ViewerServer&) = delete;
 
   // Binds and serves on a thread of its own; returns the port. Throws Error(kIo) when the
   // address cannot be bound.
   int start();
-  void stop();
+  void stop() { http_.stop(); }
   // http(s)://HOST:PORT/ as a browser on this machine reaches it.
-  std::string url() const;
+  std::string url() const { return http_.url(); }
 
  private:
   void add_routes();
 
   Coordinator& coordinator_;
   ViewerConfig config_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
-  int port_ = 0;
+  rpc::HttpEndpoint http_;
 };
 
 }  // namespace parapm::service

@@ -28,11 +28,6 @@ std::string lower(std::string s) {
   return s;
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // The buffer every accessor points into, and the JSON describing its views and accessors.
 class BufferBuilder {
  public:
@@ -168,7 +163,7 @@ std::string glb(std::string text, std::string bin) {
 
 bool is_gltf_path(const std::string& path) {
   const std::string name = lower(path);
-  return ends_with(name, ".glb") || ends_with(name, ".gltf");
+  return name.ends_with(".glb") || name.ends_with(".gltf");
 }
 
 std::string gltf_bytes(const std::vector<GltfLevel>& levels, bool binary) {
@@ -210,7 +205,7 @@ std::string gltf_bytes(const std::vector<GltfLevel>& levels, bool binary) {
 void write_gltf(const std::vector<GltfLevel>& levels, const std::string& path) {
   const std::string name = lower(path);
   if (!is_gltf_path(name)) throw_invalid(path + ": a glTF file is named .glb or .gltf");
-  io::write_file_bytes(path, gltf_bytes(levels, ends_with(name, ".glb")));
+  io::write_file_bytes(path, gltf_bytes(levels, name.ends_with(".glb")));
 }
 
 }  // namespace parapm
