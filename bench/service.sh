@@ -8,8 +8,9 @@
 # threads), and prints one TSV row: mesh, p, in-process wall s, service wall s (client: upload
 # to end of download), its parts (upload, wait, download), the transport inside the job
 # (coordinator reading the upload, encoding jobs, subset calls' time beyond the workers' own
-# summed over calls, storing the PM), transport / service wall, and whether both .pm files are
-# byte-identical (they must be).
+# summed over calls, storing the PM), the MB of jobs and of results moved between coordinator
+# and workers and their sum per input face (bytes), transport / service wall, and whether both
+# .pm files are byte-identical (they must be).
 # Environment: P (default 2), METRIC (default energy), WORKERS, WORKER_THREADS, PORT (default
 # 50151), BENCH_OUT (default ./bench-out-service), PARAPM_BUILD_DIR (default build/).
 set -euo pipefail
@@ -44,8 +45,9 @@ for mesh in "$@"; do
     -o "$out/$name-local.pm" > /dev/null
   t1=$(date +%s.%N)
   same=no; cmp -s "$out/$name-service.pm" "$out/$name-local.pm" && same=yes
+  faces="$("$bin" info "$out/$name-local.pm" --json | jq .input_faces)"
   jq -r --argjson fin "$fin" --arg mesh "$name" --arg p "$p" --arg local "$(echo "$t1 - $t0" | bc)" \
-    --arg same "$same" '
+    --arg same "$same" --argjson faces "$faces" '
     ($fin.transport // {}) as $t
     | [($t.read_seconds // 0), ($t.encode_seconds // 0), ($t.call_overhead_seconds // 0),
        ($t.store_seconds // 0)] as $parts
@@ -57,5 +59,7 @@ for mesh in "$@"; do
        ($parts[] | . * 1000 | round / 1000),
        ((($t.job_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
        ((($t.result_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
+       (((($t.job_bytes // "0") | tonumber) + (($t.result_bytes // "0") | tonumber)) / $faces
+        | round),
        ($moved / .client.total_seconds * 1000 | round / 1000), $same] | @tsv' <<< "$svc"
 done

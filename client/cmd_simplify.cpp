@@ -82,6 +82,8 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
                       {"keys_reused", r.keys_reused},
                       {"band_pass_collapses", r.band_pass_collapses},
                       {"band_pass_seconds", r.band_pass_seconds},
+                      {"append_beyond_band_seconds", r.append_beyond_band_seconds},
+                      {"critical_seconds", round_critical_seconds(r)},
                       {"subsets", subsets}});
   }
   return {{"p", stats.subsets},
@@ -91,6 +93,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
           {"setup_seconds", stats.setup_seconds},
           {"final_pass_collapses", stats.final_pass_collapses},
           {"final_pass_seconds", stats.final_pass_seconds},
+          {"final_work_seconds", stats.final_work_seconds},
           {"final_append_seconds", stats.final_append_seconds},
           {"pm_build_seconds", stats.pm_build_seconds},
           {"cpu_seconds", stats.cpu_seconds},

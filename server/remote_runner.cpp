@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "parallel/job_codec.h"
+#include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
 #include "parapm.grpc.pb.h"
 #include "rpc_security.h"
@@ -232,9 +233,11 @@ class RemoteRunner::Dispatch {
   // A finished flight: its result, or a retry elsewhere, or the job's failure (Error).
   void take_outcome(Flight& f) {
     const SubsetJob& job = jobs_[f.index];
-    if (f.status.ok() && !f.slot.worker_id.empty() && f.result.state.metric != job.state.metric)
-      f.status = {grpc::StatusCode::DATA_LOSS,
-                  "the worker returned a state of metric '" + f.result.state.metric + "'"};
+    if (f.status.ok() && !f.slot.worker_id.empty() &&
+        f.result.state.metric != returned_state_metric(job))
+      f.status = {grpc::StatusCode::DATA_LOSS, "the worker returned a state of metric '" +
+                                                   f.result.state.metric + "', expected '" +
+                                                   returned_state_metric(job) + "'"};
     if (f.status.ok()) {
       if (!f.slot.worker_id.empty()) {
         TransportStats& transport = runner_.transport_;

@@ -121,7 +121,7 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
     spdlog::info("{}: started, {} faces", name, job.mesh.face_count());
     SubsetResult result;
     try {
-      result = simplify_subset(job, progress, &cancel);
+      result = simplify_subset(std::move(job), progress, &cancel);
     } catch (const Error& e) {
       if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded)
         spdlog::info("{}: stopped ({}) after {:.3f} s", name, e.what(), seconds_since(start));

@@ -97,7 +97,7 @@ bool link_condition_holds(const CollapseMesh& mesh, VertexId vs, VertexId vt,
 // With `subset`, first that it keeps the subset rule there: vs, vt and every vertex adjacent to
 // either are owned by `subset` (so that it reads and changes that subset's part of the mesh
 // only, before anything else of it is read).
-EdgeFaces check_and_collapse(CollapseMesh& mesh, const CollapseRecord& r, size_t index,
+EdgeFaces check_and_collapse(CollapseMesh& mesh, CollapseRecord& r, size_t index,
                              const std::vector<uint32_t>* vertex_subset, uint32_t subset,
                              CollapseMesh::RemovedCounts* counted) {
   auto fail = [&](const std::string& what) {
@@ -120,11 +120,23 @@ EdgeFaces check_and_collapse(CollapseMesh& mesh, const CollapseRecord& r, size_t
   if (!mesh.vertex_alive(r.vs) || !mesh.vertex_alive(r.vt))
     fail("names a vertex that is not in the mesh");
   const EdgeFaces edge = mesh.edge_faces(r.vs, r.vt);
-  if ((edge.left == kNoId && edge.right == kNoId) || edge.left != r.fl || edge.right != r.fr ||
-      edge.left_apex != r.vl || edge.right_apex != r.vr)
+  if ((edge.left == kNoId && edge.right == kNoId) || edge.left != r.fl || edge.right != r.fr)
     fail("does not find the faces its subset saw");
+  if (r.to_complete) {
+    r.vl = edge.left_apex;
+    r.vr = edge.right_apex;
+    r.corner_wedges = corner_wedges_of(mesh, r);
+    r.vs_position = mesh.position(r.vs);
+    r.vt_position = mesh.position(r.vt);
+    r.to_complete = false;
+  } else if (edge.left_apex != r.vl || edge.right_apex != r.vr) {
+    fail("does not find the apexes its subset saw");
+  } else if (r.corner_wedges != corner_wedges_of(mesh, r)) {
+    fail("names other corner wedges");
+  } else if (r.vs_position != mesh.position(r.vs) || r.vt_position != mesh.position(r.vt)) {
+    fail("does not start where the mesh has its vertices");
+  }
   if (!link_condition_holds(mesh, r.vs, r.vt, edge)) fail("breaks the link condition");
-  if (r.corner_wedges != corner_wedges_of(mesh, r)) fail("names other corner wedges");
   for (WedgeId w : r.changed_wedges)
     if (!mesh.has_wedges() ||
         !(is_corner_wedge_at(mesh, r.vs, w) || is_corner_wedge_at(mesh, r.vt, w)))
@@ -135,11 +147,11 @@ EdgeFaces check_and_collapse(CollapseMesh& mesh, const CollapseRecord& r, size_t
 
 }  // namespace
 
-ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseRecord>& records,
+ReplayReport replay_collapses(CollapseMesh& mesh, std::vector<CollapseRecord>& records,
                               PriorityModule* priority) {
   ReplayReport report;
   for (size_t i = 0; i < records.size(); ++i) {
-    const CollapseRecord& r = records[i];
+    CollapseRecord& r = records[i];
     const EdgeFaces edge = check_and_collapse(mesh, r, i, nullptr, 0, nullptr);
     if (priority) {
       CollapseCandidate done;
@@ -158,8 +170,7 @@ ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseReco
   return report;
 }
 
-ReplayReport replay_subsets(CollapseMesh& mesh,
-                            const std::vector<std::vector<CollapseRecord>>& lists,
+ReplayReport replay_subsets(CollapseMesh& mesh, std::vector<std::vector<CollapseRecord>>& lists,
                             const std::vector<uint32_t>& vertex_subset, unsigned threads,
                             const std::function<void()>& beside) {
   if (vertex_subset.size() != mesh.vertex_capacity())

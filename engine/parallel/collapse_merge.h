@@ -31,12 +31,15 @@ struct ReplayReport {
 };
 
 // Performs `records` on `mesh` in order, checking that each is an edge of the present mesh
-// with the faces and apexes the record names (else Error(kInvalidInput): the subset rule was
-// broken, or the records did not come from a job of this mesh). When `priority` is given
+// with the faces, apexes, corner wedges and positions the record names (else
+// Error(kInvalidInput): the subset rule was broken, or the records did not come from a job of
+// this mesh); a record to complete (CollapseRecord::to_complete) gets its apexes, corner
+// wedges and positions from the mesh instead, so that no worker can make a PM whose splits
+// do not restore the input. When `priority` is given
 // (initialised on `mesh` before the first record), it is told of every collapse, so that its state
 // follows the mesh (the final pass continues with it); the records' own wedge changes and errors
 // are kept.
-ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseRecord>& records,
+ReplayReport replay_collapses(CollapseMesh& mesh, std::vector<CollapseRecord>& records,
                               PriorityModule* priority);
 
 // Performs each subset's records (lists[s], in its order) on `mesh`, the subsets side by side
@@ -49,8 +52,7 @@ ReplayReport replay_collapses(CollapseMesh& mesh, const std::vector<CollapseReco
 // `vertex_subset`, one entry per vertex of the mesh) and before anything of it is changed: a
 // job that broke the rule is refused (Error(kInvalidInput)), not raced. The mesh is left
 // partly replayed then.
-ReplayReport replay_subsets(CollapseMesh& mesh,
-                            const std::vector<std::vector<CollapseRecord>>& lists,
+ReplayReport replay_subsets(CollapseMesh& mesh, std::vector<std::vector<CollapseRecord>>& lists,
                             const std::vector<uint32_t>& vertex_subset, unsigned threads,
                             const std::function<void()>& beside = {});
 

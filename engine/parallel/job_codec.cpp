@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 5;
+constexpr uint8_t kVersion = 6;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -46,6 +46,9 @@ constexpr uint8_t kOwned = 1, kLocked = 2;
 constexpr uint8_t kRecordPositionsAsF32 = 1;
 // Energy state flags.
 constexpr uint8_t kResiduals = 1;
+constexpr uint8_t kPositions = 2;   // EnergyState::positions
+constexpr uint8_t kPointsF32 = 4;   // every point's position is exactly a float (an input vertex's)
+constexpr uint8_t kSamplesF32 = 8;  // every curve sample's position is exactly a float
 
 // The fewest bytes an element can take, for ByteReader::check_fits: a count that cannot fit
 // in what remains is refused before anything is reserved.
@@ -55,7 +58,7 @@ constexpr uint64_t kMinWedgeBytes = 1 + 1;         // its vertex, global id
 constexpr uint64_t kMinKeyBytes = 1 + 1 + 8;       // a's gap, b's span, cost
 constexpr uint64_t kMinDeferredBytes = 1 + 1 + 4;  // a's gap, b's span, key
 // A record: flags, vs vt, vl fl vr fr, 9 f32, 6 corner wedges, cost, error, change count.
-constexpr uint64_t kMinRecordBytes = 1 + 2 + 4 + 36 + 6 + 8 + 4 + 1;
+constexpr uint64_t kMinRecordBytes = 1 + 2 + 2 + 12 + 8 + 4 + 1;
 constexpr uint64_t kMinSampleBytes = 1 + 24 + 8 + 1 + 1;  // id, position, distance, u, w
 constexpr uint64_t kQuadricBytes = 11 * 8;
 
@@ -234,24 +237,28 @@ void read_quadric(ByteReader& in, const StateBounds& bounds, QuadricState& s) {
 // floats per wedge), or refuses a state that has two.
 int energy_floats(const EnergyState& s) {
   size_t k = 0;
-  if (!s.points.empty()) {
+  if (!s.positions && !s.point_values.empty()) cannot_encode("energy state point values");
+  if (s.positions && !s.points.empty()) {
     k = s.point_values.size() / s.points.size();
   } else if (!s.wedges.empty()) {
     k = s.wedge_values.size() / s.wedges.size();
   }
-  if (k > size_t(ScalarAttributes::kMaxFloats) || s.point_values.size() != s.points.size() * k ||
+  if (k > size_t(ScalarAttributes::kMaxFloats) ||
+      s.point_values.size() != (s.positions ? s.points.size() * k : 0) ||
       s.wedge_values.size() != s.wedges.size() * k || s.wedge_class.size() != s.wedges.size())
     cannot_encode("energy state attribute sizes disagree");
   return int(k);
 }
 
-void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool residuals) {
+void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool residuals,
+                 bool as_f32) {
   const EnergyState::Point& p = s.points[i];
   out.varint(p.id);
-  write_position(out, p.position, false);
+  if (s.positions) write_position(out, p.position, as_f32);
   out.f64(p.distance_sq);
   if (residuals) out.f64(p.residual);
-  for (int j = 0; j < k; ++j) out.f32(s.point_values[i * size_t(k) + size_t(j)]);
+  if (s.positions)
+    for (int j = 0; j < k; ++j) out.f32(s.point_values[i * size_t(k) + size_t(j)]);
 }
 
 // Each vertex's span of a begin array (size vertices + 1, from 0 to the list's end).
@@ -265,22 +272,27 @@ void check_spans(const std::vector<uint32_t>& begin, size_t vertices, size_t lis
 
 void write_energy(ByteWriter& out, const EnergyState& s) {
   const int k = energy_floats(s);
-  bool residuals = false;
-  for (const EnergyState::Point& p : s.points)
+  bool residuals = false, points_f32 = s.positions, samples_f32 = s.positions;
+  for (const EnergyState::Point& p : s.points) {
     residuals |= std::bit_cast<uint64_t>(p.residual) != 0;
+    points_f32 = points_f32 && is_float(p.position);
+  }
+  for (const EnergyState::CurveSample& c : s.samples)
+    samples_f32 = samples_f32 && is_float(c.position);
   out.varint(s.faces.size());
   write_increasing(out, s.faces, "energy state face");
   out.varint(s.vertices.size());
   write_increasing(out, s.vertices, "energy state vertex");
   out.u8(uint8_t(k));
-  out.u8(residuals ? kResiduals : 0);
+  out.u8(uint8_t((residuals ? kResiduals : 0) | (s.positions ? kPositions : 0) |
+                 (points_f32 ? kPointsF32 : 0) | (samples_f32 ? kSamplesF32 : 0)));
   // Points in export order: each face's, then each vertex's parked one.
   size_t next = 0;
   for (FaceId f : s.faces) {
     size_t end = next;
     while (end < s.points.size() && s.points[end].face == f && s.points[end].vertex == kNoId) ++end;
     out.varint(end - next);
-    for (; next < end; ++next) write_point(out, s, next, k, residuals);
+    for (; next < end; ++next) write_point(out, s, next, k, residuals, points_f32);
   }
   const size_t face_points = next;
   for (VertexId v : s.vertices)
@@ -292,7 +304,7 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
   for (const EnergyState::CurveSample& c : s.samples) {
     if (c.u == kNoId) cannot_encode("energy state curve sample on no vertex");
     out.varint(c.id);
-    write_position(out, c.position, false);
+    if (s.positions) write_position(out, c.position, samples_f32);
     out.f64(c.distance_sq);
     out.varint(c.u);
     out.varint(uint32_t(c.w + 1u));
@@ -303,7 +315,7 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
   for (size_t i = 0; i < s.vertices.size(); ++i) {
     const bool parked = next < s.points.size() && s.points[next].vertex == s.vertices[i];
     out.u8(parked ? 1 : 0);
-    if (parked) write_point(out, s, next++, k, residuals);
+    if (parked) write_point(out, s, next++, k, residuals, points_f32);
     out.varint(s.sharp_begin[i + 1] - s.sharp_begin[i]);
     for (uint32_t j = s.sharp_begin[i]; j < s.sharp_begin[i + 1]; ++j)
       out.varint(s.sharp_neighbors[j]);
@@ -325,40 +337,54 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
   }
 }
 
-void read_point(ByteReader& in, int k, bool residuals, FaceId face, VertexId vertex,
+void read_point(ByteReader& in, int k, bool residuals, bool as_f32, FaceId face, VertexId vertex,
                 EnergyState& s) {
   EnergyState::Point p;
   p.id = in.varint32();
   p.face = face;
   p.vertex = vertex;
-  p.position = read_position(in, false);
+  if (s.positions) p.position = read_position(in, as_f32);
   p.distance_sq = in.f64();
   p.residual = residuals ? in.f64() : 0.0;
-  for (int j = 0; j < k; ++j) s.point_values.push_back(in.f32());
+  if (s.positions)
+    for (int j = 0; j < k; ++j) s.point_values.push_back(in.f32());
   s.points.push_back(p);
 }
 
-void read_energy(ByteReader& in, const StateBounds& bounds, EnergyState& s) {
+// A job's state carries positions, a returned one does not (EnergyState::positions).
+void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, EnergyState& s) {
   in.set_context("energy state");
   read_increasing(in, read_count(in, 2, "energy faces"), bounds.faces, s.faces);
   read_increasing(in, read_count(in, 4, "energy vertices"), bounds.vertices, s.vertices);
   const int k = in.u8();
   if (k > ScalarAttributes::kMaxFloats) in.fail("too many floats per point: " + std::to_string(k));
   const uint8_t flags = in.u8();
-  if (flags & ~kResiduals) in.fail("unknown energy state flags");
+  if (flags & ~(kResiduals | kPositions | kPointsF32 | kSamplesF32))
+    in.fail("unknown energy state flags");
   const bool residuals = flags & kResiduals;
-  const uint64_t point_bytes = 1 + 24 + 8 + (residuals ? 8 : 0) + 4 * uint64_t(k);
+  s.positions = flags & kPositions;
+  if (s.positions != positions)
+    in.fail(positions ? "a job's state without its points' positions"
+                      : "a returned state with positions (they never change)");
+  const bool points_f32 = flags & kPointsF32, samples_f32 = flags & kSamplesF32;
+  if ((points_f32 || samples_f32) && !positions) in.fail("float positions flagged, none present");
+  const uint64_t point_bytes =
+      1 + 8 + (residuals ? 8 : 0) + (positions ? (points_f32 ? 12 : 24) + 4 * uint64_t(k) : 0);
 
   for (size_t i = 0; i < s.faces.size(); ++i) {
     in.set_context("energy face", i);
     const uint64_t n = read_count(in, point_bytes, "points");
-    for (uint64_t j = 0; j < n; ++j) read_point(in, k, residuals, s.faces[i], kNoId, s);
+    for (uint64_t j = 0; j < n; ++j) read_point(in, k, residuals, points_f32, s.faces[i], kNoId, s);
   }
   in.set_context("curve samples");
-  s.samples.resize(read_count(in, kMinSampleBytes, "curve samples"));
+  s.samples.resize(read_count(in,
+                              kMinSampleBytes - (!positions    ? 24
+                                                 : samples_f32 ? 12
+                                                               : 0),
+                              "curve samples"));
   for (EnergyState::CurveSample& c : s.samples) {
     c.id = in.varint32();
-    c.position = read_position(in, false);
+    if (positions) c.position = read_position(in, samples_f32);
     c.distance_sq = in.f64();
     c.u = read_id(in, bounds.vertices, "curve sample vertex");
     c.w = read_id_or_none(in, bounds.vertices, "curve sample vertex");
@@ -370,7 +396,7 @@ void read_energy(ByteReader& in, const StateBounds& bounds, EnergyState& s) {
     const VertexId v = s.vertices[i];
     const uint8_t parked = in.u8();
     if (parked > 1) in.fail("bad parked flag");
-    if (parked) read_point(in, k, residuals, kNoId, v, s);
+    if (parked) read_point(in, k, residuals, points_f32, kNoId, v, s);
     const uint64_t sharp = read_count(in, 1, "sharp neighbours");
     for (uint64_t j = 0; j < sharp; ++j) {
       const VertexId x = read_id(in, bounds.vertices, "sharp neighbour");
@@ -415,12 +441,15 @@ void write_state(ByteWriter& out, const MetricState& s) {
   if (code == 2) write_energy(out, s.energy);
 }
 
-void read_state(ByteReader& in, const StateBounds& bounds, MetricState& s) {
+// A job's state (`job`), or a returned one: without positions, and never the quadric's
+// (job_state.h, returns_state).
+void read_state(ByteReader& in, const StateBounds& bounds, bool job, MetricState& s) {
   in.set_context("state");
   s = MetricState{};
   s.metric = read_metric(in);
+  if (s.metric == "quadric" && !job) in.fail("a returned quadric state (quadric jobs return none)");
   if (s.metric == "quadric") read_quadric(in, bounds, s.quadric);
-  if (s.metric == "energy") read_energy(in, bounds, s.energy);
+  if (s.metric == "energy") read_energy(in, bounds, job, s.energy);
 }
 
 // ---- Job --------------------------------------------------------------------------------
@@ -684,7 +713,7 @@ void read_job(ByteReader& in, SubsetJob& job) {
   job.owned_faces = in.varint64();
   if (job.owned_faces > faces) in.fail("more owned faces than faces");
 
-  read_state(in, StateBounds{vertices, faces, wedges}, job.state);
+  read_state(in, StateBounds{vertices, faces, wedges}, /*job=*/true, job.state);
   in.set_context("state");
   check_job_state(in, job);
   read_keys(in, vertices, job.keys);
@@ -697,14 +726,12 @@ void read_job(ByteReader& in, SubsetJob& job) {
 void write_record(ByteWriter& out, const CollapseRecord& r, size_t k) {
   if (r.changed_values.size() != r.changed_wedges.size() * k)
     cannot_encode("records with different floats per changed wedge");
-  const bool as_f32 = is_float(r.vs_position) && is_float(r.vt_position) && is_float(r.position);
+  const bool as_f32 = is_float(r.position);
   out.u8(as_f32 ? kRecordPositionsAsF32 : 0);
   out.varint(r.vs);
   out.varint(r.vt);
-  for (uint32_t id : {r.vl, r.fl, r.vr, r.fr}) out.varint(uint32_t(id + 1u));
-  for (const Vec3* p : {&r.vs_position, &r.vt_position, &r.position})
-    write_position(out, *p, as_f32);
-  for (WedgeId w : r.corner_wedges) out.varint(uint32_t(w + 1u));
+  for (uint32_t id : {r.fl, r.fr}) out.varint(uint32_t(id + 1u));
+  write_position(out, r.position, as_f32);
   out.f64(r.cost);
   out.f32(r.error);
   out.varint(r.changed_wedges.size());
@@ -718,13 +745,10 @@ void read_record(ByteReader& in, size_t k, CollapseRecord& r) {
   r.vs = read_id(in, kNoId, "vs");
   r.vt = read_id(in, kNoId, "vt");
   if (r.vs == r.vt) in.fail("vs and vt are one vertex");
-  r.vl = read_id_or_none(in, kNoId, "vl");
   r.fl = read_id_or_none(in, kNoId, "fl");
-  r.vr = read_id_or_none(in, kNoId, "vr");
   r.fr = read_id_or_none(in, kNoId, "fr");
-  for (Vec3* p : {&r.vs_position, &r.vt_position, &r.position})
-    *p = read_position(in, flags & kRecordPositionsAsF32);
-  for (WedgeId& w : r.corner_wedges) w = read_id_or_none(in, kNoId, "corner wedge");
+  r.position = read_position(in, flags & kRecordPositionsAsF32);
+  r.to_complete = true;  // the rest is the coordinator's mesh's (collapse_merge.h)
   r.cost = read_not_nan(in, "cost");
   r.error = in.f32();
   if (std::isnan(r.error)) in.fail("error is NaN");
@@ -763,7 +787,7 @@ void read_summary(ByteReader& in, SubsetResult& r) {
   read_magic(in, kSummaryMagic, "subset summary");
   r.round = in.varint32();
   r.subset = in.varint32();
-  read_state(in, StateBounds{}, r.state);
+  read_state(in, StateBounds{}, /*job=*/false, r.state);
   read_keys(in, kNoId, r.keys);
   read_deferred(in, kNoId, r.deferred);
   in.set_context("counts");

@@ -8,8 +8,8 @@
 // id then each gap minus one). Every message starts with a 4-byte magic naming its kind and a
 // version byte, so that one kind is never decoded as another.
 //
-//   (The version byte is 5 for every kind: 4 added the energy's tuning to the job's options,
-//   5 the deferred edges to the job and the summary, and the costings to the summary.)
+//   (The version byte is 6 for every kind; DECISIONS.md, "The job codec's versions", says
+//   what each one added.)
 //   job     "PPJB" 4 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
 //           samples_per_face f64, crease_angle f64, attribute_weight f64, star_planes_weight
@@ -23,23 +23,28 @@
 //           values f32, then (flag 16) per face 3 wedges v | global_wedge ids+ |
 //           owned_faces v | state | keys | deferred.
 //   state   metric u8, then the metric's part (the other part must be empty):
-//           quadric: n v, vertices ids+, n x 11 f64 (a00 a01 a02 a11 a12 a22 b0 b1 b2 c w).
+//           quadric (a job's only: quadric jobs return none): n v, vertices ids+, n x 11 f64
+//           (a00 a01 a02 a11 a12 a22 b0 b1 b2 c w).
 //           energy: faces n v + ids+, vertices n v + ids+, k u8 (floats per point and per
-//           wedge, 0..9), flags u8 (1: residuals present) | per face: its point count v, then
-//           its points | curve samples: n v, per sample id v, position 3 f64, distance_sq
-//           f64, u v, w id+1 | per vertex: parked u8 (0/1) [point], sharp count v and
-//           neighbours v, listed count v and sample indices v | curve_samples_total v |
-//           wedges n v + ids+, n x k f32 values, per wedge (its index - the index of its
-//           class's wedge) v. A point: id v, position 3 f64, distance_sq f64, [residual f64],
-//           k f32; its face or vertex is the one it is written under (export order).
+//           wedge, 0..9), flags u8 (1: residuals present; 2: positions present, set in a
+//           job's state and only there; 4: the points' positions as 3 f32, 8: the curve
+//           samples', each set when every one is exactly a float, as an input vertex's is) |
+//           per face: its point count v, then its points |
+//           curve samples: n v, per sample id v, [position 3 f64], distance_sq f64, u v, w
+//           id+1 | per vertex: parked u8 (0/1) [point], sharp count v and neighbours v,
+//           listed count v and sample indices v | curve_samples_total v | wedges n v + ids+,
+//           n x k f32 values, per wedge (its index - the index of its class's wedge) v. A
+//           point: id v, [position 3 f64], distance_sq f64, [residual f64], [k f32 (with
+//           positions)]; its face or vertex is the one it is written under (export order).
 //   keys    n v, then per key (sorted by (a, b), a < b: edge_keys.h) a minus the previous
 //           key's a v, b - a - 1 v, cost f64 (NaN: the edge cannot be placed).
 //   deferred n v, then per edge (sorted by (a, b), a < b: simplifier.h, DeferredEdge) as a
 //           key, with its key f32 in place of the cost.
 //   records "PPCR" 4 | n v | k u8 (floats per changed wedge) | per record: flags u8 (1:
-//           positions as f32), vs v, vt v, vl fl vr fr id+1, vs_position vt_position position
-//           (3 f32 or 3 f64 each), corner_wedges 6 x id+1, cost f64, error f32, changed n v,
-//           n ids v, n x k f32.
+//           position as f32), vs v, vt v, fl fr id+1, position (3 f32 or 3 f64), cost f64,
+//           error f32, changed n v, n ids v, n x k f32. The apexes, corner wedges and
+//           positions before the collapse are left out: the coordinator's replay takes them
+//           from its mesh (CollapseRecord::to_complete).
 //   summary "PPSS" 4 | round v, subset v | state | keys | deferred | keys_reused v,
 //           costings v, faces v, owned_faces v, free_vertices v | collapses rejected stale
 //           reevaluated evaluations v, stop_reason (length v <= 4096, bytes) | wall_seconds
@@ -74,7 +79,7 @@ std::string encode_subset_job(const SubsetJob& job);
 SubsetJob decode_subset_job(std::string_view bytes);
 
 // One batch of records (a worker streams several); ids are the whole mesh's, checked by
-// replay_collapses (collapse_merge.h) against the coordinator's mesh.
+// replay_collapses (collapse_merge.h) against the coordinator's mesh, which completes them.
 std::string encode_collapse_records(const CollapseRecord* records, size_t count);
 void decode_collapse_records(std::string_view bytes, std::vector<CollapseRecord>& append_to);
 

@@ -28,6 +28,20 @@ class WithoutInitialize : public PriorityWrapper {
 
 }  // namespace
 
+bool job_state_needed(const PriorityModule& master, uint32_t round) {
+  return round > 0 || !dynamic_cast<const QuadricPriority*>(&master);
+}
+
+namespace {
+bool metric_returns_state(const std::string& metric) { return metric != "quadric"; }
+}  // namespace
+
+bool returns_state(const PriorityModule& module) { return metric_returns_state(module.name()); }
+
+std::string returned_state_metric(const SubsetJob& job) {
+  return job.state.empty() || !metric_returns_state(job.state.metric) ? "" : job.state.metric;
+}
+
 MetricState export_job_state(const PriorityModule& master, const SubsetJob& job) {
   MetricState state;
   state.metric = master.name();
@@ -56,6 +70,7 @@ void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const Su
 
 MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
                                 const SubsetJob& job, const std::vector<CollapseRecord>& records) {
+  if (!returns_state(module)) return {};
   std::vector<uint8_t> changed(mesh.vertex_capacity(), 0);
   for (const CollapseRecord& r : records) {
     if (r.vs >= changed.size() || r.vt >= changed.size() || !job.owned[r.vs] || !job.owned[r.vt])
@@ -64,9 +79,7 @@ MetricState export_result_state(const PriorityModule& module, const CollapseMesh
   }
   MetricState state;
   state.metric = module.name();
-  if (const auto* q = dynamic_cast<const QuadricPriority*>(&module)) {
-    state.quadric = q->export_global(maps_of(job), changed);
-  } else if (const auto* e = dynamic_cast<const EnergyPriority*>(&module)) {
+  if (const auto* e = dynamic_cast<const EnergyPriority*>(&module)) {
     state.energy = e->export_global(mesh, maps_of(job), changed);
   } else {
     throw_internal("export_result_state: no state export for metric " + module.name());
@@ -74,13 +87,18 @@ MetricState export_result_state(const PriorityModule& module, const CollapseMesh
   return state;
 }
 
-void import_result_state(PriorityModule& master, const MetricState& state) {
+void import_result_state(PriorityModule& master, const MetricState& state,
+                         const std::vector<CollapseRecord>& records) {
+  if (auto* q = dynamic_cast<QuadricPriority*>(&master)) {
+    if (!state.empty()) throw_invalid("a quadric job returns no state; this result has one");
+    q->check_records(records, 0, nullptr);
+    q->follow_records(records);
+    return;
+  }
   if (state.metric != master.name())
     throw_internal("import_result_state: a state of metric '" + state.metric + "' for " +
                    master.name());
-  if (auto* q = dynamic_cast<QuadricPriority*>(&master)) {
-    q->import_global(state.quadric);
-  } else if (auto* e = dynamic_cast<EnergyPriority*>(&master)) {
+  if (auto* e = dynamic_cast<EnergyPriority*>(&master)) {
     e->import_global(state.energy);
   } else {
     throw_internal("import_result_state: no state import for metric " + master.name());
@@ -88,10 +106,9 @@ void import_result_state(PriorityModule& master, const MetricState& state) {
 }
 
 void check_state_covers(const MetricState& state, const std::vector<CollapseRecord>& records) {
-  const bool energy = state.metric == "energy";
-  if (!energy && state.metric != "quadric")
+  if (state.metric != "energy")
     throw_internal("check_state_covers: no state of metric '" + state.metric + "'");
-  const std::vector<VertexId>& vertices = energy ? state.energy.vertices : state.quadric.vertices;
+  const std::vector<VertexId>& vertices = state.energy.vertices;
   const std::vector<FaceId>& faces = state.energy.faces;
   auto increasing = [](const std::vector<uint32_t>& ids) {
     return std::adjacent_find(ids.begin(), ids.end(), std::greater_equal<>()) == ids.end();
@@ -104,11 +121,10 @@ void check_state_covers(const MetricState& state, const std::vector<CollapseReco
       if (!std::binary_search(vertices.begin(), vertices.end(), v))
         throw_invalid(state.metric + " state: does not cover vertex " + std::to_string(v) +
                       ", an end of its job's collapse " + std::to_string(i));
-    if (energy)
-      for (FaceId f : {r.fl, r.fr})
-        if (f != kNoId && !std::binary_search(faces.begin(), faces.end(), f))
-          throw_invalid("energy state: does not cover face " + std::to_string(f) +
-                        ", removed by its job's collapse " + std::to_string(i));
+    for (FaceId f : {r.fl, r.fr})
+      if (f != kNoId && !std::binary_search(faces.begin(), faces.end(), f))
+        throw_invalid("energy state: does not cover face " + std::to_string(f) +
+                      ", removed by its job's collapse " + std::to_string(i));
   }
 }
 
@@ -119,10 +135,13 @@ ImportTimes import_result_states(PriorityModule& master,
                                  const std::vector<const std::vector<CollapseRecord>*>& records) {
   const auto start = std::chrono::steady_clock::now();
   ImportTimes times;
+  auto* quadric = dynamic_cast<QuadricPriority*>(&master);
   for (const MetricState* state : states)
-    if (state->metric != master.name())
-      throw_internal("import_result_states: a state of metric '" + state->metric + "' for " +
-                     master.name());
+    if (quadric ? !state->empty() : state->metric != master.name())
+      throw_invalid("import_result_states: a state of metric '" + state->metric + "' for " +
+                    master.name() + (quadric ? " (whose jobs return none)" : ""));
+  if (quadric && records.size() != states.size())
+    throw_internal("import_result_states: the quadric follows its jobs' records; none given");
   if (!records.empty() && records.size() != states.size())
     throw_internal("import_result_states: " + std::to_string(records.size()) +
                    " record lists for " + std::to_string(states.size()) + " states");
@@ -139,12 +158,11 @@ ImportTimes import_result_states(PriorityModule& master,
     if (!records.empty()) check_state_covers(*states[k], *records[k]);
   };
   double sequential = 0;
-  if (auto* q = dynamic_cast<QuadricPriority*>(&master)) {
+  if (quadric) {
     side_by_side(check_cpu, [&](size_t k) {
-      q->check_global(states[k]->quadric, uint32_t(k), &vertex_subset);
-      covers(k);
+      quadric->check_records(*records[k], uint32_t(k), &vertex_subset);
     });
-    side_by_side(apply_cpu, [&](size_t k) { q->import_global(states[k]->quadric); });
+    side_by_side(apply_cpu, [&](size_t k) { quadric->follow_records(*records[k]); });
   } else if (auto* e = dynamic_cast<EnergyPriority*>(&master)) {
     const auto begin = std::chrono::steady_clock::now();
     e->begin_global_imports();

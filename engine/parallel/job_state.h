@@ -2,7 +2,8 @@
 // module exports each job's part in the job's local ids, the job's module imports it instead
 // of initialising (so that a job of any round sees the sequential build's sample points and
 // quadrics), and the job returns the state of what it owns, which the master imports instead
-// of re-running collapsed() on every merged record.
+// of re-running collapsed() on every merged record. The quadric's travels one way only, and
+// not in round 0 (job_state_needed, returns_state).
 #pragma once
 
 #include <memory>
@@ -14,6 +15,21 @@
 
 namespace parapm {
 
+// Whether a job of `master`'s metric needs the master's state (when it does not, the job
+// initialises its own module, to the same state): not for the quadric's jobs of round 0, on
+// the input mesh, whose owned vertices' quadrics are sums over their whole fans (the job's
+// halo, subset_job.h) in the master's order (local ids follow global ones). 56-88 bytes per
+// vertex a job need not carry.
+bool job_state_needed(const PriorityModule& master, uint32_t round);
+
+// Whether a job of `module`'s metric returns its state. The quadric's does not: its quadrics
+// change only by collapsed() (Q_vs += Q_vt), which the master follows from the job's records
+// (import_result_states) exactly, at the cost of a copy.
+bool returns_state(const PriorityModule& module);
+// The metric of the state `job`'s result carries: its state's, or none (empty) for a job without
+// one or of a metric that returns none. (What a worker's reply must hold.)
+std::string returned_state_metric(const SubsetJob& job);
+
 // The master's state of the job's faces, vertices and wedges, in the job's local ids.
 // `master` is the module make_priority_module made for the job's metric, initialised on the
 // whole mesh. Const: jobs may be exported concurrently.
@@ -24,14 +40,16 @@ MetricState export_job_state(const PriorityModule& master, const SubsetJob& job)
 void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job);
 
 // The job's module state at its end, in global ids: what its collapses `records` (in local
-// ids) changed, the rest being as the master has it (the quadrics of their vertices; the
-// energy's faces around them, their corners and wedges).
+// ids) changed, the rest being as the master has it (the energy's faces around them, their
+// corners and wedges); for a metric that returns none (returns_state), an empty state.
 MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
                                 const SubsetJob& job, const std::vector<CollapseRecord>& records);
 
-// The master takes a job's returned state. The jobs of a round own disjoint faces, vertices
-// and wedges, and mixed faces never change (subset_rule.h), so the order of imports is free.
-void import_result_state(PriorityModule& master, const MetricState& state);
+// The master takes a job's returned state, or follows its `records` (global ids) where the
+// metric returns none. The jobs of a round own disjoint faces, vertices and wedges, and mixed
+// faces never change (subset_rule.h), so the order of imports is free.
+void import_result_state(PriorityModule& master, const MetricState& state,
+                         const std::vector<CollapseRecord>& records);
 
 // The states of a round's jobs (states[k]: subset k's job's, metric `master`'s) into the
 // master, side by side on `threads` threads (0: the hardware's): every state is checked first,
@@ -41,9 +59,11 @@ void import_result_state(PriorityModule& master, const MetricState& state);
 // naming another subset's face would have two threads write it); then all are taken, side by
 // side (their faces, vertices and points are disjoint; a curve sample on an edge between two
 // subsets is written by the subset of its first end), then the wedges, one state after the
-// other. The master's result is import_result_state's of each, in any order. With `records`
-// (records[k]: the records of state k's job, in global ids), each state must also cover what
-// they changed (check_state_covers).
+// other. The master's result is import_result_state's of each, in any order. `records`
+// (records[k]: the records of state k's job, in global ids): each state must also cover what
+// they changed (check_state_covers); a metric that returns no state (returns_state) follows
+// them instead, each list checked first as a state is, and the states must be empty. May be
+// left out for a metric that returns states.
 struct ImportTimes {
   double seconds = 0;                // wall
   double critical_seconds = 0;       // with a core per state: the steps' slowest ones, in turn

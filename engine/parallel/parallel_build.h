@@ -142,6 +142,9 @@ struct RoundStats {
   // The band pass alone (the append and the next partition beside it are the next round's
   // append_seconds and partition_seconds, the mesh's copy for that partition too).
   double band_pass_seconds = 0;
+  // The append beside this round's band pass, when the partition drawn beside it was not
+  // taken: what of it outlasted the band pass.
+  double append_beyond_band_seconds = 0;
   std::vector<SubsetTiming> subsets;
 };
 
@@ -154,7 +157,8 @@ struct ParallelStats {
   std::vector<RoundStats> round_stats;
   double setup_seconds = 0;  // the master's metric, initialised once on the whole mesh
   uint64_t final_pass_collapses = 0;
-  double final_pass_seconds = 0;
+  double final_pass_seconds = 0;    // its set-up and its collapses
+  double final_work_seconds = 0;    // its collapses
   double final_append_seconds = 0;  // the last round's records appended, beside the final pass
   double pm_build_seconds = 0;
   uint64_t collapses = 0;
@@ -165,13 +169,17 @@ struct ParallelStats {
   // edge samples', the master's (band passes, final pass). Deterministic, unlike cpu_seconds:
   // the build's work, to compare with SimplifyStats::costings of the sequential build.
   uint64_t costings = 0;
-  // What the build would take with one processor per subset: setup, then per round the
-  // partition (or the previous round's append, if longer), extraction (its sequential steps
-  // and the slowest job's), the slowest subset's CPU, the merge and the band pass, then the
-  // final pass (or the last append) and the PM assembly (CPU of the jobs, not wall: on a
-  // loaded machine wall time is not the job's).
+  // What the build would take with one processor per subset (critical_path_seconds below).
   double critical_path_seconds = 0;
 };
+
+// The critical path of a build whose stages `stats` timed: the set-up, then per round
+// (round_critical_seconds) the partition (or the previous round's append, if longer),
+// extraction (its sequential steps and the slowest job's), the slowest subset's CPU, the merge
+// and the band pass, then the final pass (or the last append) and the PM assembly. CPU of the
+// jobs, not wall: on a loaded machine wall time is not the job's.
+double round_critical_seconds(const RoundStats& round);
+double critical_path_seconds(const ParallelStats& stats);
 
 // Where a round's subset jobs run. The in-process build runs them on a thread pool; the
 // coordinator sends them to worker daemons. Whatever runs them, results[i] must be

@@ -358,7 +358,6 @@ void ParallelBuilder::set_up() {
   // The setup's own time: the first partition is round 0's (which the critical path counts
   // only where it outlasts the initialisation: RoundStats::partition_overlap_seconds).
   st_.setup_seconds = seconds_since(t) - section_seconds + initialize_seconds_;
-  st_.critical_path_seconds = st_.setup_seconds;
   subset_options_ = subset_options_of(options_, mesh_);
   records_.reserve(whole.live_vertices());
 }
@@ -435,8 +434,9 @@ bool ParallelBuilder::counts(const RoundStats& r) {
 }
 
 void ParallelBuilder::forgo_foreseen() {
-  if (foreseen_.beside_band)
-    st_.critical_path_seconds += std::max(0.0, foreseen_.append_seconds - foreseen_.band_seconds);
+  if (foreseen_.beside_band && !st_.round_stats.empty())
+    st_.round_stats.back().append_beyond_band_seconds =
+        std::max(0.0, foreseen_.append_seconds - foreseen_.band_seconds);
   foreseen_ = Foreseen{};
 }
 
@@ -580,7 +580,7 @@ void ParallelBuilder::extract_jobs(Round& r) {
     jobs[i] =
         extract_subset(whole, mesh_.layout, mesh_.wedge_values, mesh_.positions_are_float, locked_,
                        r.vertex_subset, owned[i], uint32_t(i), rs.round, subset_options_);
-    jobs[i].state = export_job_state(*master_, jobs[i]);
+    if (job_state_needed(*master_, rs.round)) jobs[i].state = export_job_state(*master_, jobs[i]);
     for (FaceId f = 0; f < jobs[i].mesh.face_count(); ++f) {
       const Triangle& c = jobs[i].mesh.faces[f];
       if (jobs[i].owned[c[0]] && jobs[i].owned[c[1]] && jobs[i].owned[c[2]])
@@ -695,7 +695,7 @@ void ParallelBuilder::merge(Round& r) {
   if (parallel_.replay_state) {
     // Tests only: the merged sequence drives the master's module, one collapse at a time
     // (merged from a copy: take_results reads the lists).
-    const std::vector<CollapseRecord> merged = merge_by_cost(r.lists);
+    std::vector<CollapseRecord> merged = merge_by_cost(r.lists);
     r.replay = replay_collapses(*whole_, merged, master_.get());
     take_results(r);
     records_.insert(records_.end(), merged.begin(), merged.end());
@@ -831,10 +831,6 @@ void ParallelBuilder::finish_round(Round& r) {
   RoundStats& rs = r.rs;
   bound_before_ = std::move(r.bound);
   rs.faces_after = whole_->live_faces();
-  st_.critical_path_seconds += rs.partition_seconds + rs.append_seconds -
-                               rs.partition_overlap_seconds + rs.extract_critical_seconds +
-                               rs.slowest_subset_cpu_seconds + rs.merge_seconds -
-                               rs.merge_overlap_seconds + rs.band_pass_seconds;
   spdlog::debug(
       "parallel round {}: {} subsets {}->{} faces (goal {}{}; {} border faces), partition "
       "{:.3f} s, extract {:.3f} s, subsets {:.3f} s (slowest {:.3f} s CPU), merge {:.3f} s ({} "
@@ -880,7 +876,7 @@ void ParallelBuilder::final_pass() {
   const Beside timed =
       run_beside(parallel_.threads, [&] { final_records = pass.run(limits, progress, cancel_); },
                  {[this] { append_pending(); }});
-  final_work_seconds_ = timed.work_seconds;
+  st_.final_work_seconds = timed.work_seconds;
   st_.final_pass_collapses = final_records.size();
   st_.final_pass_seconds = setup_seconds + timed.work_seconds;
   st_.final_append_seconds = timed.side_seconds[0];
@@ -906,9 +902,7 @@ ProgressiveMesh ParallelBuilder::progressive_mesh() {
   pm.info.metric = master_->name();
   st_.pm_build_seconds = seconds_since(t);
   st_.collapses = records_.size();
-  st_.critical_path_seconds += st_.final_pass_seconds +
-                               std::max(0.0, st_.final_append_seconds - final_work_seconds_) +
-                               st_.pm_build_seconds;
+  st_.critical_path_seconds = critical_path_seconds(st_);
   st_.seconds = seconds_since(start_);
   st_.cpu_seconds = subsets_cpu_ + (thread_cpu_seconds() - master_cpu_start_);
   // The master's: band passes and final pass.

@@ -167,9 +167,6 @@ class ParallelBuilder {
     std::vector<uint32_t> vertex_subset;
     double copy_seconds = 0, partition_seconds = 0, append_seconds = 0, band_seconds = 0;
   } foreseen_;
-
-  // The final pass's figures, for the PM's critical path.
-  double final_work_seconds_ = 0;
 };
 
 }  // namespace parapm

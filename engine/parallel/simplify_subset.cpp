@@ -56,8 +56,12 @@ std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseM
   return module;
 }
 
-SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress,
-                             const CancelToken* cancel) {
+namespace {
+
+// `release` (null, or `job` itself when the caller gives it up): its state and keys are
+// released once imported.
+SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCallback& progress,
+                      const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
   validate_subset_job(job);
@@ -75,12 +79,18 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   std::unique_ptr<PriorityModule> metric = job_module(job, working);
   // With a state, the metric is the master's over the job: imported, not initialised.
   std::unique_ptr<PriorityModule> imported;
-  if (!job.state.empty()) imported = without_initialize(*metric);
+  const bool had_state = !job.state.empty();
+  if (had_state) imported = without_initialize(*metric);
   PriorityModule& module = imported ? *imported : *metric;
   std::optional<KeyMemo> memo;  // only for a metric whose keys are worth carrying (costly())
   if (metric->costly()) {
     memo.emplace(module, working.vertex_capacity());
     memo->reset(job.keys);
+  }
+  if (release) {
+    // The module and the memo hold copies: the job's own would only double a job's memory.
+    release->state = MetricState{};
+    release->keys = std::vector<EdgeKey>{};
   }
   std::unique_ptr<PriorityModule> priority =
       make_subset_priority(memo ? *memo : module, std::move(free_vertex));
@@ -93,10 +103,10 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
   if (job.options.defer_recosting) limits.defer_above_faces = 0;
   limits.first_deferred = &job.deferred;
   result.records = simplifier.run(limits, progress, cancel);
-  if (!job.state.empty()) result.state = export_result_state(*metric, working, job, result.records);
+  if (had_state) result.state = export_result_state(*metric, working, job, result.records);
   for (CollapseRecord& r : result.records) globalise(r, job);
   // Keys mean something to the master only when the job's state is the master's.
-  if (memo && !job.state.empty()) {
+  if (memo && had_state) {
     result.keys = current_keys_in_global_ids(*memo, working, job);
     // But those the module refused last (infinite key): the next round's jobs cost them at
     // once, as before, rather than wait for their queues to empty.
@@ -117,6 +127,18 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
       result.stats.evaluations, result.stats.deferred, result.keys_reused,
       result.stats.stop_reason);
   return result;
+}
+
+}  // namespace
+
+SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress,
+                             const CancelToken* cancel) {
+  return simplify(job, nullptr, progress, cancel);
+}
+
+SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress,
+                             const CancelToken* cancel) {
+  return simplify(job, &job, progress, cancel);
 }
 
 }  // namespace parapm

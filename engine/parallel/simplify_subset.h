@@ -45,6 +45,10 @@ struct SubsetResult {
 // kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing.
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr);
+// The same, releasing the job's state and keys as soon as its metric has imported them (a
+// job's peak memory holds them once, not twice); `job` is left valid, without them.
+SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress = {},
+                             const CancelToken* cancel = nullptr);
 
 // The options a job's metric is made with (Error(kInvalidInput) for invalid ones).
 SimplifyOptions simplify_options_of(const SubsetOptions& subset);

@@ -169,8 +169,9 @@ class EnergyPriority : public PriorityModule {
   // (changed: per local vertex; dead faces with empty lists), their corners and wedges. Those
   // vertices are free (subset_rule.h), so all of it is the job's own; the rest of its part is
   // as the master exported it, and the master keeps it (so a returned state holds what
-  // changed, not every point of the job). import_global: the master overwrites the state's
-  // faces, vertices and wedges.
+  // changed, not every point of the job), without positions (EnergyState::positions).
+  // import_global: the master overwrites the state's faces, vertices and wedges, the points
+  // and curve samples at the positions it holds for their ids.
   EnergyState export_local(const IdMaps& maps) const;
   void import_local(const CollapseMesh& mesh, const EnergyState& state);
   EnergyState export_global(const CollapseMesh& mesh, const IdMaps& maps,

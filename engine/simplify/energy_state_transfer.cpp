@@ -16,12 +16,15 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
                                   bool to_local, EnergyState& out) const {
   const IdTranslation to_face{maps.face, to_local}, to_vertex{maps.vertex, to_local};
   const int floats = scalar_.enabled() ? scalar_.floats() : 0;
+  // A job's returned state (to global ids) leaves out what never changes (EnergyState::positions).
+  out.positions = to_local;
   // A face's drift goes into its points' distances: the state holds bounds, and no drift.
   auto add_point = [&](const FacePoint& p, FaceId face, VertexId vertex, double distance_sq) {
     const uint32_t id = p.id;
-    out.points.push_back({point_id_.empty() ? id : point_id_[id], face, vertex, p.position,
-                          distance_sq, floats ? scalar_.residual(id) : 0.0});
-    if (floats)
+    out.points.push_back({point_id_.empty() ? id : point_id_[id], face, vertex,
+                          to_local ? p.position : Vec3{}, distance_sq,
+                          floats ? scalar_.residual(id) : 0.0});
+    if (floats && to_local)
       out.point_values.insert(out.point_values.end(), scalar_.point_values(id),
                               scalar_.point_values(id) + floats);
   };
@@ -79,6 +82,7 @@ EnergyState EnergyPriority::export_global(const CollapseMesh& mesh, const IdMaps
 }
 
 void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& state) {
+  if (!state.positions) throw_invalid("energy state: a job's state without its points' positions");
   const double diagonal = diagonal_of(mesh);
   topology_price_ = topology_price(diagonal);
   const bool scalar = mesh.has_wedges() && attributes_.layout.any();
@@ -132,8 +136,8 @@ void EnergyPriority::begin_global_imports() {
 
 // What a job gives back (possibly from a worker over the network) may only rearrange the
 // points it was given: every point once, one that was on the state's faces or parked at its
-// vertices, at the position it was sampled at (points never move), on one of those faces or
-// parked at one of those vertices; and with owners, only faces and vertices of its subset.
+// vertices, on one of those faces or parked at one of those vertices; and with owners, only
+// faces and vertices of its subset. (Points never move: their positions are the master's.)
 // Checked before the master changes anything. (A point may be missing: a collapse that leaves
 // its vertex without faces drops its star's points, as the sequential build does.)
 // Side by side for different subsets: a state's faces and vertices are checked to be its
@@ -173,8 +177,6 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
       why = " out of range";
     } else if (const uint32_t t = point_tag(p.id).load(std::memory_order_relaxed); t != tag) {
       why = t == given ? " given twice" : " is not the job's";
-    } else if (p.position != positions_[p.id]) {
-      why = " moved from where it was sampled";
     } else if (p.face != kNoId ? !face_ours(p.face) || face_tag_[p.face] != tag
                                : !vertex_ours(p.vertex) || vertex_tag_[p.vertex] != tag) {
       why = " is on a face or vertex the state does not list";

@@ -52,6 +52,11 @@ struct EnergyState {
     double distance_sq = 0;
     VertexId u = kNoId, w = kNoId;  // the sharp edge it projects onto (w = kNoId: onto u)
   };
+  // Whether the points' and curve samples' positions and the points' attribute values
+  // (point_values) are present: a job's state carries them; a job's returned state does not
+  // (they never change from where they were sampled, and the master holds them by id), and
+  // its receiver reads none of them (their fields are left at zero and point_values empty).
+  bool positions = true;
   // The faces the state covers: their point lists are exactly the points naming them, in the
   // order written (list order). A covered face without points has an empty list.
   std::vector<FaceId> faces;

@@ -121,6 +121,9 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
     }
   }
 
+  for (const CollapseRecord& r : records)
+    if (r.to_complete)
+      throw_internal("build_pm_from_collapses: a record the replay did not complete");
   pm.splits.reserve(records.size());
   float error_bound = 0;  // running maximum, so that the bound never decreases with coarsening
   std::vector<float> bound(records.size());

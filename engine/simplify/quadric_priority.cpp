@@ -112,35 +112,26 @@ void QuadricPriority::import_local(const CollapseMesh& mesh, const QuadricState&
   }
 }
 
-QuadricState QuadricPriority::export_global(const IdMaps& maps,
-                                            const std::vector<uint8_t>& changed) const {
-  QuadricState state;
-  for (VertexId v = 0; v < changed.size(); ++v)
-    if (changed[v]) {
-      state.vertices.push_back((*maps.vertex)[v]);
-      state.quadrics.push_back(quadrics_[v]);
+void QuadricPriority::check_records(const std::vector<CollapseRecord>& records, uint32_t subset,
+                                    const std::vector<uint32_t>* vertex_subset) const {
+  for (size_t i = 0; i < records.size(); ++i) {
+    const CollapseRecord& r = records[i];
+    for (VertexId v : {r.vs, r.vt}) {
+      if (v >= quadrics_.size())
+        throw_invalid("collapse " + std::to_string(i) + ": vertex " + std::to_string(v) +
+                      " out of range");
+      if (vertex_subset && (*vertex_subset)[v] != subset)
+        throw_invalid("collapse " + std::to_string(i) + ": vertex " + std::to_string(v) +
+                      " is another subset's");
     }
-  return state;
-}
-
-void QuadricPriority::check_global(const QuadricState& state, uint32_t subset,
-                                   const std::vector<uint32_t>* vertex_subset) const {
-  if (state.vertices.size() != state.quadrics.size())
-    throw_invalid("quadric state: vertices and quadrics disagree");
-  for (VertexId v : state.vertices) {
-    if (v >= quadrics_.size()) throw_invalid("quadric state: vertex out of range");
-    if (vertex_subset && (*vertex_subset)[v] != subset)
-      throw_invalid("quadric state: vertex " + std::to_string(v) + " is another subset's");
+    if (r.vs == r.vt)
+      throw_invalid("collapse " + std::to_string(i) + ": vertex " + std::to_string(r.vs) +
+                    " into itself");
   }
 }
 
-void QuadricPriority::import_global(const QuadricState& state) {
-  if (state.vertices.size() != state.quadrics.size())
-    throw_invalid("quadric state: vertices and quadrics disagree");
-  for (size_t i = 0; i < state.vertices.size(); ++i) {
-    if (state.vertices[i] >= quadrics_.size()) throw_invalid("quadric state: vertex out of range");
-    quadrics_[state.vertices[i]] = state.quadrics[i];
-  }
+void QuadricPriority::follow_records(const std::vector<CollapseRecord>& records) {
+  for (const CollapseRecord& r : records) quadrics_[r.vs] += quadrics_[r.vt];
 }
 
 }  // namespace parapm

@@ -9,6 +9,7 @@
 #include "simplify/module_state.h"
 #include "simplify/modules.h"
 #include "simplify/quadric.h"
+#include "simplify/simplifier.h"
 
 namespace parapm {
 
@@ -30,21 +31,21 @@ class QuadricPriority : public PriorityModule {
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override { return costings_; }
 
-  // State export/import for the parallel construction (module_state.h). export_local: the
+  // State transfer for the parallel construction (module_state.h). export_local: the
   // quadrics of a job's vertices (maps: its local -> global ids), in its local ids.
-  // import_local: a job's module from that state, instead of initialize(). export_global: the
-  // quadrics of the vertices marked in `changed` (per local vertex: those the job's collapses
-  // moved or removed; the others' quadrics are the master's), in global ids.
-  // import_global: the master overwrites those vertices' quadrics.
+  // import_local: a job's module from that state, instead of initialize(). A job returns no
+  // quadrics: its collapses change them only by collapsed() (Q_vs += Q_vt), so the master
+  // follows a job from its records (follow_records), exactly and at the cost of a copy.
   QuadricState export_local(const IdMaps& maps) const;
   void import_local(const CollapseMesh& mesh, const QuadricState& state);
-  QuadricState export_global(const IdMaps& maps, const std::vector<uint8_t>& changed) const;
-  void import_global(const QuadricState& state);
-  // Before import_global of several jobs' states side by side (job_state.h): throws
-  // Error(kInvalidInput) unless every vertex of `state` is in range and, with vertex_subset,
-  // the subset's.
-  void check_global(const QuadricState& state, uint32_t subset,
-                    const std::vector<uint32_t>* vertex_subset) const;
+  // Before follow_records of several jobs side by side (job_state.h): throws
+  // Error(kInvalidInput) unless both ends of every record are distinct, in range and, with
+  // vertex_subset, the subset's (a dishonest reply naming another subset's vertex would have
+  // two threads write it).
+  void check_records(const std::vector<CollapseRecord>& records, uint32_t subset,
+                     const std::vector<uint32_t>* vertex_subset) const;
+  // collapsed()'s change of every record, in order (check_records first).
+  void follow_records(const std::vector<CollapseRecord>& records);
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 
  private:

@@ -292,8 +292,8 @@ void SharpCurves::export_state(const std::vector<VertexId>& vertices, const IdTr
       if (u == kNoId || (s.w != kNoId && w == kNoId)) continue;
       if (index[id] == kNoId) {
         index[id] = uint32_t(out.samples.size());
-        out.samples.push_back(
-            {sample_id_.empty() ? id : sample_id_[id], s.position, s.distance_sq, u, w});
+        out.samples.push_back({sample_id_.empty() ? id : sample_id_[id],
+                               out.positions ? s.position : Vec3{}, s.distance_sq, u, w});
       }
       out.listed.push_back(index[id]);
     }
@@ -370,7 +370,7 @@ void SharpCurves::check_global(const EnergyState& state) const {
 void SharpCurves::import_global(const EnergyState& state, const std::vector<uint32_t>* written) {
   check_global(state);
   auto write = [&](const EnergyState::CurveSample& s) {
-    samples_[s.id] = {s.position, s.distance_sq, s.u, s.w};
+    samples_[s.id] = {samples_[s.id].position, s.distance_sq, s.u, s.w};  // (samples never move)
   };
   if (written) {
     for (uint32_t i : *written) write(state.samples.at(i));

@@ -81,7 +81,8 @@ class SharpCurves {
   // sharp and listed lists, the samples listed there (with their every end translating) to
   // out.samples. import_local builds the curves of a job's mesh from such a state (local ids)
   // instead of initialize(); import_global overwrites the state's vertices and its samples (or
-  // only those of `written`: indices into state.samples), after check_global, which throws
+  // only those of `written`: indices into state.samples; their positions stay this module's:
+  // samples never move), after check_global, which throws
   // Error(kInvalidInput) for a state whose lists or ids do not fit (it changes nothing).
   void export_state(const std::vector<VertexId>& vertices, const IdTranslation& to,
                     EnergyState& out) const;

@@ -39,6 +39,10 @@ struct CollapseRecord {
   // (floats_per_wedge each); the values before are those the previous records left.
   std::vector<WedgeId> changed_wedges;
   std::vector<float> changed_values;
+  // Set on a record decoded from a worker (job_codec.h), which leaves out what the
+  // coordinator's mesh tells: vl, vr, corner_wedges, vs_position and vt_position are the
+  // replay's to find (collapse_merge.h), which then clears it.
+  bool to_complete = false;
 };
 
 // An edge waiting in the queue for a costing (SimplifierLimits::first_deferred), a < b.

@@ -133,6 +133,22 @@ void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& 
   expect_same_deferred(a.deferred, b.deferred, what);
 }
 
+// What records carry over the wire; the rest the coordinator's replay completes
+// (ReplayRefusesRecordsThatDoNotFitTheMesh checks that it completes them as they were).
+void expect_same_sent_records(const std::vector<CollapseRecord>& sent,
+                              const std::vector<CollapseRecord>& received,
+                              const std::string& what) {
+  ASSERT_EQ(sent.size(), received.size()) << what;
+  for (size_t i = 0; i < sent.size(); ++i) {
+    const CollapseRecord &r = sent[i], &s = received[i];
+    ASSERT_TRUE(r.vs == s.vs && r.vt == s.vt && r.fl == s.fl && r.fr == s.fr &&
+                same_bits(r.position, s.position) && same_bits(r.cost, s.cost) &&
+                same_bits(r.error, s.error) && r.changed_wedges == s.changed_wedges &&
+                same_bits(r.changed_values, s.changed_values) && s.to_complete)
+        << what << " record " << i;
+  }
+}
+
 void expect_same_records(const std::vector<CollapseRecord>& a, const std::vector<CollapseRecord>& b,
                          const std::string& what) {
   ASSERT_EQ(a.size(), b.size()) << what;
@@ -235,8 +251,8 @@ TEST(JobCodec, JobsRecordsAndSummariesComeBackBitForBit) {
     ASSERT_EQ(remote.deferred.empty(), std::string(c.metric) == "quadric") << what;
     expect_same_records(original.records, remote.records, what + " simplified remotely");
     expect_same_state(original.state, remote.state, what + " result state");
-    expect_same_records(original.records, records_round_trip(remote.records, 97),
-                        what + " records");
+    expect_same_sent_records(original.records, records_round_trip(remote.records, 97),
+                             what + " records");
     SubsetResult summary;
     summary.records = remote.records;  // left as they are
     decode_subset_summary(encode_subset_summary(remote), summary);
@@ -363,33 +379,84 @@ TEST(JobCodec, HugeCountsAreRefusedBeforeAllocating) {
   // A job of 3 vertices and 2^40 faces, and one of 2^40 vertices.
   std::string message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(5);  // the codec's version
+    out.u8(6);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), uint64_t(3), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 faces"), std::string::npos) << message;
   EXPECT_NE(message.find("subset job: byte "), std::string::npos) << message;
   message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(5);  // the codec's version
+    out.u8(6);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 vertices"), std::string::npos) << message;
   message = message_of(Kind::kRecords, [&](ByteWriter& out) {
     out.bytes("PPCR", 4);
-    out.u8(5);
+    out.u8(6);
     out.varint(kHuge);
   });
   EXPECT_NE(message.find("1099511627776 records"), std::string::npos) << message;
   // A summary whose energy state claims 2^40 faces.
   message = message_of(Kind::kSummary, [&](ByteWriter& out) {
     out.bytes("PPSS", 4);
-    out.u8(5);
+    out.u8(6);
     out.varint(0);
     out.varint(0);
     out.u8(2);  // energy
     out.varint(kHuge);
   });
   EXPECT_NE(message.find("1099511627776 energy faces"), std::string::npos) << message;
+}
+
+// A returned state leaves out what never changes (EnergyState::positions), and a quadric job
+// returns none (job_state.h): the decoder refuses a summary that carries either, and a job
+// whose energy state has no positions (its module could not place its points).
+TEST(JobCodec, ReturnedStatesCarryNoPositionsAndNoQuadrics) {
+  SimplifyOptions options;
+  options.metric = "energy";
+  testing::RoundZero round("stratocaster-9k.ply", options, 4);
+  SubsetJob& job = round.jobs[0];
+  job.options.target_faces = job.mesh.face_count() / 2;
+  const SubsetResult result = simplify_subset(job);
+  ASSERT_FALSE(result.state.energy.points.empty());
+  EXPECT_FALSE(result.state.energy.positions);
+  auto refused = [](const std::function<void()>& decode, const std::string& expected) {
+    try {
+      decode();
+      ADD_FAILURE() << expected << ": decoded";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  SubsetResult with_positions = result;
+  with_positions.state.energy.positions = true;
+  with_positions.state.energy.point_values.clear();  // (stratocaster: no attributes)
+  SubsetResult decoded;
+  refused([&] { decode_subset_summary(encode_subset_summary(with_positions), decoded); },
+          "a returned state with positions");
+  SubsetResult quadric;
+  quadric.state.metric = "quadric";
+  quadric.state.quadric.vertices = {3};
+  quadric.state.quadric.quadrics = {Quadric{}};
+  refused([&] { decode_subset_summary(encode_subset_summary(quadric), decoded); },
+          "a returned quadric state");
+  SubsetJob without = job;
+  without.state.energy.positions = false;
+  without.state.energy.point_values.clear();
+  refused([&] { decode_subset_job(encode_subset_job(without)); },
+          "a job's state without its points' positions");
+  // The honest summary decodes to the state the job returned.
+  decode_subset_summary(encode_subset_summary(result), decoded);
+  ASSERT_EQ(decoded.state.energy.points.size(), result.state.energy.points.size());
+  for (size_t i = 0; i < decoded.state.energy.points.size(); ++i) {
+    const EnergyState::Point &a = decoded.state.energy.points[i],
+                             &b = result.state.energy.points[i];
+    ASSERT_TRUE(a.id == b.id && a.face == b.face && a.vertex == b.vertex &&
+                a.distance_sq == b.distance_sq && a.residual == b.residual &&
+                a.position == b.position)
+        << i;
+  }
 }
 
 // A summary's state is in global ids, which only the master can check: it refuses ids
@@ -416,7 +483,7 @@ TEST(JobCodec, MasterRefusesAReturnedStateOutsideItsMesh) {
     decode_subset_summary(encode_subset_summary(bad), decoded);
     // ... and the master refuses it.
     try {
-      import_result_state(*round.master, decoded.state);
+      import_result_state(*round.master, decoded.state, {});
       ADD_FAILURE() << what << ": imported";
     } catch (const Error& e) {
       EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << what << ": " << e.what();
@@ -432,7 +499,7 @@ TEST(JobCodec, MasterRefusesAReturnedStateOutsideItsMesh) {
         s.vertices.back() = outside;
       },
       "vertex");
-  import_result_state(*round.master, result.state);  // the genuine one still goes in
+  import_result_state(*round.master, result.state, {});  // the genuine one still goes in
 }
 
 // Queue keys and deferred edges name vertices: a job's must be its own (the decoder checks), a
@@ -504,7 +571,25 @@ TEST(JobCodec, ReplayRefusesRecordsThatDoNotFitTheMesh) {
   ASSERT_GT(records.size(), 160u);
   {
     CollapseMesh whole(mesh);
-    EXPECT_EQ(replay_collapses(whole, records, nullptr).collapses, records.size());
+    std::vector<CollapseRecord> all = records;
+    EXPECT_EQ(replay_collapses(whole, all, nullptr).collapses, records.size());
+  }
+  {
+    // Decoded, the records lack what the mesh tells; the replay completes them as they were.
+    std::vector<CollapseRecord> decoded;
+    decode_collapse_records(encode_collapse_records(records.data(), records.size()), decoded);
+    ASSERT_EQ(decoded.size(), records.size());
+    EXPECT_TRUE(decoded.front().to_complete);
+    CollapseMesh whole(mesh);
+    replay_collapses(whole, decoded, nullptr);
+    for (size_t i = 0; i < records.size(); ++i) {
+      const CollapseRecord &a = decoded[i], &b = records[i];
+      ASSERT_TRUE(!a.to_complete && a.vl == b.vl && a.vr == b.vr && a.fl == b.fl && a.fr == b.fr &&
+                  a.corner_wedges == b.corner_wedges && a.vs_position == b.vs_position &&
+                  a.vt_position == b.vt_position && a.position == b.position &&
+                  a.changed_wedges == b.changed_wedges && a.changed_values == b.changed_values)
+          << "record " << i;
+    }
   }
   size_t with_changes = 0;
   while (with_changes < records.size() && records[with_changes].changed_wedges.empty())
@@ -515,12 +600,13 @@ TEST(JobCodec, ReplayRefusesRecordsThatDoNotFitTheMesh) {
   auto refused = [&](size_t k, const std::function<void(CollapseRecord&)>& damage,
                      const char* what) {
     CollapseMesh whole(mesh);
-    replay_collapses(whole, {records.begin(), records.begin() + ptrdiff_t(k)}, nullptr);
+    std::vector<CollapseRecord> before(records.begin(), records.begin() + ptrdiff_t(k));
+    replay_collapses(whole, before, nullptr);
     const size_t live_faces = whole.live_faces();
-    CollapseRecord bad = records[k];
-    damage(bad);
+    std::vector<CollapseRecord> bad = {records[k]};
+    damage(bad[0]);
     try {
-      replay_collapses(whole, {bad}, nullptr);
+      replay_collapses(whole, bad, nullptr);
       ADD_FAILURE() << what << ": replayed";
     } catch (const Error& e) {
       EXPECT_EQ(e.code(), ErrorCode::kInvalidInput) << what << ": " << e.what();
@@ -545,6 +631,16 @@ TEST(JobCodec, ReplayRefusesRecordsThatDoNotFitTheMesh) {
   refused(
       3, [&](CollapseRecord& r) { r.corner_wedges[1] = WedgeId(mesh.wedge_count()); },
       "corner wedge out of range");
+  refused(
+      3, [&](CollapseRecord& r) { r.vt_position[2] += 1e-3; }, "vt not where the mesh has it");
+  // A record to complete takes its apexes from the mesh, but not its faces.
+  refused(
+      3,
+      [&](CollapseRecord& r) {
+        r.to_complete = true;
+        std::swap(r.fl, r.fr);
+      },
+      "faces swapped, to complete");
   refused(
       with_changes, [&](CollapseRecord& r) { r.changed_wedges[0] = WedgeId(mesh.wedge_count()); },
       "changed wedge out of range");

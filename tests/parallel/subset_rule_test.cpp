@@ -229,12 +229,14 @@ void expect_side_by_side_replay_is_the_merged_one(const std::string& name,
                                                   const std::string& metric, uint32_t p) {
   const Round round = run_round(name, metric, p);
   CollapseMesh merged(round.repaired.mesh);
-  replay_collapses(merged, merge_by_cost(lists_of(round)), nullptr);
+  std::vector<CollapseRecord> sequence = merge_by_cost(lists_of(round));
+  replay_collapses(merged, sequence, nullptr);
   for (unsigned threads : {1u, 2u, 4u}) {
     CollapseMesh side(round.repaired.mesh);
     bool ran_beside = false;
-    const ReplayReport report = replay_subsets(side, lists_of(round), round.partition.vertex_subset,
-                                               threads, [&] { ran_beside = true; });
+    std::vector<std::vector<CollapseRecord>> lists = lists_of(round);
+    const ReplayReport report = replay_subsets(side, lists, round.partition.vertex_subset, threads,
+                                               [&] { ran_beside = true; });
     EXPECT_TRUE(ran_beside);
     size_t records = 0;
     for (const SubsetResult& r : round.results) records += r.records.size();
@@ -296,7 +298,8 @@ TEST(SubsetRule, SideBySideReplayRefusesARecordOfAnotherSubset) {
   ASSERT_TRUE(found);
   CollapseMesh again(mesh);
   try {
-    replay_subsets(again, {{border}, {}}, subset, 2);
+    std::vector<std::vector<CollapseRecord>> lists = {{border}, {}};
+    replay_subsets(again, lists, subset, 2);
     ADD_FAILURE() << "a border edge replayed";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("subset rule"), std::string::npos) << e.what();
