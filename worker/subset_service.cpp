@@ -11,6 +11,7 @@
 #include "rpc_server.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/memory.h"
 #include "util/progress.h"
 
 namespace parapm::worker {
@@ -148,6 +149,7 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
     return grpc::Status::OK;
   });
   record_outcome(status, seconds_since(start), bytes_sent);
+  release_free_memory();  // the subset's memory, freed on this call's thread, back to the system
   return status;
 }
 

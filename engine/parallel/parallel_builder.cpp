@@ -27,6 +27,7 @@
 #include "simplify/surface_samples.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/memory.h"
 #include "util/number_text.h"
 
 namespace parapm {
@@ -441,6 +442,9 @@ void ParallelBuilder::forgo_foreseen() {
 }
 
 bool ParallelBuilder::round() {
+  // What the last round's jobs freed on the pool's threads (1-40 ms on the 871k dragon; the
+  // peak at p = 16 is a quarter lower).
+  release_free_memory();
   if (round_index_ >= 64) {
     forgo_foreseen();  // (the rounds' limit)
     return false;
@@ -895,6 +899,7 @@ void ParallelBuilder::final_pass() {
 }
 
 ProgressiveMesh ParallelBuilder::progressive_mesh() {
+  release_free_memory();  // before the PM's arrays, the build's largest
   const auto t = std::chrono::steady_clock::now();
   PmBuildOptions build_options;
   build_options.keep_order = options_.keep_order;

@@ -58,8 +58,8 @@ std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseM
 
 namespace {
 
-// `release` (null, or `job` itself when the caller gives it up): its state and keys are
-// released once imported.
+// `release` (null, or `job` itself when the caller gives it up): its mesh, state and keys are
+// released once the working mesh, the module and the memo hold them.
 SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCallback& progress,
                       const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
@@ -88,7 +88,9 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
     memo->reset(job.keys);
   }
   if (release) {
-    // The module and the memo hold copies: the job's own would only double a job's memory.
+    // The working mesh, the module and the memo hold copies: the job's own would only add to
+    // a job's memory.
+    release->mesh = Mesh{};
     release->state = MetricState{};
     release->keys = std::vector<EdgeKey>{};
   }

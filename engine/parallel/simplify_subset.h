@@ -45,8 +45,9 @@ struct SubsetResult {
 // kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing.
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr);
-// The same, releasing the job's state and keys as soon as its metric has imported them (a
-// job's peak memory holds them once, not twice); `job` is left valid, without them.
+// The same, releasing the job's mesh, state and keys as soon as its working mesh and metric
+// hold them (a job's peak memory holds them once, not twice); `job` keeps its ids, owned and
+// locked flags and options.
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr);
 

@@ -3,6 +3,10 @@
 #include <cstdio>
 #include <cstring>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 namespace parapm {
 namespace {
 
@@ -26,5 +30,11 @@ uint64_t status_field_kb(const char* field) {
 
 uint64_t peak_memory_bytes() { return status_field_kb("VmHWM:") * 1024; }
 uint64_t current_memory_bytes() { return status_field_kb("VmRSS:") * 1024; }
+
+void release_free_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
 
 }  // namespace parapm
