@@ -82,20 +82,3 @@ nlohmann::json repair_report_json(const RepairReport& r) {
 void print_json(const nlohmann::json& object) { std::cout << object.dump() << std::endl; }
 
 }  // namespace parapm::cli
-
-#include <filesystem>
-
-namespace parapm::cli {
-
-uint64_t binary_ply_size(const Mesh& mesh) {
-  namespace fs = std::filesystem;
-  const fs::path path =
-      fs::temp_directory_path() / ("parapm-size-" + std::to_string(::getpid()) + ".ply");
-  write_mesh(mesh, path.string());
-  std::error_code ec;
-  const uint64_t size = fs::file_size(path, ec);
-  fs::remove(path, ec);
-  return size;
-}
-
-}  // namespace parapm::cli

@@ -48,8 +48,3 @@ nlohmann::json repair_report_json(const RepairReport& report);
 void print_json(const nlohmann::json& object);
 
 }  // namespace parapm::cli
-
-namespace parapm::cli {
-// Size in bytes of `mesh` written as binary PLY (what the .pm size is compared against).
-uint64_t binary_ply_size(const Mesh& mesh);
-}  // namespace parapm::cli

@@ -35,5 +35,6 @@ void check_mesh_start(const ReadContext& ctx, MeshFormat format, std::string_vie
 void check_writable(const Mesh& mesh);
 std::string write_obj(const Mesh& mesh);              // obj_writer.cpp
 std::string write_ply(const Mesh& mesh, bool ascii);  // ply_writer.cpp
+uint64_t binary_ply_size(const Mesh& mesh);           // write_ply(mesh, false).size()
 
 }  // namespace parapm::io

@@ -114,4 +114,9 @@ void write_mesh(const Mesh& mesh, const std::string& path, const WriteOptions& o
   io::write_file_bytes(path, bytes);
 }
 
+uint64_t binary_ply_size(const Mesh& mesh) {
+  io::check_writable(mesh);
+  return io::binary_ply_size(mesh);
+}
+
 }  // namespace parapm

@@ -95,4 +95,8 @@ struct WriteOptions {
 //   file back gives a mesh whose seam vertices are split.
 void write_mesh(const Mesh& mesh, const std::string& path, const WriteOptions& options = {});
 
+// The size in bytes of the binary PLY write_mesh would write for `mesh` (a .ply path), without
+// writing it: what the CLI compares a .pm's size with. Refuses what write_mesh refuses.
+uint64_t binary_ply_size(const Mesh& mesh);
+
 }  // namespace parapm

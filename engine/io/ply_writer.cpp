@@ -97,23 +97,28 @@ class PlyOut {
   bool first_ = true;
 };
 
-}  // namespace
+// The PLY vertices the writer emits: one per wedge, one for a vertex without wedges.
+uint64_t ply_vertex_count(const Mesh& mesh) {
+  if (!mesh.layout.any()) return mesh.positions.size();
+  std::vector<uint8_t> has_wedge(mesh.positions.size(), 0);
+  for (VertexId v : mesh.wedge_vertex) has_wedge[v] = 1;
+  uint64_t count = mesh.wedge_count();
+  for (uint8_t h : has_wedge) count += h ? 0 : 1;
+  return count;
+}
 
-std::string write_ply(const Mesh& mesh, bool ascii) {
+// A binary PLY vertex's bytes: positions, then normals, texcoords (floats) and colours (uchar).
+size_t binary_vertex_bytes(const AttributeLayout& layout, bool float_positions) {
+  return (float_positions ? 12 : 24) + (layout.normals ? 12 : 0) + (layout.texcoords ? 8 : 0) +
+         (layout.colors ? 4 : 0);
+}
+
+std::string ply_header(const Mesh& mesh, bool ascii, uint64_t vertices, bool float_positions) {
   const AttributeLayout& layout = mesh.layout;
-  std::vector<VertexId> wedge_to_ply;
-  const std::vector<PlyVertex> vertices = ply_vertices(mesh, &wedge_to_ply);
-  const bool float_positions = mesh.positions_are_float && all_positions_are_float(mesh.positions);
-  const bool wide_indices = vertices.size() > uint64_t(INT32_MAX);
-
-  std::string out;
-  const size_t vertex_bytes = (float_positions ? 12 : 24) + size_t(layout.floats_per_wedge()) * 4;
-  out.reserve(256 + vertices.size() * (ascii ? 3 * vertex_bytes : vertex_bytes) +
-              mesh.faces.size() * (ascii ? 30 : 13));
-  out += "ply\n";
+  std::string out = "ply\n";
   out += ascii ? "format ascii 1.0\n" : "format binary_little_endian 1.0\n";
   out += "comment written by ParaPM\n";
-  out += "element vertex " + std::to_string(vertices.size()) + "\n";
+  out += "element vertex " + std::to_string(vertices) + "\n";
   for (const char* axis : {"x", "y", "z"})
     out += std::string("property ") + (float_positions ? "float " : "double ") + axis + "\n";
   if (layout.normals) out += "property float nx\nproperty float ny\nproperty float nz\n";
@@ -121,10 +126,37 @@ std::string write_ply(const Mesh& mesh, bool ascii) {
   if (layout.colors)
     out += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
   out += "element face " + std::to_string(mesh.faces.size()) + "\n";
-  out += wide_indices ? "property list uchar uint vertex_indices\n"
-                      : "property list uchar int vertex_indices\n";
+  out += vertices > uint64_t(INT32_MAX) ? "property list uchar uint vertex_indices\n"
+                                         : "property list uchar int vertex_indices\n";
   out += "end_header\n";
+  return out;
+}
 
+bool writes_float_positions(const Mesh& mesh) {
+  return mesh.positions_are_float && all_positions_are_float(mesh.positions);
+}
+
+}  // namespace
+
+uint64_t binary_ply_size(const Mesh& mesh) {
+  const bool float_positions = writes_float_positions(mesh);
+  const uint64_t vertices = ply_vertex_count(mesh);
+  return ply_header(mesh, false, vertices, float_positions).size() +
+         vertices * binary_vertex_bytes(mesh.layout, float_positions) +
+         mesh.faces.size() * (1 + 3 * 4);
+}
+
+std::string write_ply(const Mesh& mesh, bool ascii) {
+  const AttributeLayout& layout = mesh.layout;
+  std::vector<VertexId> wedge_to_ply;
+  const std::vector<PlyVertex> vertices = ply_vertices(mesh, &wedge_to_ply);
+  const bool float_positions = writes_float_positions(mesh);
+  const bool wide_indices = vertices.size() > uint64_t(INT32_MAX);
+
+  const size_t vertex_bytes = binary_vertex_bytes(layout, float_positions);
+  std::string out = ply_header(mesh, ascii, vertices.size(), float_positions);
+  out.reserve(out.size() + vertices.size() * (ascii ? 3 * vertex_bytes : vertex_bytes) +
+              mesh.faces.size() * (ascii ? 30 : 13));
   PlyOut ply(out, ascii);
   static constexpr float kDefaults[9] = {0, 0, 0, 0, 0, 1, 1, 1, 1};  // normal, uv, rgba
   for (const PlyVertex& pv : vertices) {
