@@ -127,7 +127,7 @@ std::string ply_header(const Mesh& mesh, bool ascii, uint64_t vertices, bool flo
     out += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
   out += "element face " + std::to_string(mesh.faces.size()) + "\n";
   out += vertices > uint64_t(INT32_MAX) ? "property list uchar uint vertex_indices\n"
-                                         : "property list uchar int vertex_indices\n";
+                                        : "property list uchar int vertex_indices\n";
   out += "end_header\n";
   return out;
 }

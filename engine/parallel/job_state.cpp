@@ -20,6 +20,8 @@ IdMaps maps_of(const SubsetJob& job) {
   return {&job.global_vertex, &job.global_face, &job.global_wedge};
 }
 
+bool metric_returns_state(const std::string& metric) { return metric != "quadric"; }
+
 class WithoutInitialize : public PriorityWrapper {
  public:
   using PriorityWrapper::PriorityWrapper;
@@ -31,10 +33,6 @@ class WithoutInitialize : public PriorityWrapper {
 bool job_state_needed(const PriorityModule& master, uint32_t round) {
   return round > 0 || !dynamic_cast<const QuadricPriority*>(&master);
 }
-
-namespace {
-bool metric_returns_state(const std::string& metric) { return metric != "quadric"; }
-}  // namespace
 
 bool returns_state(const PriorityModule& module) { return metric_returns_state(module.name()); }
 
