@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "parallel/job_codec.h"
+#include "parallel/job_pool.h"
 #include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
 #include "parapm.grpc.pb.h"
@@ -122,16 +123,18 @@ class RemoteRunner::Dispatch {
   }
 
  private:
+  // Side by side, one job per hardware thread (each request is its own).
   void encode_requests() {
     const auto encode_start = std::chrono::steady_clock::now();
     requests_.resize(jobs_.size());
-    for (size_t i = 0; i < jobs_.size(); ++i) {
+    run_jobs(jobs_.size(), 0, [&](size_t i) {
       requests_[i].set_job_id(runner_.options_.job_id);
       requests_[i].set_round(jobs_[i].round);
       requests_[i].set_subset(jobs_[i].subset);
       requests_[i].set_job(encode_subset_job(jobs_[i]));
-      runner_.transport_.job_bytes += requests_[i].job().size();
-    }
+    });
+    for (const parapm::v1::SubsetRequest& request : requests_)
+      runner_.transport_.job_bytes += request.job().size();
     runner_.transport_.encode_seconds += seconds_since(encode_start);
   }
 
