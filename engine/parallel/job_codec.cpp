@@ -57,7 +57,7 @@ constexpr uint64_t kMinFaceBytes = 3 + 1;          // corners, global id
 constexpr uint64_t kMinWedgeBytes = 1 + 1;         // its vertex, global id
 constexpr uint64_t kMinKeyBytes = 1 + 1 + 8;       // a's gap, b's span, cost
 constexpr uint64_t kMinDeferredBytes = 1 + 1 + 4;  // a's gap, b's span, key
-// A record: flags, vs vt, vl fl vr fr, 9 f32, 6 corner wedges, cost, error, change count.
+// A record: flags, vs vt, fl fr, 3 f32, cost, error, change count.
 constexpr uint64_t kMinRecordBytes = 1 + 2 + 2 + 12 + 8 + 4 + 1;
 constexpr uint64_t kMinSampleBytes = 1 + 24 + 8 + 1 + 1;  // id, position, distance, u, w
 constexpr uint64_t kQuadricBytes = 11 * 8;
