@@ -129,6 +129,25 @@ uint32_t read_id(ByteReader& in, uint64_t bound, const char* what) {
   return id;
 }
 
+constexpr uint64_t kAnyId = uint64_t(1) << 32;  // a bound no 32-bit id reaches
+
+// An id written as its difference from the id written before it in the same list (zigzag
+// varint): a face's corners and its neighbours' are near each other in the spatially ordered
+// ids, so most take one byte.
+void write_near(ByteWriter& out, uint32_t id, uint32_t& previous) {
+  out.zigzag64(int64_t(id) - int64_t(previous));
+  previous = id;
+}
+
+uint32_t read_near(ByteReader& in, uint64_t bound, uint32_t& previous, const char* what) {
+  const uint64_t start = in.offset();
+  const int64_t id = int64_t(previous) + in.zigzag64();
+  if (id < 0 || uint64_t(id) >= bound)
+    in.fail_at(start, std::string(what) + " " + std::to_string(id) + " out of range");
+  previous = uint32_t(id);
+  return previous;
+}
+
 Vec3 read_position(ByteReader& in, bool as_f32) {
   const uint64_t start = in.offset();
   Vec3 p;
@@ -251,9 +270,9 @@ int energy_floats(const EnergyState& s) {
 }
 
 void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool residuals,
-                 bool as_f32) {
+                 bool as_f32, uint32_t& previous_id) {
   const EnergyState::Point& p = s.points[i];
-  out.varint(p.id);
+  write_near(out, p.id, previous_id);
   if (s.positions) write_position(out, p.position, as_f32);
   out.f64(p.distance_sq);
   if (residuals) out.f64(p.residual);
@@ -288,11 +307,12 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
                  (points_f32 ? kPointsF32 : 0) | (samples_f32 ? kSamplesF32 : 0)));
   // Points in export order: each face's, then each vertex's parked one.
   size_t next = 0;
+  uint32_t previous_id = 0;
   for (FaceId f : s.faces) {
     size_t end = next;
     while (end < s.points.size() && s.points[end].face == f && s.points[end].vertex == kNoId) ++end;
     out.varint(end - next);
-    for (; next < end; ++next) write_point(out, s, next, k, residuals, points_f32);
+    for (; next < end; ++next) write_point(out, s, next, k, residuals, points_f32, previous_id);
   }
   const size_t face_points = next;
   for (VertexId v : s.vertices)
@@ -301,9 +321,10 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
   if (next != s.points.size()) cannot_encode("energy state points are not in export order");
 
   out.varint(s.samples.size());
+  uint32_t previous_sample = 0;
   for (const EnergyState::CurveSample& c : s.samples) {
     if (c.u == kNoId) cannot_encode("energy state curve sample on no vertex");
-    out.varint(c.id);
+    write_near(out, c.id, previous_sample);
     if (s.positions) write_position(out, c.position, samples_f32);
     out.f64(c.distance_sq);
     out.varint(c.u);
@@ -315,7 +336,7 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
   for (size_t i = 0; i < s.vertices.size(); ++i) {
     const bool parked = next < s.points.size() && s.points[next].vertex == s.vertices[i];
     out.u8(parked ? 1 : 0);
-    if (parked) write_point(out, s, next++, k, residuals, points_f32);
+    if (parked) write_point(out, s, next++, k, residuals, points_f32, previous_id);
     out.varint(s.sharp_begin[i + 1] - s.sharp_begin[i]);
     for (uint32_t j = s.sharp_begin[i]; j < s.sharp_begin[i + 1]; ++j)
       out.varint(s.sharp_neighbors[j]);
@@ -338,9 +359,9 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
 }
 
 void read_point(ByteReader& in, int k, bool residuals, bool as_f32, FaceId face, VertexId vertex,
-                EnergyState& s) {
+                uint32_t& previous_id, EnergyState& s) {
   EnergyState::Point p;
-  p.id = in.varint32();
+  p.id = read_near(in, kAnyId, previous_id, "point id");
   p.face = face;
   p.vertex = vertex;
   if (s.positions) p.position = read_position(in, as_f32);
@@ -370,11 +391,13 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, Ener
   if ((points_f32 || samples_f32) && !positions) in.fail("float positions flagged, none present");
   const uint64_t point_bytes =
       1 + 8 + (residuals ? 8 : 0) + (positions ? (points_f32 ? 12 : 24) + 4 * uint64_t(k) : 0);
+  uint32_t previous_id = 0, previous_sample = 0;  // (near: in the order written)
 
   for (size_t i = 0; i < s.faces.size(); ++i) {
     in.set_context("energy face", i);
     const uint64_t n = read_count(in, point_bytes, "points");
-    for (uint64_t j = 0; j < n; ++j) read_point(in, k, residuals, points_f32, s.faces[i], kNoId, s);
+    for (uint64_t j = 0; j < n; ++j)
+      read_point(in, k, residuals, points_f32, s.faces[i], kNoId, previous_id, s);
   }
   in.set_context("curve samples");
   s.samples.resize(read_count(in,
@@ -383,7 +406,7 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, Ener
                                                                : 0),
                               "curve samples"));
   for (EnergyState::CurveSample& c : s.samples) {
-    c.id = in.varint32();
+    c.id = read_near(in, kAnyId, previous_sample, "curve sample id");
     if (positions) c.position = read_position(in, samples_f32);
     c.distance_sq = in.f64();
     c.u = read_id(in, bounds.vertices, "curve sample vertex");
@@ -396,7 +419,7 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, Ener
     const VertexId v = s.vertices[i];
     const uint8_t parked = in.u8();
     if (parked > 1) in.fail("bad parked flag");
-    if (parked) read_point(in, k, residuals, points_f32, kNoId, v, s);
+    if (parked) read_point(in, k, residuals, points_f32, kNoId, v, previous_id, s);
     const uint64_t sharp = read_count(in, 1, "sharp neighbours");
     for (uint64_t j = 0; j < sharp; ++j) {
       const VertexId x = read_id(in, bounds.vertices, "sharp neighbour");
@@ -625,13 +648,16 @@ void write_job(ByteWriter& out, const SubsetJob& job) {
     out.u8(uint8_t((job.owned[v] ? kOwned : 0) | (job.locked[v] ? kLocked : 0)));
   }
   write_increasing(out, job.global_vertex, "global vertex");
+  uint32_t previous = 0;
   for (const Triangle& t : m.faces)
-    for (VertexId v : t) out.varint(v);
+    for (VertexId v : t) write_near(out, v, previous);
   write_increasing(out, job.global_face, "global face");
-  for (VertexId v : m.wedge_vertex) out.varint(v);
+  previous = 0;
+  for (VertexId v : m.wedge_vertex) write_near(out, v, previous);
   for (float x : m.wedge_values) out.f32(x);
+  previous = 0;
   for (const auto& w : m.face_wedges)
-    for (WedgeId id : w) out.varint(id);
+    for (WedgeId id : w) write_near(out, id, previous);
   write_increasing(out, job.global_wedge, "global wedge");
   out.varint(job.owned_faces);
   write_state(out, job.state);
@@ -680,28 +706,31 @@ void read_job(ByteReader& in, SubsetJob& job) {
   in.set_context("global vertex ids");
   read_increasing(in, vertices, kNoId, job.global_vertex);
   m.faces.resize(faces);
+  uint32_t previous = 0;
   for (size_t f = 0; f < faces; ++f) {
     in.set_context("face", f);
     Triangle& t = m.faces[f];
-    for (VertexId& v : t) v = read_id(in, vertices, "corner");
+    for (VertexId& v : t) v = read_near(in, vertices, previous, "corner");
     if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) in.fail("a corner is repeated");
   }
   in.set_context("global face ids");
   read_increasing(in, faces, kNoId, job.global_face);
   m.wedge_vertex.resize(wedges);
+  previous = 0;
   for (size_t w = 0; w < wedges; ++w) {
     in.set_context("wedge", w);
-    m.wedge_vertex[w] = read_id(in, vertices, "wedge vertex");
+    m.wedge_vertex[w] = read_near(in, vertices, previous, "wedge vertex");
   }
   in.set_context("wedge values");
   m.wedge_values.resize(wedges * floats);
   for (float& x : m.wedge_values) x = in.f32();
   if (flags & kCornerWedges) {
     m.face_wedges.resize(faces);
+    previous = 0;
     for (size_t f = 0; f < faces; ++f) {
       in.set_context("corner wedges", f);
       for (int k = 0; k < 3; ++k) {
-        const WedgeId w = m.face_wedges[f][k] = read_id(in, wedges, "corner wedge");
+        const WedgeId w = m.face_wedges[f][k] = read_near(in, wedges, previous, "corner wedge");
         // The simplifier takes a corner's wedge to be its vertex's (repair.h rule 1).
         if (m.wedge_vertex[w] != m.faces[f][k]) in.fail("a corner's wedge is another vertex's");
       }

@@ -5,8 +5,9 @@
 //
 // Layout (little-endian, byte_io.h; "v" is a LEB128 varint, "id+1" a varint of the id plus
 // one modulo 2^32 so that kNoId costs one byte, "ids+" strictly increasing ids as the first
-// id then each gap minus one). Every message starts with a 4-byte magic naming its kind and a
-// version byte, so that one kind is never decoded as another.
+// id then each gap minus one, "near" an id as the zigzag varint of its difference from the
+// one before it in its list, the first from 0). Every message starts with a 4-byte magic naming its
+// kind and a version byte, so that one kind is never decoded as another.
 //
 //   (The version byte is 6 for every kind; DECISIONS.md, "The job codec's versions", says
 //   what each one added.)
@@ -19,8 +20,8 @@
 //           positions_are_float, 2 normals, 4 texcoords, 8 colours, 16 corner wedges, 32
 //           positions stored as f32: set when every coordinate is exactly a float) | per
 //           vertex: position (3 f32 or 3 f64), owned | locked << 1 u8 | global_vertex ids+ |
-//           per face: 3 corners v | global_face ids+ | per wedge: wedge_vertex v, then all
-//           values f32, then (flag 16) per face 3 wedges v | global_wedge ids+ |
+//           per face: 3 corners near | global_face ids+ | per wedge: wedge_vertex near,
+//           then all values f32, then (flag 16) per face 3 wedges near | global_wedge ids+ |
 //           owned_faces v | state | keys | deferred.
 //   state   metric u8, then the metric's part (the other part must be empty):
 //           quadric (a job's only: quadric jobs return none): n v, vertices ids+, n x 11 f64
@@ -30,12 +31,13 @@
 //           job's state and only there; 4: the points' positions as 3 f32, 8: the curve
 //           samples', each set when every one is exactly a float, as an input vertex's is) |
 //           per face: its point count v, then its points |
-//           curve samples: n v, per sample id v, [position 3 f64], distance_sq f64, u v, w
+//           curve samples: n v, per sample id near, [position 3 f64], distance_sq f64, u v, w
 //           id+1 | per vertex: parked u8 (0/1) [point], sharp count v and neighbours v,
 //           listed count v and sample indices v | curve_samples_total v | wedges n v + ids+,
 //           n x k f32 values, per wedge (its index - the index of its class's wedge) v. A
-//           point: id v, [position 3 f64], distance_sq f64, [residual f64], [k f32 (with
-//           positions)]; its face or vertex is the one it is written under (export order).
+//           point: id near, [position 3 f64], distance_sq f64, [residual f64], [k f32 (with
+//           positions)]; its face or vertex is the one it is written under (export order);
+//           its id is near the point written before it, across faces and vertices.
 //   keys    n v, then per key (sorted by (a, b), a < b: edge_keys.h) a minus the previous
 //           key's a v, b - a - 1 v, cost f64 (NaN: the edge cannot be placed).
 //   deferred n v, then per edge (sorted by (a, b), a < b: simplifier.h, DeferredEdge) as a
