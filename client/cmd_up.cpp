@@ -1,12 +1,15 @@
 // parapm up [--workers N] [--data DIR]: the whole service on this machine in the foreground,
 // a coordinator and N workers on loopback, as child processes (the same daemons one starts on
-// many machines). Ctrl-C (or SIGTERM) stops them all cleanly. A worker that exits is started
+// many machines). Ctrl-C (or SIGTERM) stops them all cleanly; killed, it leaves none behind
+// (each child gets SIGTERM when it ends). A worker that exits is started
 // again, after a pause that doubles with each exit in a row (0.5 s up to 30 s; a worker that
 // lived a minute starts the count again); the coordinator exiting stops the rest, exit status 1.
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -17,8 +20,6 @@
 #include "commands.h"
 #include "service_client.h"
 #include "util/error.h"
-
-extern char** environ;
 
 namespace parapm::cli {
 namespace {
@@ -51,6 +52,9 @@ std::filesystem::path sibling_program(const std::string& name) {
   return program;
 }
 
+// The child process of `program`, started from the main thread. It stops (SIGTERM) when this
+// process ends, however it ends (a SIGKILL or a crash too), so that no coordinator or worker
+// outlives `parapm up` holding its ports.
 pid_t spawn(const std::filesystem::path& program, const std::vector<std::string>& args) {
   std::vector<char*> argv;
   std::string name = program.string();
@@ -58,17 +62,20 @@ pid_t spawn(const std::filesystem::path& program, const std::vector<std::string>
   std::vector<std::string> copy = args;
   for (std::string& a : copy) argv.push_back(a.data());
   argv.push_back(nullptr);
-  // The children must see SIGINT / SIGTERM, which this process blocks for sigwait.
-  posix_spawnattr_t attr;
-  posix_spawnattr_init(&attr);
+  // Everything is prepared before fork(): between fork() and exec() only async-signal-safe
+  // calls. The children must see SIGINT / SIGTERM, which this process blocks for sigwait.
   sigset_t none;
   sigemptyset(&none);
-  posix_spawnattr_setsigmask(&attr, &none);
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, name.c_str(), nullptr, &attr, argv.data(), environ);
-  posix_spawnattr_destroy(&attr);
-  if (rc != 0) throw Error(ErrorCode::kIo, "cannot start " + name + ": " + std::strerror(rc));
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(126);  // the parent ended before the line above
+    execv(name.c_str(), argv.data());
+    _exit(127);
+  }
+  if (pid < 0) throw Error(ErrorCode::kIo, "cannot start " + name + ": " + std::strerror(errno));
   return pid;
 }
 

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -112,6 +113,46 @@ TEST_F(ServiceCli, UpSubmitFetchStreamAndStopWithCtrlC) {
   EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 0) << up.log();
   CliResult after = run_parapm({"jobs", "--server", server}, dir());
   EXPECT_EQ(after.exit_code, 3) << "the coordinator still answers after Ctrl-C: " << after.output;
+}
+
+// The processes `pid` has started (/proc/PID/task/PID/children).
+std::vector<pid_t> children_of(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
+  std::vector<pid_t> children;
+  for (pid_t child = 0; in >> child;) children.push_back(child);
+  return children;
+}
+
+// Gone, or a zombie left for whoever reaps orphans here.
+bool ended(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat;
+  if (!std::getline(in, stat)) return true;
+  const size_t name_end = stat.rfind(')');
+  return name_end == std::string::npos || stat.compare(name_end + 2, 1, "Z") == 0;
+}
+
+// `parapm up` killed outright (SIGKILL: no chance to stop anything) leaves no coordinator or
+// worker behind holding its ports: each child stops when it ends.
+TEST_F(ServiceCli, UpKilledLeavesNoDaemonBehind) {
+  const std::string server = "127.0.0.1:" + std::to_string(free_port());
+  ChildProcess up("up",
+                  {(fs::path(PARAPM_BINARY_DIR) / "parapm").string(), "up", "--workers", "2",
+                   "--data", (dir() / "up-data").string(), "--listen", server},
+                  dir() / "up.log");
+  for (int i = 0; i < 200 && up.log().find("ParaPM is up") == std::string::npos; ++i)
+    std::this_thread::sleep_for(milliseconds(50));
+  ASSERT_TRUE(up.running()) << up.log();
+  const std::vector<pid_t> children = children_of(up.pid());
+  ASSERT_EQ(children.size(), 3u) << "a coordinator and two workers\n" << up.log();
+  up.kill_now();
+  for (pid_t child : children) {
+    for (int i = 0; i < 200 && !ended(child); ++i) std::this_thread::sleep_for(milliseconds(50));
+    EXPECT_TRUE(ended(child)) << "process " << child << " outlived parapm up";
+    if (!ended(child)) ::kill(child, SIGKILL);
+  }
+  CliResult after = run_parapm({"jobs", "--server", server}, dir());
+  EXPECT_EQ(after.exit_code, 3) << "the coordinator still answers: " << after.output;
 }
 
 size_t count_of(const std::string& text, const std::string& what) {
