@@ -68,7 +68,7 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
   uint64_t bytes_sent = 0;
   const grpc::Status status = rpc::serve(auth_, context, [&]() -> grpc::Status {
     metrics_.job_bytes.Increment(double(request->job().size()));
-    const SubsetJob job = decode_subset_job(request->job());
+    SubsetJob job = decode_subset_job(request->job());
     const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +
                              " subset " + std::to_string(job.subset);
     if (!acquire_slot(context)) return {grpc::StatusCode::CANCELLED, "cancelled while queued"};
