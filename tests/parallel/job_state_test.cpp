@@ -540,7 +540,8 @@ TEST(JobState, QuadricRecordsSideBySideTakeOnlyTheirOwnSubsets) {
 
   import_result_states(*round.master, {&states[0], &states[1]}, vertex_subset, faces, 2,
                        {&records[0], &records[1]});
-  // What the jobs' modules hold at their end: the same records followed one at a time.
+  // Side by side as one at a time on a second master (ImportedStateEqualsTheReplayedState
+  // checks the followed quadrics against collapsed() on every merged record).
   auto one_by_one =
       make_priority_module(SimplifyOptions{}, round.repaired.mesh, locked_vertices(round.repaired));
   one_by_one->initialize(round.whole);
