@@ -141,10 +141,12 @@ void write_near(ByteWriter& out, uint32_t id, uint32_t& previous) {
 
 uint32_t read_near(ByteReader& in, uint64_t bound, uint32_t& previous, const char* what) {
   const uint64_t start = in.offset();
-  const int64_t id = int64_t(previous) + in.zigzag64();
-  if (id < 0 || uint64_t(id) >= bound)
-    in.fail_at(start, std::string(what) + " " + std::to_string(id) + " out of range");
-  previous = uint32_t(id);
+  const int64_t difference = in.zigzag64();
+  // (Checked before adding: a hostile difference near 2^63 must not overflow.)
+  if (difference < -int64_t(previous) || difference >= int64_t(bound) - int64_t(previous))
+    in.fail_at(start, std::string(what) + ": " + std::to_string(previous) + " + " +
+                          std::to_string(difference) + " out of range");
+  previous = uint32_t(int64_t(previous) + difference);
   return previous;
 }
 
