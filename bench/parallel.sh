@@ -31,11 +31,10 @@ metrics="${METRICS:-energy quadric}"
 ps="${PS:-2 4}"
 ratio="${RATIO:-0.01}"
 repeats="${REPEATS:-1}"
-[[ "$repeats" =~ ^[1-9][0-9]*$ ]] || { echo "$0: REPEATS must be a positive integer" >&2; exit 2; }
+check_repeats "$repeats"
 out="${BENCH_OUT:-$PWD/bench-out-parallel}"
-bin="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
+bin="$(parapm_program "$root")"
 metro="${METRO:-${PEERS_BUILD:-$PWD/.peers-build}/metro}"
-[[ -x "$bin" ]] || { echo "no $bin (build the parapm target)" >&2; exit 2; }
 [[ -x "$metro" ]] || { echo "no metro (set METRO, or run bench/run.sh once)" >&2; exit 2; }
 par_opts=()
 [[ -n "${ROUNDS:-}" ]] && par_opts+=(--rounds "$ROUNDS")

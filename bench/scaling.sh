@@ -24,10 +24,9 @@ metrics="${METRICS:-energy quadric}"
 ps="${PS:-2 4 8 16}"
 ratio="${RATIO:-0.02}"
 repeats="${REPEATS:-3}"
-[[ "$repeats" =~ ^[1-9][0-9]*$ ]] || { echo "$0: REPEATS must be a positive integer" >&2; exit 2; }
+check_repeats "$repeats"
 out="${BENCH_OUT:-$PWD/bench-out-scaling}"
-bin="${PARAPM_BUILD_DIR:-$root/build}/bin/parapm"
-[[ -x "$bin" ]] || { echo "no $bin (build the parapm target)" >&2; exit 2; }
+bin="$(parapm_program "$root")"
 command -v jq > /dev/null || { echo "$0 needs jq" >&2; exit 2; }
 mkdir -p "$out"
 

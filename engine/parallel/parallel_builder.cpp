@@ -442,9 +442,7 @@ void ParallelBuilder::forgo_foreseen() {
 }
 
 bool ParallelBuilder::round() {
-  // What the last round's jobs freed on the pool's threads (1-40 ms on the 871k dragon; the
-  // peak at p = 16 is a quarter lower).
-  release_free_memory();
+  release_free_memory();  // what the last round's jobs freed on the pool's threads
   if (round_index_ >= 64) {
     forgo_foreseen();  // (the rounds' limit)
     return false;

@@ -42,16 +42,25 @@ nlohmann::json json_of(const CliResult& result) {
   return {};
 }
 
-class ServiceCli : public ServiceTest {};
+class ServiceCli : public ServiceTest {
+ protected:
+  // `parapm up` with `workers` workers, listening on `server`, its data in the test's folder.
+  std::vector<std::string> up_command(int workers, const std::string& server) {
+    return {(fs::path(PARAPM_BINARY_DIR) / "parapm").string(),
+            "up",
+            "--workers",
+            std::to_string(workers),
+            "--data",
+            (dir() / "up-data").string(),
+            "--listen",
+            server};
+  }
+};
 
 TEST_F(ServiceCli, UpSubmitFetchStreamAndStopWithCtrlC) {
   const int port = free_port();
   const std::string server = "127.0.0.1:" + std::to_string(port);
-  const fs::path bin = PARAPM_BINARY_DIR;
-  ChildProcess up("up",
-                  {(bin / "parapm").string(), "up", "--workers", "2", "--data",
-                   (dir() / "up-data").string(), "--listen", server},
-                  dir() / "up.log");
+  ChildProcess up("up", up_command(2, server), dir() / "up.log");
   // Ready when the coordinator wrote its port and both workers registered.
   for (int i = 0; i < 200 && up.log().find("registered with coordinator") == std::string::npos; ++i)
     std::this_thread::sleep_for(milliseconds(50));
@@ -136,10 +145,7 @@ bool ended(pid_t pid) {
 // worker behind holding its ports: each child stops when it ends.
 TEST_F(ServiceCli, UpKilledLeavesNoDaemonBehind) {
   const std::string server = "127.0.0.1:" + std::to_string(free_port());
-  ChildProcess up("up",
-                  {(fs::path(PARAPM_BINARY_DIR) / "parapm").string(), "up", "--workers", "2",
-                   "--data", (dir() / "up-data").string(), "--listen", server},
-                  dir() / "up.log");
+  ChildProcess up("up", up_command(2, server), dir() / "up.log");
   for (int i = 0; i < 200 && up.log().find("ParaPM is up") == std::string::npos; ++i)
     std::this_thread::sleep_for(milliseconds(50));
   ASSERT_TRUE(up.running()) << up.log();
@@ -165,10 +171,7 @@ size_t count_of(const std::string& text, const std::string& what) {
 // and the service keeps building.
 TEST_F(ServiceCli, UpStartsACrashedWorkerAgain) {
   const std::string server = "127.0.0.1:" + std::to_string(free_port());
-  ChildProcess up("up",
-                  {(fs::path(PARAPM_BINARY_DIR) / "parapm").string(), "up", "--workers", "1",
-                   "--data", (dir() / "up-data").string(), "--listen", server},
-                  dir() / "up.log");
+  ChildProcess up("up", up_command(1, server), dir() / "up.log");
   auto wait_for = [&](const std::string& what, size_t count) {
     for (int i = 0; i < 400 && count_of(up.log(), what) < count; ++i)
       std::this_thread::sleep_for(milliseconds(50));
