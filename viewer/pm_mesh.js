@@ -6,7 +6,8 @@
 //  - with vr: start at the face holding vs->vr and turn counter-clockwise until the face
 //    holding vl->vs is taken, or there is no next face (a boundary);
 //  - with vl, and vr absent or that walk stopped at a boundary: start at the face holding
-//    vl->vs and turn clockwise until there is no previous face.
+//    vl->vs and turn clockwise until there is no previous face;
+//  - a vs without faces (nor vl, vr) has an empty fan: the split brings a component back.
 // Positions: vs takes vsAfter, the new vertex vt = n0 + i vtAfter; undoing restores vs.
 //
 // Buffers for drawing: `positions` (Float32Array, 3 per vertex, every vertex the decoder has
@@ -199,6 +200,12 @@ export class PmMesh {
   #findFan(i) {
     const d = this.decoder, vs = d.vs[i], vl = d.vl[i], vr = d.vr[i];
     const t = this.faces, lists = this.vertexCorners, n = lists.count(vs);
+    if (n === 0) {
+      // A component coming back: vs, vl and vr are faceless, joined by the new faces alone.
+      if (vl >= 0 && lists.count(vl) > 0) return `${vl} has faces but ${vs} has none`;
+      if (vr >= 0 && lists.count(vr) > 0) return `${vr} has faces but ${vs} has none`;
+      return 0;
+    }
     this.#scratchFor(n);
     const a = this.ringA, b = this.ringB, taken = this.taken, ring = lists.pool, s = lists.start(vs);
     for (let j = 0; j < n; j++) {

@@ -860,7 +860,11 @@ void ParallelBuilder::final_pass() {
   keys_->reset(carried);
   const uint64_t reused_before = keys_->reused();
   std::unique_ptr<PriorityModule> continued = without_initialize(*master_queue_);
-  Simplifier pass(whole, *continued, standard_constraints(locked_, whole_components()));
+  // Components vanish here only: in the jobs and the band passes a lone triangle waits for
+  // this pass, which costs it against the whole mesh's coarse collapses.
+  Simplifier pass(
+      whole, *continued,
+      standard_constraints(locked_, whole_components(), options_.components_may_vanish));
   SimplifierLimits limits;
   limits.target_faces = target_;
   if (options_.defer_recosting) limits.defer_above_faces = defer_line_;

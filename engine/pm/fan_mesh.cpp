@@ -7,7 +7,9 @@
 //  - with vl present and either vr absent or that walk stopped at a boundary: start at the
 //    face holding vl->vs and turn clockwise until there is no previous face;
 //  - a starting face that does not exist contributes nothing (the new face fl or fr then
-//    lies on a boundary of the fine mesh).
+//    lies on a boundary of the fine mesh);
+//  - a vs without faces has an empty fan; vl and vr then have no faces either, and fl and fr
+//    make a new component (the collapse of a component's last faces, undone).
 // Why both ends: in the fine mesh the faces of vt other than fl and fr run counter-clockwise
 // from fr to fl; when vt is a boundary vertex that run is cut in two by the boundary, and in
 // the coarse mesh the two pieces hang off the face holding vs->vr and the face holding vl->vs.
@@ -103,6 +105,15 @@ uint32_t FanMesh::find_b(VertexId x) const {
 std::string FanMesh::find_fan(const VertexSplit& s, std::vector<FaceId>& fan) {
   fan.clear();
   const VertexId vs = s.vs;
+  if (vertex_faces_.of(vs).empty()) {
+    // A component coming back: vs, vl and vr (when present) are faceless vertices, which the
+    // split joins by fl and fr alone.
+    for (VertexId side : {s.vl, s.vr})
+      if (side != kNoId && !vertex_faces_.of(side).empty())
+        return (side == s.vl ? "vl " : "vr ") + str(side) + " has faces but vs " + str(vs) +
+               " has none";
+    return {};
+  }
   ring_.clear();
   for (FaceId f : vertex_faces_.of(vs)) {
     const Triangle& t = faces_[f];

@@ -13,7 +13,9 @@
 //   to vt are the fan that starts at the face holding the directed edge vs->vr and turns
 //   counter-clockwise around vs up to the face holding vl->vs; where vt was a boundary
 //   vertex the fan is cut by the boundary and is walked from both ends (see fan_mesh.cpp).
-//   Their corners at vs become corners at vt; corner wedges do not change.
+//   Their corners at vs become corners at vt; corner wedges do not change. A vs without
+//   faces has an empty fan, and vl and vr (when present) have no faces either: the split
+//   brings back a component whose last faces were collapsed away, as fl and fr.
 #pragma once
 
 #include <array>

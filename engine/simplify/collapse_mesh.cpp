@@ -132,11 +132,12 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
   moved.shrink_to_fit();
   vertex_alive_[vt] = 0;
   ++here.vertices;
-  // An apex whose only face was removed is gone too (legal collapses never do this: the
-  // component minimum keeps a lone triangle; kept for the invariant alive == has faces).
-  for (VertexId apex : {removed.left_apex, removed.right_apex})
-    if (apex != kNoId && vertex_alive_[apex] && faces_of_[apex].empty()) {
-      vertex_alive_[apex] = 0;
+  // The collapse of a component's last triangle (ComponentMinimum, when components may vanish)
+  // leaves vs and the apex without faces: they stay in the mesh (the split that brings the
+  // triangle back needs them) but are no longer alive, as alive means having faces.
+  for (VertexId v : {vs, removed.left_apex, removed.right_apex})
+    if (v != kNoId && vertex_alive_[v] && faces_of_[v].empty()) {
+      vertex_alive_[v] = 0;
       ++here.vertices;
     }
   if (counted) {

@@ -6,6 +6,7 @@
 
 #include "simplify/face_fold.h"
 #include "simplify/modules.h"
+#include "simplify/vec_math.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -27,11 +28,15 @@ class LockedVertices : public ConstraintModule {
 };
 
 // Counts the live vertices of each connected component; components never merge or split
-// under legal collapses, so the counts only go down by one per collapse.
+// under legal collapses, so the counts only go down by one per collapse. A closed component
+// keeps a tetrahedron (a closed surface has no smaller form), an open one its last triangle,
+// unless components may vanish: then an open component may lose it too, but for the largest
+// (by area when the pass starts), so that the mesh never vanishes whole, and those touching
+// another component (mark_touching_components).
 class ComponentMinimum : public ConstraintModule {
  public:
-  explicit ComponentMinimum(std::shared_ptr<const std::vector<uint32_t>> components)
-      : given_(std::move(components)) {}
+  ComponentMinimum(std::shared_ptr<const std::vector<uint32_t>> components, bool may_vanish)
+      : given_(std::move(components)), may_vanish_(may_vanish) {}
   std::string name() const override { return "component-minimum"; }
   bool topological() const override { return true; }
   void initialize(const CollapseMesh& mesh) override {
@@ -57,21 +62,64 @@ class ComponentMinimum : public ConstraintModule {
       ++count_[c];
       if (mesh.is_boundary(v)) closed_[c] = 0;
     }
+    if (may_vanish_) {
+      largest_ = largest_component(mesh);
+      mark_touching_components(mesh);
+    }
   }
   bool allows(const CollapseMesh&, const CollapseCandidate& c, const EdgeFaces&) const override {
     const uint32_t comp = component_[c.vs];
-    return count_[comp] > (closed_[comp] ? 4u : 3u);
+    if (closed_[comp]) return count_[comp] > 4u;
+    const bool may_vanish = may_vanish_ && comp != largest_ && !touching_[comp];
+    return count_[comp] > (may_vanish ? 2u : 3u);
   }
   void collapsed(const CollapseMesh&, const CollapseCandidate& c) override {
     --count_[component_[c.vs]];
   }
 
  private:
+  // The component of the largest area (the first of equals): the one kept whatever the cost.
+  uint32_t largest_component(const CollapseMesh& mesh) const {
+    std::vector<double> area(count_.size(), 0.0);
+    for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+      if (!mesh.face_alive(f)) continue;
+      const Triangle& t = mesh.face(f);
+      const Vec3& p0 = mesh.position(t[0]);
+      area[component_[t[0]]] +=
+          length(triangle_normal(p0, mesh.position(t[1]), mesh.position(t[2])));
+    }
+    return uint32_t(std::max_element(area.begin(), area.end()) - area.begin());
+  }
+
+  // Components with a vertex at the same place as another component's: pieces of one surface
+  // the input did not weld (a soup of triangles), where a vanishing piece opens a hole in that
+  // surface, not a part leaving the scene. They keep their last triangle.
+  void mark_touching_components(const CollapseMesh& mesh) {
+    touching_.assign(count_.size(), 0);
+    if (count_.size() < 2) return;
+    std::vector<std::pair<Vec3, uint32_t>> placed;
+    for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
+      if (mesh.vertex_alive(v)) placed.emplace_back(mesh.position(v), component_[v]);
+    std::sort(placed.begin(), placed.end());
+    for (size_t i = 0; i < placed.size();) {
+      size_t end = i + 1;
+      bool shared = false;
+      for (; end < placed.size() && placed[end].first == placed[i].first; ++end)
+        shared |= placed[end].second != placed[i].second;
+      if (shared)
+        for (size_t k = i; k < end; ++k) touching_[placed[k].second] = 1;
+      i = end;
+    }
+  }
+
   std::shared_ptr<const std::vector<uint32_t>> given_;
+  bool may_vanish_;
   std::vector<uint32_t> found_;
   const uint32_t* component_ = nullptr;  // per vertex: given_'s or found_'s
   std::vector<uint32_t> count_;
   std::vector<uint8_t> closed_;
+  std::vector<uint8_t> touching_;
+  uint32_t largest_ = 0;
 };
 
 class BoundaryRule : public ConstraintModule {
@@ -126,10 +174,12 @@ class FaceGeometry : public ConstraintModule {
 }  // namespace
 
 std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
-    const std::vector<uint8_t>& locked, std::shared_ptr<const std::vector<uint32_t>> components) {
+    const std::vector<uint8_t>& locked, std::shared_ptr<const std::vector<uint32_t>> components,
+    bool components_may_vanish) {
   std::vector<std::unique_ptr<ConstraintModule>> modules;
   modules.push_back(std::make_unique<LockedVertices>(locked));
-  modules.push_back(std::make_unique<ComponentMinimum>(std::move(components)));
+  modules.push_back(
+      std::make_unique<ComponentMinimum>(std::move(components), components_may_vanish));
   modules.push_back(std::make_unique<BoundaryRule>());
   modules.push_back(std::make_unique<LinkCondition>());
   modules.push_back(std::make_unique<FaceGeometry>());

@@ -52,6 +52,8 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   if (!survivor.possible) return false;
   out.vs = survivor.keep_b ? b : a;
   out.vt = survivor.keep_b ? a : b;
+  if (leaves_no_face(mesh, a, b))
+    return module_.options_.components_may_vanish && evaluate_removal(mesh, a, b, survivor, out);
   StarSums sums = gather_star(mesh, a, b);
   if (scratch_.star.empty()) return false;
   const StarPoints points = gather_star_points(link_fan(sums, a, b));
@@ -73,6 +75,73 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   if (module_.scalar_.enabled()) out.cost += attribute_change(placing, chosen);
   // Penalised, not forbidden (Hoppe 96), at a price per point of the star.
   if (survivor.topology) out.cost += module_.topology_price_ * std::max(1.0, points.points_around);
+  return std::isfinite(out.cost);
+}
+
+bool EnergyEvaluator::leaves_no_face(const CollapseMesh& mesh, VertexId a, VertexId b) {
+  for (const auto& [end, other] : {std::pair{a, b}, std::pair{b, a}})
+    for (FaceId f : mesh.faces_of(end))
+      if (corner_of(mesh.face(f), other) < 0) return false;
+  return true;
+}
+
+bool EnergyEvaluator::evaluate_removal(const CollapseMesh& mesh, VertexId a, VertexId b,
+                                       const Survivor& survivor, CollapseCandidate& out) {
+  // The points: those of the faces removed and the samples still parked at a and b.
+  double before = 0;
+  Vec3 sum{};
+  std::vector<Vec3>& points = scratch_.removal_points;
+  points.clear();
+  for (FaceId f : mesh.faces_of(a))
+    for (const FacePoint& p : module_.face_points_[f]) {
+      points.push_back(p.position);
+      before += p.distance_sq;
+    }
+  for (VertexId end : {a, b})
+    if (module_.parked_point_[end] != EnergyPriority::kNoPoint)
+      points.push_back(module_.positions_[module_.parked_point_[end]]);
+  for (const Vec3& x : points) sum = add(sum, x);
+  const SharpCurves& curves = module_.curves_;
+  curves.gather(a, b, mesh, module_.options_.max_sampled_points);
+  before += curves.gathered_distance_sq();
+
+  // Each point at its squared distance to v; the samples at theirs to the segments left.
+  struct Priced {
+    double energy, max_distance_sq;
+  };
+  auto price = [&](const Vec3& v, SharpCurves::Fit* curve_fit) {
+    Priced priced{0, 0};
+    for (const Vec3& x : points) {
+      const Vec3 d = sub(x, v);
+      priced.energy += dot(d, d);
+      priced.max_distance_sq = std::max(priced.max_distance_sq, dot(d, d));
+    }
+    const SharpCurves::Fit fit = curves.gathered() ? curves.project(v) : SharpCurves::Fit{};
+    priced.energy += fit.distance_sq;
+    priced.max_distance_sq = std::max(priced.max_distance_sq, fit.max_distance_sq);
+    if (curve_fit) *curve_fit = fit;
+    return priced;
+  };
+  const bool round = module_.options_.round_to_float;
+  Vec3 v = mesh.position(out.vs);
+  Priced best = price(v, nullptr);
+  if (!survivor.fixed) {
+    // From the points' centroid, one least-squares step with the curves' model there.
+    const Vec3 centroid = points.empty() ? scale(add(mesh.position(a), mesh.position(b)), 0.5)
+                                         : scale(sum, 1.0 / double(points.size()));
+    SharpCurves::Fit curve_fit;
+    const Vec3 start = rounded(centroid, round);
+    Priced at_start = price(start, &curve_fit);
+    const double weight = double(points.size()) + curve_fit.a;
+    const Vec3 solved =
+        weight > 0 ? rounded(scale(add(sum, curve_fit.b), 1.0 / weight), round) : start;
+    const Priced at_solved = price(solved, nullptr);
+    for (const auto& [place, priced] : {std::pair{start, at_start}, std::pair{solved, at_solved}})
+      if (priced.energy < best.energy) v = place, best = priced;
+  }
+  out.position = v;
+  out.cost = best.energy - before;
+  out.error = std::sqrt(best.max_distance_sq);
   return std::isfinite(out.cost);
 }
 

@@ -174,6 +174,14 @@ class EnergyEvaluator {
   //    scratch_.projected), weighted as the star's planes weigh the geometry.
   double attribute_change(const Placing& placing, const Placement& chosen);
 
+  // The collapse of a component's last faces (ComponentMinimum, when components may vanish):
+  // no face is left around either end. Its points have no surface left but the surviving
+  // vertex: each costs its squared distance to it (the curves' samples theirs to the segments
+  // left), and the vertex goes where their sum is least, unless its place is fixed.
+  static bool leaves_no_face(const CollapseMesh& mesh, VertexId a, VertexId b);
+  bool evaluate_removal(const CollapseMesh& mesh, VertexId a, VertexId b, const Survivor& survivor,
+                        CollapseCandidate& out);
+
   // The measures and solves the steps share.
   void gather_face(FaceId f, int home);
   const PointMoments& moments_of(FaceId f);
@@ -223,6 +231,7 @@ class EnergyEvaluator {
     std::vector<Projected> projected;  // per star point, at the chosen placement
     std::array<std::vector<Projected>, 16> placement_projections;
     std::vector<PreparedTriangle> prepared;  // star with v at the projected position
+    std::vector<Vec3> removal_points;        // evaluate_removal's points
   };
   StarScratch scratch_;
 

@@ -113,7 +113,10 @@ class ConstraintModule {
 // The legality rules every collapse obeys (Hoppe 96 section 3, and METHOD.md section 1), in
 // the order they are checked, cheapest first:
 //   locked vertices: a vertex the repair step duplicated is never removed nor moved;
-//   minimum size: a closed component keeps more than 4 vertices, an open one more than 3;
+//   minimum size: a closed component keeps at least 4 vertices (a tetrahedron), an open one
+//     at least 3 (a triangle); with `components_may_vanish`, an open component may also
+//     collapse its last triangle away (its last vertices stay, faceless), unless it is the one
+//     of the largest area or has a vertex where another component has one;
 //   boundary: an edge between two boundary vertices must itself be a boundary edge;
 //   link condition: vs and vt share no neighbour other than the apexes of the edge's faces;
 //   geometry: no remaining face around vs or vt flips its normal or becomes degenerate.
@@ -124,6 +127,7 @@ class ConstraintModule {
 // parallel build's band passes and final pass would each pay on the whole mesh).
 std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
     const std::vector<uint8_t>& locked,
-    std::shared_ptr<const std::vector<uint32_t>> components = {});
+    std::shared_ptr<const std::vector<uint32_t>> components = {},
+    bool components_may_vanish = false);
 
 }  // namespace parapm

@@ -175,6 +175,48 @@ TEST(PmCursor, ExtractDropsUnusedWedges) {
   EXPECT_EQ(c.extract().wedge_count(), 6u);
 }
 
+// A component whose last triangle was collapsed away: two faceless base vertices, and the
+// split that brings the triangle back as fl (vr absent) or fl and fr; undone, they are faceless
+// again.
+TEST(PmCursor, SplitOfAFacelessVertexBringsAComponentBack) {
+  for (bool with_fr : {false, true}) {
+    ProgressiveMesh pm;
+    pm.base.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
+    pm.base.faces = {{3, 4, 5}};  // vertices 0, 1, 2 have no faces
+    VertexSplit s;
+    s.vs = 0;
+    s.vl = 1;
+    s.vr = with_fr ? 2 : kNoId;
+    s.vs_before = s.vs_after = {0, 0, 0};
+    s.vt_after = {1, 1, 0};
+    pm.splits.push_back(s);
+    validate_pm(pm);
+    PmCursor c(pm);
+    const Snapshot base = snapshot(c);
+    c.apply_next();
+    std::vector<Triangle> fine = {{3, 4, 5}, {0, 6, 1}};
+    if (with_fr) fine.push_back({6, 0, 2});
+    EXPECT_EQ(c.faces(), fine);
+    EXPECT_TRUE(is_oriented_manifold(c.faces()));
+    c.undo_last();
+    EXPECT_EQ(snapshot(c), base);
+  }
+}
+
+TEST(PmCursor, SplitOfAFacelessVertexTowardsOneWithFacesThrows) {
+  ProgressiveMesh pm;
+  pm.base.positions = {{0, 0, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
+  pm.base.faces = {{1, 2, 3}};
+  VertexSplit s;
+  s.vs = 0;
+  s.vl = 1;  // has a face: the new face would hang off another component's vertex
+  pm.splits.push_back(s);
+  PmCursor c(pm);
+  const Snapshot before = snapshot(c);
+  EXPECT_THROW(c.apply_next(), Error);
+  EXPECT_EQ(snapshot(c), before);
+}
+
 // Corrupt splits: the cursor throws and stays where it was; nothing loops.
 TEST(PmCursor, SplitWithVlNotAdjacentThrows) {
   ProgressiveMesh pm = testing::octahedron_pm();

@@ -15,9 +15,10 @@ Mesh make_mesh(std::vector<Vec3> positions, std::vector<Triangle> faces) {
 }
 
 // Which standard constraint (by name) vetoes collapsing vt into vs at vs's position; "" if none.
-std::string veto(const Mesh& mesh, VertexId vs, VertexId vt, std::vector<uint8_t> locked = {}) {
+std::string veto(const Mesh& mesh, VertexId vs, VertexId vt, std::vector<uint8_t> locked = {},
+                 bool components_may_vanish = false) {
   CollapseMesh cm(mesh);
-  auto modules = standard_constraints(locked);
+  auto modules = standard_constraints(locked, {}, components_may_vanish);
   for (auto& m : modules) m->initialize(cm);
   CollapseCandidate c;
   c.vs = vs;
@@ -42,6 +43,35 @@ Mesh octahedron() {
 
 TEST(Legality, TetrahedronCannotCollapse) {
   EXPECT_EQ(veto(tetrahedron(), 0, 1), "component-minimum");
+}
+
+// Two lone triangles, a large and a small one: each keeps its triangle, unless components may
+// vanish; then the small one's may collapse away, never the largest one's (the mesh never
+// vanishes whole), nor one touching another component.
+TEST(Legality, OnlyTheLargestOpenComponentKeepsItsLastTriangleWhenComponentsMayVanish) {
+  const Mesh m = make_mesh({{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {20, 0, 0}, {21, 0, 0}, {20, 1, 0}},
+                           {{0, 1, 2}, {3, 4, 5}});
+  EXPECT_EQ(veto(m, 3, 4), "component-minimum");
+  EXPECT_EQ(veto(m, 0, 1), "component-minimum");
+  EXPECT_EQ(veto(m, 3, 4, {}, true), "");
+  EXPECT_EQ(veto(m, 0, 1, {}, true), "component-minimum");
+  // A closed component keeps its tetrahedron either way.
+  EXPECT_EQ(veto(tetrahedron(), 0, 1, {}, true), "component-minimum");
+  // So does a piece with a vertex where another component has one (an unwelded soup's
+  // triangle: losing it would open a hole in the surface the pieces make together).
+  Mesh touching = m;
+  touching.positions[3] = touching.positions[1];
+  EXPECT_EQ(veto(touching, 3, 4, {}, true), "component-minimum");
+}
+
+// The collapse of a lone triangle's edge leaves its three vertices without faces: not alive.
+TEST(Legality, CollapsingALoneTriangleLeavesNoLiveVertex) {
+  CollapseMesh cm(make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}}));
+  cm.collapse(0, 1, {0.5, 0, 0}, cm.edge_faces(0, 1));
+  EXPECT_EQ(cm.live_faces(), 0u);
+  EXPECT_EQ(cm.live_vertices(), 0u);
+  for (VertexId v : {0u, 1u, 2u}) EXPECT_FALSE(cm.vertex_alive(v)) << v;
+  EXPECT_EQ(cm.position(0), (Vec3{0.5, 0, 0}));
 }
 
 TEST(Legality, OctahedronEdgeCollapses) { EXPECT_EQ(veto(octahedron(), 0, 2), ""); }

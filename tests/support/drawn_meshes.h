@@ -40,6 +40,21 @@ inline Mesh uv_sphere(int rings, int segments, double ripple = 0) {
   return m;
 }
 
+// Numbers uniform in [lo, hi) from a seed (splitmix64): where the drawn scenes put their parts.
+class SeededUniform {
+ public:
+  explicit SeededUniform(uint64_t seed) : state_(seed) {}
+  double operator()(double lo, double hi) {
+    uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return lo + (hi - lo) * double(z ^ (z >> 31)) / 18446744073709551616.0;
+  }
+
+ private:
+  uint64_t state_;
+};
+
 // An open ground square (two triangles, side 100, z = 0, boundary all round) carrying `boxes`
 // closed boxes of 12 triangles, each a separate component 0.2-1 wide and 0.2-2 tall, placed by
 // a seeded generator: a scene of many small parts on one large open one.
@@ -47,12 +62,7 @@ inline Mesh ground_with_boxes(int boxes, uint64_t seed = 1) {
   Mesh m;
   m.positions = {{0, 0, 0}, {100, 0, 0}, {100, 100, 0}, {0, 100, 0}};
   m.faces = {{0, 1, 2}, {0, 2, 3}};
-  auto uniform = [&seed](double lo, double hi) {  // splitmix64
-    uint64_t z = (seed += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return lo + (hi - lo) * double(z ^ (z >> 31)) / 18446744073709551616.0;
-  };
+  SeededUniform uniform(seed);
   for (int k = 0; k < boxes; ++k) {
     const double x = uniform(1, 98), y = uniform(1, 98), side = uniform(0.2, 1);
     const double height = uniform(0.2, 2);
@@ -66,6 +76,34 @@ inline Mesh ground_with_boxes(int boxes, uint64_t seed = 1) {
       m.faces.push_back({o + q[0], o + q[1], o + q[2]});
       m.faces.push_back({o + q[0], o + q[2], o + q[3]});
     }
+  }
+  return m;
+}
+
+// An open ground square (side 100, z = 0, 8 x 8 quads, boundary all round) under `patches`
+// small open parts: each a 2 x 2 grid of quads 0.2-1 wide, 0.1-2 above the ground and a
+// separate component with a boundary all round, placed by a seeded generator (a scene of many
+// small parts, as CAD assemblies and game levels are).
+inline Mesh ground_with_patches(int patches, uint64_t seed = 1) {
+  Mesh m;
+  auto grid = [&m](int n, double x, double y, double side, double z, double tilt) {
+    const auto o = VertexId(m.positions.size());
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i)
+        m.positions.push_back({x + side * i / n, y + side * j / n, z + tilt * side * i / n});
+    auto at = [&](int i, int j) { return o + VertexId(j * (n + 1) + i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        m.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+        m.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+  };
+  grid(8, 0, 0, 100, 0, 0);
+  SeededUniform uniform(seed);
+  for (int k = 0; k < patches; ++k) {
+    const double x = uniform(1, 98), y = uniform(1, 98), side = uniform(0.2, 1);
+    const double z = uniform(0.1, 2), tilt = uniform(-0.5, 0.5);
+    grid(2, x, y, side, z, tilt);
   }
   return m;
 }

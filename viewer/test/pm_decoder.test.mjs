@@ -6,7 +6,7 @@
 import {test} from 'node:test';
 import assert from 'node:assert/strict';
 import {execFileSync} from 'node:child_process';
-import {readFileSync, readdirSync} from 'node:fs';
+import {readFileSync, readdirSync, writeFileSync} from 'node:fs';
 import {join} from 'node:path';
 
 import {PmDecoder, PmFormatError} from '../pm_decoder.js';
@@ -81,33 +81,68 @@ function decodeInPieces(bytes, seed) {
   return decoder;
 }
 
+// The decoded PM at several face counts, refining, coarsening and refining again, against the
+// levels `parapm lod` writes.
+function expectLodLevels(dir, pm, seed) {
+  const bytes = new Uint8Array(readFileSync(pm));
+  const decoder = decodeInPieces(bytes, seed);
+  assert.ok(decoder.done, 'every split decoded');
+  const mesh = new PmMesh(decoder);
+  const h = decoder.header;
+  const counts = [h.baseFaces, Math.round(h.fullFaces * 0.1), Math.round(h.fullFaces * 0.5), h.fullFaces,
+    Math.round(h.fullFaces * 0.3), h.baseFaces, Math.round(h.fullFaces * 0.7)];  // up, down, up again
+  for (const count of counts) {
+    const level = join(dir, `l${count}.ply`);
+    execFileSync(parapm, ['--log-level', 'error', 'lod', pm, '--faces', String(count), '--ascii', '-o', level]);
+    const expected = lodLevel(level);
+    mesh.setLevel(mesh.levelForFaces(count));
+    assert.equal(mesh.faceCount * 3, expected.faces.length, `${count} faces`);
+    assert.deepEqual(cornerPositions(mesh), expected.corners, `${count} faces: the corners`);
+    if (!h.floatsPerWedge) {
+      assert.equal(mesh.vertexCount, expected.vertices, `${count} faces: vertices`);
+      assert.deepEqual(Array.from(mesh.faces.subarray(0, 3 * mesh.faceCount)), expected.faces);
+    } else {
+      expectSameAttributes(mesh, h.layout, expected, `${count} faces`);
+    }
+  }
+  return h;
+}
+
 for (const name of meshes) {
   test(`${name}: the decoded levels are parapm lod's`, () => withTempDir((dir) => {
     // The energy: its attributes' values change at splits (E_scalar), the quadric's do not.
-    const pm = simplified(dir, name, '--metric', 'energy');
-    const bytes = new Uint8Array(readFileSync(pm));
-    const decoder = decodeInPieces(bytes, name.length);
-    assert.ok(decoder.done, 'every split decoded');
-    const mesh = new PmMesh(decoder);
-    const h = decoder.header;
-    const counts = [h.baseFaces, Math.round(h.fullFaces * 0.1), Math.round(h.fullFaces * 0.5), h.fullFaces,
-      Math.round(h.fullFaces * 0.3), h.baseFaces, Math.round(h.fullFaces * 0.7)];  // up, down, up again
-    for (const count of counts) {
-      const level = join(dir, `l${count}.ply`);
-      execFileSync(parapm, ['--log-level', 'error', 'lod', pm, '--faces', String(count), '--ascii', '-o', level]);
-      const expected = lodLevel(level);
-      mesh.setLevel(mesh.levelForFaces(count));
-      assert.equal(mesh.faceCount * 3, expected.faces.length, `${count} faces`);
-      assert.deepEqual(cornerPositions(mesh), expected.corners, `${count} faces: the corners`);
-      if (!h.floatsPerWedge) {
-        assert.equal(mesh.vertexCount, expected.vertices, `${count} faces: vertices`);
-        assert.deepEqual(Array.from(mesh.faces.subarray(0, 3 * mesh.faceCount)), expected.faces);
-      } else {
-        expectSameAttributes(mesh, h.layout, expected, `${count} faces`);
-      }
-    }
+    expectLodLevels(dir, simplified(dir, name, '--metric', 'energy'), name.length);
   }));
 }
+
+// A ground square under 60 small open parts (each a separate component of two triangles), with
+// --components-may-vanish: the parts' last triangles collapse away at coarse levels, and the splits that bring them back
+// start from faceless vertices.
+test('parts that vanish at coarse levels come back as parapm lod has them', () => withTempDir((dir) => {
+  const lines = ['v 0 0 0', 'v 100 0 0', 'v 100 100 0', 'v 0 100 0', 'f 1 2 3', 'f 1 3 4'];
+  let state = 7;
+  const uniform = (lo, hi) => {
+    state = (state * 1103515245 + 12345) % 2147483648;
+    return lo + (hi - lo) * state / 2147483648;
+  };
+  const parts = 60;
+  for (let k = 0; k < parts; k++) {
+    const x = uniform(1, 98), y = uniform(1, 98), z = uniform(0.1, 2), side = uniform(0.2, 1);
+    lines.push(`v ${x} ${y} ${z}`, `v ${x + side} ${y} ${z}`, `v ${x + side} ${y + side} ${z + side / 3}`,
+      `v ${x} ${y + side} ${z}`);
+    const o = 4 + 4 * k;
+    lines.push(`f ${o + 1} ${o + 2} ${o + 3}`, `f ${o + 1} ${o + 3} ${o + 4}`);
+  }
+  const scene = join(dir, 'scene.obj');
+  writeFileSync(scene, lines.join('\n') + '\n');
+  for (const metric of ['quadric', 'energy']) {
+    const pm = join(dir, `${metric}.pm`);
+    execFileSync(parapm, ['--log-level', 'error', 'simplify', scene, '-o', pm, '--metric', metric,
+      '--components-may-vanish']);
+    const h = expectLodLevels(dir, pm, 3);
+    assert.ok(h.baseFaces < parts, `${metric}: ${h.baseFaces} faces at the base, ${parts + 1} components`);
+  }
+}));
 
 test('a damaged file is an error naming its byte, not a wrong mesh', () => {
   withTempDir((dir) => {
