@@ -65,6 +65,11 @@ LoadedMesh load_and_repair(const std::string& path, const RepairOptions& options
         path, r.degenerate_faces_removed, r.duplicate_faces_removed,
         r.unreferenced_vertices_removed, r.nonmanifold_vertices, r.vertex_copies_added,
         r.nonmanifold_edges);
+  if (loaded.read.welded_vertices > 0 && loaded.read.format != MeshFormat::kStl)
+    spdlog::info(
+        "welded {}: {} vertices at exactly the place of an earlier one (their faces "
+        "now share it)",
+        path, loaded.read.welded_vertices);
   for (const std::string& what : loaded.read.ignored) spdlog::info("ignored: {}", what);
   return loaded;
 }

@@ -31,7 +31,7 @@ struct SimplifyArgs {
   uint64_t seed = 1;
   bool keep_order = false;
   bool free_copies = false;
-  bool components_may_vanish = false;
+  bool keep_components = false;
   uint32_t parallel = 1;  // subsets p; 1: the sequential build
   unsigned threads = 0;   // 0: min(p, hardware threads)
   uint32_t rounds = ParallelOptions{}.rounds;
@@ -118,7 +118,7 @@ int run_simplify(const SimplifyArgs& args) {
   options.seed = args.seed;
   options.keep_order = args.keep_order;
   options.free_copies = args.free_copies;
-  options.components_may_vanish = args.components_may_vanish;
+  options.keep_components = args.keep_components;
   options.defer_recosting = !args.no_deferred_recosting;
   SimplifyStats stats;
   ParallelStats parallel_stats;
@@ -288,13 +288,13 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                 "the copies never "
                 "move, and are most of what remains at coarse levels of a mesh with many of "
                 "them");
-  cmd->add_flag("--components-may-vanish", args->components_may_vanish,
-                "Let an open component's last triangle collapse away when its cost comes: small "
-                "separate parts vanish at coarse levels (a vertex split brings each back), so a "
-                "scene of many parts simplifies below one triangle per part. The largest "
-                "component, closed ones (a tetrahedron at least) and those with a vertex where "
-                "another component has one (an unwelded surface's pieces) keep theirs. Default: "
-                "every component keeps a triangle at every level");
+  cmd->add_flag("--keep-components", args->keep_components,
+                "Keep at least one triangle of every connected component at every level. "
+                "Default: an open component's last triangle collapses away when its cost comes, "
+                "so small separate parts vanish at coarse levels (a vertex split brings each "
+                "back) and a scene of many parts simplifies below one triangle per part; the "
+                "largest component, closed ones (a tetrahedron at least) and those with a "
+                "vertex where another component has one keep theirs");
   cmd->add_option("--parallel", args->parallel,
                   "Build with P subsets simplified in parallel (Langis 1999): --rounds rounds, "
                   "each partitioning the current mesh anew and simplifying the subsets in "

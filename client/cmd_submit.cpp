@@ -28,7 +28,7 @@ struct SubmitArgs {
   std::optional<double> star_planes_weight, volume_weight, spring_scale, crease_min_length;
   bool keep_order = false;
   bool free_copies = false;
-  bool components_may_vanish = false;
+  bool keep_components = false;
   bool wait = false;
   bool json = false;
 };
@@ -70,7 +70,7 @@ int run_submit(SubmitArgs& args) {
   if (args.crease_min_edges) e.set_min_crease_edges(*args.crease_min_edges);
   o.set_keep_order(args.keep_order);
   o.set_free_copies(args.free_copies);
-  o.set_components_may_vanish(args.components_may_vanish);
+  o.set_keep_components(args.keep_components);
   parapm::v1::Job job;
   {
     auto context = client.context();
@@ -198,9 +198,9 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--free-copies", args->free_copies,
                 "the repair's copies of a non-manifold input vertex simplify like any vertex "
                 "(coarser levels; the sheets part at coarse levels: cracks)");
-  cmd->add_flag("--components-may-vanish", args->components_may_vanish,
-                "small separate open parts vanish at coarse levels (default: every connected "
-                "component keeps a triangle at every level)");
+  cmd->add_flag("--keep-components", args->keep_components,
+                "every connected component keeps a triangle at every level (default: small "
+                "separate open parts vanish at coarse levels)");
   cmd->add_flag("--wait", args->wait, "follow the job to its end with a progress bar");
   cmd->add_flag("--json", args->json, "print the job as one JSON object");
   add_connection_options(cmd, args->connection);

@@ -70,7 +70,7 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
   if (options.has_seed()) s.seed = options.seed();
   s.keep_order = options.keep_order();
   s.free_copies = options.free_copies();
-  s.components_may_vanish = options.components_may_vanish();
+  s.keep_components = options.keep_components();
   check_simplify_options(s);  // the ranges of the weights and the crease rule
 
   p.subsets = options.has_parallelism() ? options.parallelism() : default_parallelism;

@@ -31,6 +31,13 @@ bool stl_start_fits(std::string_view start);
 // format): so that a gzip bomb of zeros stops after its first bytes (format.cpp).
 void check_mesh_start(const ReadContext& ctx, MeshFormat format, std::string_view start);
 
+// Gives every face corner and wedge of a vertex the first vertex at exactly the same place
+// (bit-identical coordinates, -0 as +0): the pieces of a surface stored unwelded (a triangle
+// soup, parts that meet at duplicated vertices) become one surface, as STL's reader makes its
+// corners. The merged vertices stay, unused; wedges keep their values, so attributes that
+// differed across a seam stay per corner. Returns the number of vertices merged (weld.cpp).
+uint64_t weld_coincident_vertices(Mesh& mesh);
+
 // Throws kInvalidInput unless faces, wedges and attribute arrays are consistent (mesh_io.cpp).
 void check_writable(const Mesh& mesh);
 std::string write_obj(const Mesh& mesh);              // obj_writer.cpp

@@ -46,13 +46,17 @@ Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name, Re
 
   if (format == MeshFormat::kUnknown) format = io::detect_format(ctx.bytes);
   r.format = format;
+  auto welded = [&r](Mesh mesh) {
+    r.welded_vertices = io::weld_coincident_vertices(mesh);
+    return mesh;
+  };
   switch (format) {
     case MeshFormat::kObj:
-      return io::read_obj(ctx);
+      return welded(io::read_obj(ctx));
     case MeshFormat::kPly:
-      return io::read_ply(ctx);
+      return welded(io::read_ply(ctx));
     case MeshFormat::kOff:
-      return io::read_off(ctx);
+      return welded(io::read_off(ctx));
     case MeshFormat::kStl:
       return io::read_stl(ctx);
     case MeshFormat::kUnknown:

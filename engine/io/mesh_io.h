@@ -54,7 +54,9 @@ struct ReadReport {
   uint64_t triangulated_polygons = 0;  // polygons with more than 3 corners, fan-split
   uint64_t strip_triangles = 0;        // triangles that came from PLY triangle strips
   uint64_t strip_degenerates = 0;      // PLY strip triangles with a repeated index, not made faces
-  uint64_t welded_vertices = 0;        // STL: corners merged into shared vertices by exact equality
+  // Exactly coincident vertices merged (their faces then use the first at that place): STL, its
+  // corners merged into shared vertices; other formats, vertices merged (they stay, unused).
+  uint64_t welded_vertices = 0;
   uint64_t corners_without_texcoord = 0;  // OBJ: corners without vt in a file that has vt
   uint64_t corners_without_normal = 0;    // OBJ: corners without vn in a file that has vn
   uint64_t vertices_without_color = 0;    // OBJ: v without colour in a file that has some

@@ -862,9 +862,8 @@ void ParallelBuilder::final_pass() {
   std::unique_ptr<PriorityModule> continued = without_initialize(*master_queue_);
   // Components vanish here only: in the jobs and the band passes a lone triangle waits for
   // this pass, which costs it against the whole mesh's coarse collapses.
-  Simplifier pass(
-      whole, *continued,
-      standard_constraints(locked_, whole_components(), options_.components_may_vanish));
+  Simplifier pass(whole, *continued,
+                  standard_constraints(locked_, whole_components(), !options_.keep_components));
   SimplifierLimits limits;
   limits.target_faces = target_;
   if (options_.defer_recosting) limits.defer_above_faces = defer_line_;

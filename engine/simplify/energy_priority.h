@@ -102,7 +102,7 @@ struct EnergyOptions {
   double spring_scale = 0.03;
   int solves_per_start = 1;     // least-squares solves after the first projection, per start
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
-  // Price the collapse of a component's last faces (SimplifyOptions::components_may_vanish);
+  // Price the collapse of a component's last faces (unless SimplifyOptions::keep_components);
   // false: such a collapse cannot be placed, as the component minimum forbids it anyway.
   bool components_may_vanish = false;
   bool discontinuities = true;  // E_disc: sample and keep the sharp curves (sharp_curves.h)

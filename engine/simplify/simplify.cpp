@@ -87,7 +87,7 @@ std::unique_ptr<PriorityModule> make_priority_module(const SimplifyOptions& opti
     energy_options.spring_scale = options.energy.spring_scale;
     energy_options.attribute_weight = options.attribute_weight;
     energy_options.reference_diagonal = reference_diagonal;
-    energy_options.components_may_vanish = options.components_may_vanish;
+    energy_options.components_may_vanish = !options.keep_components;
     return std::make_unique<EnergyPriority>(locked, energy_options,
                                             WedgeAttributes{mesh.layout, mesh.wedge_values});
   }
@@ -110,7 +110,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   CollapseMesh working(mesh);
   std::unique_ptr<PriorityModule> priority = make_priority_module(options, mesh, locked);
   Simplifier simplifier(working, *priority,
-                        standard_constraints(locked, {}, options.components_may_vanish));
+                        standard_constraints(locked, {}, !options.keep_components));
   SimplifierLimits limits;
   limits.target_faces = target_face_count(mesh.face_count(), options);
   if (options.defer_recosting) limits.defer_above_faces = defer_recosting_line(mesh.face_count());

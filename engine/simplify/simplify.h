@@ -53,12 +53,12 @@ struct SimplifyOptions {
   // sheets part at coarse levels (cracks, often far wider than the level's distance error:
   // pm/copy_separation.h measures them). Full resolution is exact either way.
   bool free_copies = false;
-  // false: every connected component keeps at least a triangle (a closed one a tetrahedron) at
-  // every level. true: an open component's last triangle collapses away when its turn comes
+  // true: every connected component keeps at least a triangle (a closed one a tetrahedron) at
+  // every level. false: an open component's last triangle collapses away when its turn comes
   // by cost, as small parts vanish at coarse levels (a vertex split brings the triangle back
   // from faceless vertices); the largest component, closed ones and those touching another
   // (a vertex at the same place) keep theirs.
-  bool components_may_vanish = false;
+  bool keep_components = false;
   // Re-costing deferred above a tenth of the input's faces (SimplifierLimits::
   // defer_above_faces; the energy only). Off: every edge around a collapse is costed at once
   // (for measuring what deferral saves; the PM differs a little).

@@ -129,10 +129,14 @@ TEST(Writer, SeamsBecomeOnePlyVertexPerWedge) {
   }
   TempDir dir;
   write_mesh(mesh, dir.file("seam.ply"));
-  const Mesh back = read_mesh(dir.file("seam.ply"));
+  ReadReport report;
+  const Mesh back = read_mesh(dir.file("seam.ply"), &report);
   EXPECT_EQ(back.vertex_count(), 6u);  // v0 and v2 twice
-  // Vertex by vertex: v0's two wedges, v1, v2's two wedges, v3.
-  EXPECT_EQ(back.faces, (std::vector<Triangle>{{0, 2, 3}, {1, 4, 5}}));
+  // Vertex by vertex: v0's two wedges, v1, v2's two wedges, v3; the reader welds the second
+  // PLY vertices of v0 and v2 onto the first (left unused), each keeping its wedge.
+  EXPECT_EQ(report.welded_vertices, 2u);
+  EXPECT_EQ(back.faces, (std::vector<Triangle>{{0, 2, 3}, {0, 3, 5}}));
+  EXPECT_EQ(back.wedge_vertex, (std::vector<VertexId>{0, 0, 2, 3, 3, 5}));
   expect_same_corners(mesh, back, false);  // colours came from floats: quantised to uchar
   const float* w5 = back.wedge(5);
   EXPECT_EQ(w5[back.layout.color_offset() + 3], float(51 / 255.0));  // 0.2 * 255 = 51

@@ -3,7 +3,9 @@
 // minus exactly the removed faces, that a second repair changes nothing, and print one line
 // per file with the report counts and the time.
 //
-// Comparison with INVENTORY.tsv, whose counts were made by another tool on the faces as read:
+// Comparison with INVENTORY.tsv, whose counts were made by another tool on the faces as read
+// (STL welded, the other formats not: where ParaPM's reader welds coincident vertices of
+// another format, the topology differs and is not compared):
 //  - its "duplicate faces" are faces with the same three vertices in either orientation; the
 //    repair removes only same-orientation duplicates (repair.h rule 2) and keeps the
 //    opposite-orientation ones, so it counts fewer on double-sided meshes
@@ -97,8 +99,13 @@ std::map<std::string, InventoryRow> read_inventory(const std::filesystem::path& 
   return rows;
 }
 
-void compare_with_inventory(const InventoryRow& row, const Mesh& input, const RepairReport& report,
-                            const TopologyStats& before) {
+void compare_with_inventory(const InventoryRow& row, const Mesh& input, const ReadReport& read,
+                            const RepairReport& report, const TopologyStats& before) {
+  if (read.welded_vertices > 0 && read.format != MeshFormat::kStl) {
+    std::printf("  note: the reader welded %lu coincident vertices: not compared\n",
+                (unsigned long)read.welded_vertices);
+    return;
+  }
   if (input.face_count() != row.faces) {
     std::printf("  note: the reader gives %zu faces, the inventory %lu: not compared\n",
                 input.face_count(), (unsigned long)row.faces);
@@ -135,8 +142,9 @@ TEST(RepairSharedMeshes, EveryMeshBecomesAManifoldThatMergesBack) {
     const std::string name = path.filename().string();
     SCOPED_TRACE(name);
     Mesh input;
+    ReadReport read_report;
     try {
-      input = read_mesh(path.string());
+      input = read_mesh(path.string(), &read_report);
     } catch (const std::exception& error) {
       ADD_FAILURE() << "cannot read: " << error.what();
       continue;
@@ -182,7 +190,8 @@ TEST(RepairSharedMeshes, EveryMeshBecomesAManifoldThatMergesBack) {
         (unsigned long)report.nonmanifold_edges, inventory_nonmanifold.c_str(),
         (unsigned long)report.nonmanifold_vertices, (unsigned long)report.vertex_copies_added,
         (unsigned long)report.zero_area_faces, repair_ms);
-    if (row != inventory.end()) compare_with_inventory(row->second, input, report, before);
+    if (row != inventory.end())
+      compare_with_inventory(row->second, input, read_report, report, before);
   }
 }
 

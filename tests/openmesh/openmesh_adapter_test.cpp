@@ -171,7 +171,10 @@ TEST(OpenMeshAdapter, OpenMeshsReaderGivesWhatParapmsGives) {
     const std::string ext = path.extension().string();
     if (ext != ".off" && ext != ".ply" && ext != ".stl") continue;  // (OpenMesh reads no .gz)
     SCOPED_TRACE(path.filename().string());
-    const Mesh ours = read_mesh(path.string());
+    ReadReport report;
+    const Mesh ours = read_mesh(path.string(), &report);
+    // ParaPM's readers weld coincident vertices of every format, OpenMesh's only STL's.
+    if (report.welded_vertices > 0 && report.format != MeshFormat::kStl) continue;
     Mesh theirs;
     try {
       theirs = openmesh::read_openmesh(path.string());

@@ -1,8 +1,9 @@
-// Components that vanish (SimplifyOptions::components_may_vanish): a scene of many
+// Components that vanish (unless SimplifyOptions::keep_components): a scene of many
 // small open parts over a large open ground simplifies below one triangle per part, as the
 // parts' last triangles collapse away, and every path that makes the PM (the sequential build,
 // the parallel build's final pass) still gives back the input exactly; its levels apply and
-// undo, refine selectively, and survive the .pm file. By default every part keeps a triangle.
+// undo, refine selectively, and survive the .pm file. With keep_components every part keeps a
+// triangle.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -50,7 +51,6 @@ TEST(VanishingComponents, SmallOpenPartsVanishAndComeBackExactly) {
       SimplifyOptions options;
       options.metric = metric;
       options.target_faces = 40;
-      options.components_may_vanish = true;
       const ProgressiveMesh pm = build(repaired, options, p);
       const Mesh base = level_of_detail(pm, 0);
       std::printf("%s: base %zu faces in %u components (input %zu in %d)\n", what.c_str(),
@@ -89,12 +89,13 @@ TEST(VanishingComponents, SmallOpenPartsVanishAndComeBackExactly) {
   }
 }
 
-TEST(VanishingComponents, KeptByDefault) {
+TEST(VanishingComponents, KeptWhenAsked) {
   const RepairedMesh repaired = repair_mesh(ground_with_patches(kPatches));
   for (const char* metric : {"quadric", "energy"}) {
     SimplifyOptions options;
     options.metric = metric;
     options.target_faces = 40;
+    options.keep_components = true;
     for (uint32_t p : {1u, 4u}) {
       const ProgressiveMesh pm = build(repaired, options, p);
       EXPECT_EQ(components_with_faces(level_of_detail(pm, 0)), uint32_t(kPatches + 1))

@@ -208,7 +208,7 @@ std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
   if (e.has_min_crease_edges()) count("--crease-min-edges", e.min_crease_edges());
   if (o.keep_order()) args.push_back("--keep-order");
   if (o.free_copies()) args.push_back("--free-copies");
-  if (o.components_may_vanish()) args.push_back("--components-may-vanish");
+  if (o.keep_components()) args.push_back("--keep-components");
   return args;
 }
 

@@ -126,10 +126,10 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   parapm::v1::JobOptions free_copies = options(2, parapm::v1::METRIC_QUADRIC, 0);
   free_copies.set_free_copies(true);
   build_and_compare("cad-cycloidal-43k.ply", free_copies, names);
-  // Components that may vanish (`--components-may-vanish`), on the guitar's many parts.
-  parapm::v1::JobOptions vanishing = options(2, parapm::v1::METRIC_ENERGY, 0);
-  vanishing.set_components_may_vanish(true);
-  build_and_compare("stratocaster-9k.ply", vanishing, names);
+  // Every component kept (`--keep-components`), on the guitar's many parts.
+  parapm::v1::JobOptions kept = options(2, parapm::v1::METRIC_ENERGY, 0);
+  kept.set_keep_components(true);
+  build_and_compare("stratocaster-9k.ply", kept, names);
   // At p = 12 the 20k-face vessel's rounds take at most one subset per 8000 faces (the
   // quadric's default, as `parapm simplify` builds it: 2 in round 0), or 12 in every round
   // with `--min-subset-faces 0`.

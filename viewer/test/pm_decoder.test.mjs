@@ -115,8 +115,8 @@ for (const name of meshes) {
   }));
 }
 
-// A ground square under 60 small open parts (each a separate component of two triangles), with
-// --components-may-vanish: the parts' last triangles collapse away at coarse levels, and the splits that bring them back
+// A ground square under 60 small open parts (each a separate component of two triangles): the
+// parts' last triangles collapse away at coarse levels, and the splits that bring them back
 // start from faceless vertices.
 test('parts that vanish at coarse levels come back as parapm lod has them', () => withTempDir((dir) => {
   const lines = ['v 0 0 0', 'v 100 0 0', 'v 100 100 0', 'v 0 100 0', 'f 1 2 3', 'f 1 3 4'];
@@ -137,8 +137,7 @@ test('parts that vanish at coarse levels come back as parapm lod has them', () =
   writeFileSync(scene, lines.join('\n') + '\n');
   for (const metric of ['quadric', 'energy']) {
     const pm = join(dir, `${metric}.pm`);
-    execFileSync(parapm, ['--log-level', 'error', 'simplify', scene, '-o', pm, '--metric', metric,
-      '--components-may-vanish']);
+    execFileSync(parapm, ['--log-level', 'error', 'simplify', scene, '-o', pm, '--metric', metric]);
     const h = expectLodLevels(dir, pm, 3);
     assert.ok(h.baseFaces < parts, `${metric}: ${h.baseFaces} faces at the base, ${parts + 1} components`);
   }
