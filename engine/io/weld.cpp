@@ -1,5 +1,6 @@
 // Welding exactly coincident vertices of a read mesh (formats.h, weld_coincident_vertices).
 #include <bit>
+#include <random>
 #include <vector>
 
 #include "io/formats.h"
@@ -10,8 +11,12 @@ namespace {
 // The bit pattern, with -0 folded onto +0 (equal coordinates, different bits).
 uint64_t key(double c) { return c == 0 ? 0 : std::bit_cast<uint64_t>(c); }
 
+// Drawn once per process: which slot a place lands in (never the result) changes from run to
+// run, so that no file can be made whose places all collide (a quadratic read).
+const uint64_t kSalt = (uint64_t(std::random_device{}()) << 32 | std::random_device{}()) | 1;
+
 uint64_t hash_of(const Vec3& p) {
-  uint64_t h = key(p[0]) * 0x9E3779B97F4A7C15ull ^
+  uint64_t h = (key(p[0]) ^ kSalt) * 0x9E3779B97F4A7C15ull ^
                std::rotl(key(p[1]) * 0xC2B2AE3D27D4EB4Full, 21) ^
                std::rotl(key(p[2]) * 0x165667B19E3779F9ull, 42);
   return h ^ (h >> 31);
