@@ -6,8 +6,10 @@
 // triangle.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
+#include <string>
 
 #include "drawn_meshes.h"
 #include "mesh/repaired_input.h"
