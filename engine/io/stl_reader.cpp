@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "io/formats.h"
+#include "io/position_hash.h"
 #include "io/text_scanner.h"
 
 namespace parapm::io {
@@ -46,27 +47,19 @@ class Welder {
 
   VertexId vertex(const Vec3& p) {
     ++corners_;
-    const uint64_t x = key(p[0]), y = key(p[1]), z = key(p[2]);
-    uint64_t h = x * 0x9E3779B97F4A7C15ull ^ std::rotl(y * 0xC2B2AE3D27D4EB4Full, 21) ^
-                 std::rotl(z * 0x165667B19E3779F9ull, 42);
-    h ^= h >> 31;
-    for (size_t slot = size_t(h) & mask_;; slot = (slot + 1) & mask_) {
+    for (size_t slot = size_t(place_hash(p)) & mask_;; slot = (slot + 1) & mask_) {
       const VertexId v = slots_[slot];
       if (v == kNoId) {
         if (count_ == slots_.size() / 2) grow();  // ascii files do not announce their size
         return insert(p);
       }
-      const Vec3& q = mesh_.positions[v];
-      if (key(q[0]) == x && key(q[1]) == y && key(q[2]) == z) return v;
+      if (same_place(mesh_.positions[v], p)) return v;
     }
   }
 
   uint64_t corners() const { return corners_; }
 
  private:
-  // The bit pattern, with -0 folded onto +0 (equal coordinates, different bits).
-  static uint64_t key(double c) { return c == 0 ? 0 : std::bit_cast<uint64_t>(c); }
-
   VertexId insert(const Vec3& p) {
     const VertexId v = VertexId(mesh_.positions.size());
     mesh_.positions.push_back(p);
@@ -76,12 +69,7 @@ class Welder {
   }
 
   void place(VertexId v) {
-    const Vec3& p = mesh_.positions[v];
-    const uint64_t x = key(p[0]), y = key(p[1]), z = key(p[2]);
-    uint64_t h = x * 0x9E3779B97F4A7C15ull ^ std::rotl(y * 0xC2B2AE3D27D4EB4Full, 21) ^
-                 std::rotl(z * 0x165667B19E3779F9ull, 42);
-    h ^= h >> 31;
-    size_t slot = size_t(h) & mask_;
+    size_t slot = size_t(place_hash(mesh_.positions[v])) & mask_;
     while (slots_[slot] != kNoId) slot = (slot + 1) & mask_;
     slots_[slot] = v;
   }
