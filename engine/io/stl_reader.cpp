@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "io/formats.h"
-#include "io/position_hash.h"
+#include "io/place_table.h"
 #include "io/text_scanner.h"
 
 namespace parapm::io {
@@ -34,56 +34,26 @@ uint32_t binary_count(std::string_view bytes) {
   return count;
 }
 
-// Merges corners with bit-identical coordinates. Open addressing on vertex ids, sized for the
-// corner count so that it never rehashes.
+// Merges corners with bit-identical coordinates into one vertex (place_table.h), first
+// occurrence first.
 class Welder {
  public:
-  Welder(Mesh& mesh, uint64_t max_corners) : mesh_(mesh) {
-    size_t capacity = 16;
-    while (capacity < max_corners * 2) capacity *= 2;
-    slots_.assign(capacity, kNoId);
-    mask_ = capacity - 1;
-  }
+  Welder(Mesh& mesh, uint64_t max_corners) : mesh_(mesh), places_(mesh.positions, max_corners) {}
 
   VertexId vertex(const Vec3& p) {
     ++corners_;
-    for (size_t slot = size_t(place_hash(p)) & mask_;; slot = (slot + 1) & mask_) {
-      const VertexId v = slots_[slot];
-      if (v == kNoId) {
-        if (count_ == slots_.size() / 2) grow();  // ascii files do not announce their size
-        return insert(p);
-      }
-      if (same_place(mesh_.positions[v], p)) return v;
-    }
+    const auto v = VertexId(mesh_.positions.size());
+    mesh_.positions.push_back(p);
+    const VertexId first = places_.first_at(v);
+    if (first != v) mesh_.positions.pop_back();
+    return first;
   }
 
   uint64_t corners() const { return corners_; }
 
  private:
-  VertexId insert(const Vec3& p) {
-    const VertexId v = VertexId(mesh_.positions.size());
-    mesh_.positions.push_back(p);
-    place(v);
-    ++count_;
-    return v;
-  }
-
-  void place(VertexId v) {
-    size_t slot = size_t(place_hash(mesh_.positions[v])) & mask_;
-    while (slots_[slot] != kNoId) slot = (slot + 1) & mask_;
-    slots_[slot] = v;
-  }
-
-  void grow() {
-    slots_.assign(slots_.size() * 2, kNoId);
-    mask_ = slots_.size() - 1;
-    for (VertexId v = 0; v < mesh_.positions.size(); ++v) place(v);
-  }
-
   Mesh& mesh_;
-  std::vector<VertexId> slots_;
-  size_t mask_ = 0;
-  uint64_t count_ = 0;
+  PlaceTable places_;
   uint64_t corners_ = 0;
 };
 

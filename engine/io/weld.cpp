@@ -1,14 +1,16 @@
 // Welding exactly coincident vertices of a read mesh (formats.h, weld_coincident_vertices),
-// and the position hash both welders use (position_hash.h).
+// and the table of places both welders use (place_table.h).
 #include <bit>
 #include <random>
 #include <vector>
 
 #include "io/formats.h"
-#include "io/position_hash.h"
+#include "io/place_table.h"
 
 namespace parapm::io {
+namespace {
 
+// The bit pattern of a coordinate, with -0 folded onto +0 (equal coordinates, different bits).
 uint64_t coordinate_key(double c) { return c == 0 ? 0 : std::bit_cast<uint64_t>(c); }
 
 bool same_place(const Vec3& a, const Vec3& b) {
@@ -17,38 +19,61 @@ bool same_place(const Vec3& a, const Vec3& b) {
          coordinate_key(a[2]) == coordinate_key(b[2]);
 }
 
+const uint64_t kSalt = (uint64_t(std::random_device{}()) << 32 | std::random_device{}()) | 1;
+
 uint64_t place_hash(const Vec3& p) {
-  static const uint64_t salt =
-      (uint64_t(std::random_device{}()) << 32 | std::random_device{}()) | 1;
-  uint64_t h = (coordinate_key(p[0]) ^ salt) * 0x9E3779B97F4A7C15ull ^
+  uint64_t h = (coordinate_key(p[0]) ^ kSalt) * 0x9E3779B97F4A7C15ull ^
                std::rotl(coordinate_key(p[1]) * 0xC2B2AE3D27D4EB4Full, 21) ^
                std::rotl(coordinate_key(p[2]) * 0x165667B19E3779F9ull, 42);
   return h ^ (h >> 31);
 }
 
+}  // namespace
+
+PlaceTable::PlaceTable(const std::vector<Vec3>& positions, uint64_t expected)
+    : positions_(positions) {
+  size_t capacity = 16;
+  while (capacity < expected * 2) capacity *= 2;
+  slots_.assign(capacity, kNoId);
+  mask_ = capacity - 1;
+}
+
+VertexId PlaceTable::first_at(VertexId v) {
+  const Vec3& p = positions_[v];
+  for (size_t slot = size_t(place_hash(p)) & mask_;; slot = (slot + 1) & mask_) {
+    const VertexId listed = slots_[slot];
+    if (listed == kNoId) break;
+    if (same_place(positions_[listed], p)) return listed;
+  }
+  if (listed_ == slots_.size() / 2) grow();
+  list(v);
+  return v;
+}
+
+void PlaceTable::list(VertexId v) {
+  size_t slot = size_t(place_hash(positions_[v])) & mask_;
+  while (slots_[slot] != kNoId) slot = (slot + 1) & mask_;
+  slots_[slot] = v;
+  ++listed_;
+}
+
+void PlaceTable::grow() {
+  std::vector<VertexId> old(slots_.size() * 2, kNoId);
+  old.swap(slots_);
+  mask_ = slots_.size() - 1;
+  listed_ = 0;
+  for (VertexId v : old)
+    if (v != kNoId) list(v);
+}
+
 uint64_t weld_coincident_vertices(Mesh& mesh) {
   const size_t n = mesh.positions.size();
-  // Per vertex, the first vertex at its place: open addressing on vertex ids, sized for all.
-  size_t capacity = 16;
-  while (capacity < n * 2) capacity *= 2;
-  std::vector<VertexId> slots(capacity, kNoId);
+  PlaceTable places(mesh.positions, n);
   std::vector<VertexId> first(n);
   uint64_t welded = 0;
   for (VertexId v = 0; v < n; ++v) {
-    const Vec3& p = mesh.positions[v];
-    for (size_t slot = size_t(place_hash(p)) & (capacity - 1);;
-         slot = (slot + 1) & (capacity - 1)) {
-      if (slots[slot] == kNoId) {
-        slots[slot] = v;
-        first[v] = v;
-        break;
-      }
-      if (same_place(mesh.positions[slots[slot]], p)) {
-        first[v] = slots[slot];
-        ++welded;
-        break;
-      }
-    }
+    first[v] = places.first_at(v);
+    if (first[v] != v) ++welded;
   }
   if (welded == 0) return 0;
   for (Triangle& t : mesh.faces)

@@ -52,10 +52,9 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   if (!survivor.possible) return false;
   out.vs = survivor.keep_b ? b : a;
   out.vt = survivor.keep_b ? a : b;
-  if (leaves_no_face(mesh, a, b))
-    return module_.options_.components_may_vanish && evaluate_removal(mesh, a, b, survivor, out);
   StarSums sums = gather_star(mesh, a, b);
-  if (scratch_.star.empty()) return false;
+  if (scratch_.star.empty())  // no face left around either end: a component's last faces
+    return module_.options_.components_may_vanish && evaluate_removal(mesh, a, b, survivor, out);
   const StarPoints points = gather_star_points(link_fan(sums, a, b));
   const Before before = energy_before(mesh, a, b, points.by_moments);
   Placing placing;
@@ -76,13 +75,6 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   // Penalised, not forbidden (Hoppe 96), at a price per point of the star.
   if (survivor.topology) out.cost += module_.topology_price_ * std::max(1.0, points.points_around);
   return std::isfinite(out.cost);
-}
-
-bool EnergyEvaluator::leaves_no_face(const CollapseMesh& mesh, VertexId a, VertexId b) {
-  for (const auto& [end, other] : {std::pair{a, b}, std::pair{b, a}})
-    for (FaceId f : mesh.faces_of(end))
-      if (corner_of(mesh.face(f), other) < 0) return false;
-  return true;
 }
 
 bool EnergyEvaluator::evaluate_removal(const CollapseMesh& mesh, VertexId a, VertexId b,

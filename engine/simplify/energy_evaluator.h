@@ -175,10 +175,9 @@ class EnergyEvaluator {
   double attribute_change(const Placing& placing, const Placement& chosen);
 
   // The collapse of a component's last faces (ComponentMinimum, when components may vanish):
-  // no face is left around either end. Its points have no surface left but the surviving
-  // vertex: each costs its squared distance to it (the curves' samples theirs to the segments
-  // left), and the vertex goes where their sum is least, unless its place is fixed.
-  static bool leaves_no_face(const CollapseMesh& mesh, VertexId a, VertexId b);
+  // no face is left around either end (the star is empty). Its points have no surface left but
+  // the surviving vertex: each costs its squared distance to it (the curves' samples theirs to
+  // the segments left), and the vertex goes where their sum is least, unless its place is fixed.
   bool evaluate_removal(const CollapseMesh& mesh, VertexId a, VertexId b, const Survivor& survivor,
                         CollapseCandidate& out);
 
