@@ -15,7 +15,8 @@ set(PARAPM_ENGINE_LIBRARIES parapm_mesh parapm_io parapm_pm parapm_simplify para
 set(PARAPM_ENGINE_HEADERS io/gltf_writer.h io/mesh_io.h mesh/mesh.h mesh/repair.h
   parallel/edge_keys.h parallel/parallel_build.h parallel/simplify_subset.h parallel/subset_job.h
   pm/levels.h pm/pm_file.h pm/progressive_mesh.h simplify/collapse_mesh.h simplify/module_state.h
-  simplify/modules.h simplify/quad_heap.h simplify/quadric.h simplify/simplifier.h
+  simplify/copy_groups.h simplify/modules.h simplify/quad_heap.h simplify/quadric.h
+  simplify/simplifier.h
   simplify/simplify.h util/error.h util/progress.h)
 
 install(TARGETS ${PARAPM_ENGINE_LIBRARIES} parapm_openmesh EXPORT ParaPMTargets

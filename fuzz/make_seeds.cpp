@@ -93,6 +93,9 @@ int main(int argc, char** argv) {
     SubsetJob& job = jobs[0];
     job.state = export_job_state(*master, job);
     job.options.target_faces = job.mesh.face_count() / 2;
+    // A group of copies named (the grid has none), so that the seed holds the field.
+    job.copy_group.assign(job.mesh.vertex_count(), kNoId);
+    job.copy_group[0] = job.copy_group[1] = 0;
     const SubsetResult result = simplify_subset(job);
     write(dir / "job_codec" / (std::string("job-") + metric),
           std::string(1, '\0') + encode_subset_job(job));

@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 6;
+constexpr uint8_t kVersion = 7;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -40,8 +40,8 @@ constexpr size_t kMaxStopReason = 4096;
 // Mesh flags (job header).
 constexpr uint8_t kPositionsAreFloat = 1, kNormals = 2, kTexcoords = 4, kColors = 8,
                   kCornerWedges = 16, kPositionsAsF32 = 32;
-// Per-vertex flags.
-constexpr uint8_t kOwned = 1, kLocked = 2;
+// Per-vertex flags. kGrouped: SubsetJob::copy_group follows, as a varint.
+constexpr uint8_t kOwned = 1, kLocked = 2, kGrouped = 4;
 // Record flags.
 constexpr uint8_t kRecordPositionsAsF32 = 1;
 // Energy state flags.
@@ -625,6 +625,7 @@ void write_job(ByteWriter& out, const SubsetJob& job) {
   const size_t floats = size_t(m.layout.floats_per_wedge());
   if (job.global_vertex.size() != m.vertex_count() || job.owned.size() != m.vertex_count() ||
       job.locked.size() != m.vertex_count() || job.global_face.size() != m.face_count() ||
+      (!job.copy_group.empty() && job.copy_group.size() != m.vertex_count()) ||
       job.global_wedge.size() != m.wedge_count() ||
       m.wedge_values.size() != m.wedge_count() * floats ||
       (!m.face_wedges.empty() && m.face_wedges.size() != m.face_count()))
@@ -647,7 +648,10 @@ void write_job(ByteWriter& out, const SubsetJob& job) {
   for (size_t v = 0; v < m.vertex_count(); ++v) {
     if (job.owned[v] > 1 || job.locked[v] > 1) cannot_encode("owned or locked flags not 0/1");
     write_position(out, m.positions[v], as_f32);
-    out.u8(uint8_t((job.owned[v] ? kOwned : 0) | (job.locked[v] ? kLocked : 0)));
+    const uint32_t group = job.copy_group.empty() ? kNoId : job.copy_group[v];
+    out.u8(uint8_t((job.owned[v] ? kOwned : 0) | (job.locked[v] ? kLocked : 0) |
+                   (group != kNoId ? kGrouped : 0)));
+    if (group != kNoId) out.varint(group);
   }
   write_increasing(out, job.global_vertex, "global vertex");
   uint32_t previous = 0;
@@ -701,9 +705,14 @@ void read_job(ByteReader& in, SubsetJob& job) {
     in.set_context("vertex", v);
     m.positions[v] = read_position(in, as_f32);
     const uint8_t f = in.u8();
-    if (f & ~(kOwned | kLocked)) in.fail("unknown vertex flags");
+    if (f & ~(kOwned | kLocked | kGrouped)) in.fail("unknown vertex flags");
     job.owned[v] = f & kOwned ? 1 : 0;
     job.locked[v] = f & kLocked ? 1 : 0;
+    if (f & kGrouped) {
+      if (job.copy_group.empty()) job.copy_group.assign(vertices, kNoId);
+      job.copy_group[v] = in.varint32();
+      if (job.copy_group[v] >= vertices) in.fail("copy group out of range");
+    }
   }
   in.set_context("global vertex ids");
   read_increasing(in, vertices, kNoId, job.global_vertex);

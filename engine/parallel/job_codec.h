@@ -9,7 +9,7 @@
 // one before it in its list, the first from 0). Every message starts with a 4-byte magic naming its
 // kind and a version byte, so that one kind is never decoded as another.
 //
-//   (The version byte is 6 for every kind; DECISIONS.md, "The job codec's versions", says
+//   (The version byte is 7 for every kind; DECISIONS.md, "The job codec's versions", says
 //   what each one added.)
 //   job     "PPJB" 4 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
@@ -19,7 +19,8 @@
 //           defer_recosting u8 (0/1) | mesh flags u8 (1
 //           positions_are_float, 2 normals, 4 texcoords, 8 colours, 16 corner wedges, 32
 //           positions stored as f32: set when every coordinate is exactly a float) | per
-//           vertex: position (3 f32 or 3 f64), owned | locked << 1 u8 | global_vertex ids+ |
+//           vertex: position (3 f32 or 3 f64), owned | locked << 1 | grouped << 2 u8, then
+//           (grouped) copy_group v | global_vertex ids+ |
 //           per face: 3 corners near | global_face ids+ | per wedge: wedge_vertex near,
 //           then all values f32, then (flag 16) per face 3 wedges near | global_wedge ids+ |
 //           owned_faces v | state | keys | deferred.

@@ -34,19 +34,30 @@ namespace parapm {
 namespace {
 
 // The live part of a mesh as a plain mesh (what the partitioner takes), and per vertex of the
-// mesh its id there (kNoId for dead vertices).
+// mesh its id there (kNoId for dead vertices). The live copies of a group (copy_groups.h) are
+// one vertex there: its sheets join, and the partition gives all the copies to one subset,
+// whose jobs may then make their seam collapses.
 struct LiveCopy {
   Mesh mesh;
   std::vector<VertexId> compact;
 };
-LiveCopy live_copy(const CollapseMesh& mesh) {
+LiveCopy live_copy(const CollapseMesh& mesh, const CopyGroups& groups) {
   LiveCopy out;
   out.compact.assign(mesh.vertex_capacity(), kNoId);
-  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
-    if (mesh.vertex_alive(v)) {
-      out.compact[v] = VertexId(out.mesh.positions.size());
-      out.mesh.positions.push_back(mesh.position(v));
+  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
+    if (!mesh.vertex_alive(v)) continue;
+    if (groups.is_copy(v)) {
+      const auto copies = groups.of(groups.group[v]);
+      const auto first = std::find_if(copies.begin(), copies.end(),
+                                      [&](VertexId c) { return mesh.vertex_alive(c); });
+      if (*first != v) {  // (copies are in increasing order: the first is numbered already)
+        out.compact[v] = out.compact[*first];
+        continue;
+      }
     }
+    out.compact[v] = VertexId(out.mesh.positions.size());
+    out.mesh.positions.push_back(mesh.position(v));
+  }
   out.mesh.faces.reserve(mesh.live_faces());
   for (FaceId f = 0; f < mesh.face_capacity(); ++f)
     if (mesh.face_alive(f)) {
@@ -67,9 +78,9 @@ std::vector<uint32_t> partition_copy(const LiveCopy& live, uint32_t p,
   return vertex_subset;
 }
 
-std::vector<uint32_t> partition_live(const CollapseMesh& mesh, uint32_t p,
+std::vector<uint32_t> partition_live(const CollapseMesh& mesh, const CopyGroups& groups, uint32_t p,
                                      const PartitionOptions& options) {
-  return partition_copy(live_copy(mesh), p, options);
+  return partition_copy(live_copy(mesh, groups), p, options);
 }
 
 // Runs `work` on this thread and each of `sides` beside it, each on a thread of its own when
@@ -191,6 +202,11 @@ class BandPriority : public PriorityWrapper {
     if (!lagging_[a] && !lagging_[b]) return false;
     return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= ceiling_;
   }
+  bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                     CollapseCandidate& out, Costing costing) override {
+    if (!lagging_[vs] && !lagging_[vt]) return false;
+    return inner_.evaluate_seam(mesh, vs, vt, at, out, costing) && out.cost <= ceiling_;
+  }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                  const EdgeFaces& edge) override {
     lagging_[done.vs] = lagging_[done.vt] = 0;
@@ -306,6 +322,7 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
   handover_ = std::max<uint64_t>(
       target_, uint64_t(std::llround(requested.handover_ratio * double(input_faces_))));
   locked_ = locked_vertices(repaired, options.free_copies);
+  if (!options.free_copies) copy_groups_ = copy_groups(repaired);
   defer_line_ = defer_recosting_line(input_faces_);
   // After two scheduled rounds (a ratio of 0.32 at the default handover), an extra round at
   // the scheduled ratio would need 3.2 x the floor per subset to start, and mid-sized meshes
@@ -333,7 +350,7 @@ void ParallelBuilder::set_up() {
     const auto tp = std::chrono::steady_clock::now();
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, 0);
-    first_partition_ = partition_live(whole, first_subsets, partition_options);
+    first_partition_ = partition_live(whole, copy_groups_, first_subsets, partition_options);
     first_partition_seconds_ = seconds_since(tp);
   };
   std::vector<std::function<void()>> setup_tasks;
@@ -519,10 +536,12 @@ void ParallelBuilder::partition(Round& r) {
     forgo_foreseen();
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, round);
-    const Beside timed =
-        run_beside(parallel_.threads,
-                   [&] { r.vertex_subset = partition_live(*whole_, r.subsets, partition_options); },
-                   {[this] { append_pending(); }});
+    const Beside timed = run_beside(parallel_.threads,
+                                    [&] {
+                                      r.vertex_subset = partition_live(
+                                          *whole_, copy_groups_, r.subsets, partition_options);
+                                    },
+                                    {[this] { append_pending(); }});
     rs.partition_seconds = timed.work_seconds + early_check_seconds;
     rs.append_seconds = timed.side_seconds[0];
     rs.partition_overlap_seconds = std::min(timed.work_seconds, timed.side_seconds[0]);
@@ -579,9 +598,9 @@ void ParallelBuilder::extract_jobs(Round& r) {
     const double cpu = thread_cpu_seconds();
     // The jobs' meshes carry the input's wedge values; the metric's current ones
     // (E_scalar) travel in the state.
-    jobs[i] =
-        extract_subset(whole, mesh_.layout, mesh_.wedge_values, mesh_.positions_are_float, locked_,
-                       r.vertex_subset, owned[i], uint32_t(i), rs.round, subset_options_);
+    jobs[i] = extract_subset(whole, mesh_.layout, mesh_.wedge_values, mesh_.positions_are_float,
+                             locked_, r.vertex_subset, owned[i], uint32_t(i), rs.round,
+                             subset_options_, &copy_groups_);
     if (job_state_needed(*master_, rs.round)) jobs[i].state = export_job_state(*master_, jobs[i]);
     for (FaceId f = 0; f < jobs[i].mesh.face_count(); ++f) {
       const Triangle& c = jobs[i].mesh.faces[f];
@@ -654,7 +673,7 @@ void ParallelBuilder::run_subsets(Round& r) {
   auto draw_round_one = [&] {
     PartitionOptions next_options;
     next_options.seed = round_seed(options_.seed, 1);
-    foreseen_.vertex_subset = partition_live(*whole_, r.subsets, next_options);
+    foreseen_.vertex_subset = partition_live(*whole_, copy_groups_, r.subsets, next_options);
   };
   const bool draw_early = rs.round == 0 && parallel_.early_partition;
   std::vector<std::function<void()>> beside_jobs;
@@ -782,6 +801,7 @@ void ParallelBuilder::band_pass(Round& r) {
     }
     BandPriority band(*master_queue_, std::move(bound_before_), r.ceiling);
     Simplifier pass(whole, band, standard_constraints(locked_, whole_components()));
+    if (!copy_groups_.empty()) pass.join_copies(&copy_groups_);
     SimplifierLimits band_limits;
     band_limits.target_faces = std::max<uint64_t>(1, target_);
     band_limits.first_queue_around = &lagging;  // the band refuses every other edge
@@ -795,7 +815,7 @@ void ParallelBuilder::band_pass(Round& r) {
     LiveCopy copy;
     if (next.go) {
       const auto tc = std::chrono::steady_clock::now();
-      copy = live_copy(whole);
+      copy = live_copy(whole, copy_groups_);
       foreseen_.copy_seconds = seconds_since(tc);
       foreseen_.subsets = next.subsets;
     }
@@ -864,6 +884,7 @@ void ParallelBuilder::final_pass() {
   // this pass, which costs it against the whole mesh's coarse collapses.
   Simplifier pass(whole, *continued,
                   standard_constraints(locked_, whole_components(), !options_.keep_components));
+  if (!copy_groups_.empty()) pass.join_copies(&copy_groups_);
   SimplifierLimits limits;
   limits.target_faces = target_;
   if (options_.defer_recosting) limits.defer_above_faces = defer_line_;
@@ -890,9 +911,9 @@ void ParallelBuilder::final_pass() {
   const SimplifierStats& fs = pass.stats();
   spdlog::debug(
       "final pass: {} keys carried in, {} answered from them; {} evaluations, {} vetoed, {} "
-      "screened, {} requeued, {} stale",
+      "screened, {} requeued, {} stale, {} seam collapses ({} split)",
       carried.size(), keys_->reused() - reused_before, fs.evaluations, fs.rejected, fs.screened,
-      fs.requeued, fs.stale);
+      fs.requeued, fs.stale, fs.seam_collapses, fs.seams_split);
   if (events_.final_pass_done)
     events_.final_pass_done(st_.final_pass_collapses, st_.final_pass_seconds);
   records_.insert(records_.end(), std::make_move_iterator(final_records.begin()),

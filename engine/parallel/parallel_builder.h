@@ -20,6 +20,7 @@
 #include "parallel/edge_keys.h"
 #include "parallel/parallel_build.h"
 #include "simplify/collapse_mesh.h"
+#include "simplify/copy_groups.h"
 
 namespace parapm {
 
@@ -107,6 +108,8 @@ class ParallelBuilder {
   uint64_t input_faces_ = 0, target_ = 0, handover_ = 0;
   uint64_t defer_line_ = 0;  // above it, edges are costed when they reach the top
   std::vector<uint8_t> locked_;
+  CopyGroups
+      copy_groups_;  // (copy_groups.h) joined by seam collapses in the jobs and the final pass
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three
   // rounds' if that is gentler.
   double step_ = 1;

@@ -99,6 +99,8 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
   auto constraints = standard_constraints(job.locked);
   constraints.push_back(make_subset_constraint(job.owned));
   Simplifier simplifier(working, *priority, std::move(constraints));
+  const CopyGroups groups = copy_groups_of(job.copy_group);
+  if (!groups.empty()) simplifier.join_copies(&groups);
   SimplifierLimits limits;
   limits.target_faces = job.options.target_faces;
   if (job.options.max_cost > 0) limits.max_cost = job.options.max_cost;

@@ -30,6 +30,7 @@ class Marks {
     stamp_[id] = generation_;
     return true;
   }
+  bool visited(uint32_t id) const { return stamp_[id] == generation_; }
   uint32_t& slot(uint32_t id) { return slot_[id]; }
 
  private:
@@ -44,7 +45,7 @@ SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout
                          const std::vector<uint8_t>& locked,
                          const std::vector<uint32_t>& vertex_subset,
                          const std::vector<VertexId>& owned_vertices, uint32_t subset,
-                         uint32_t round, const SubsetOptions& options) {
+                         uint32_t round, const SubsetOptions& options, const CopyGroups* groups) {
   SubsetJob job;
   job.round = round;
   job.subset = subset;
@@ -77,6 +78,24 @@ SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout
     out.positions.push_back(mesh.position(g));
     job.owned.push_back(vertex_subset[g] == subset ? 1 : 0);
     job.locked.push_back(!locked.empty() && locked[g] ? 1 : 0);
+  }
+  if (groups && !groups->empty()) {
+    // A group is the job's when every live copy of it is here; named by its first one here.
+    job.copy_group.assign(job.global_vertex.size(), kNoId);
+    for (size_t i = 0; i < job.global_vertex.size(); ++i) {
+      const VertexId g = job.global_vertex[i];
+      if (!groups->is_copy(g)) continue;
+      uint32_t name = kNoId;
+      bool whole = true;
+      for (VertexId copy : groups->of(groups->group[g])) {
+        if (!mesh.vertex_alive(copy)) continue;
+        whole = whole && vertex_marks.visited(copy);
+        if (whole && name == kNoId) name = vertex_marks.slot(copy);
+      }
+      if (whole) job.copy_group[i] = name;
+    }
+    if (std::ranges::all_of(job.copy_group, [](uint32_t g) { return g == kNoId; }))
+      job.copy_group.clear();
   }
   out.faces.reserve(job.global_face.size());
   for (FaceId f : job.global_face) {
@@ -139,13 +158,14 @@ std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const Attribute
                                        const std::vector<float>& wedge_values,
                                        bool positions_are_float, const std::vector<uint8_t>& locked,
                                        const std::vector<uint32_t>& vertex_subset, uint32_t subsets,
-                                       uint32_t round, const SubsetOptions& options) {
+                                       uint32_t round, const SubsetOptions& options,
+                                       const CopyGroups* groups) {
   const std::vector<std::vector<VertexId>> owned = owned_vertices(mesh, vertex_subset, subsets);
   std::vector<SubsetJob> jobs;
   jobs.reserve(subsets);
   for (uint32_t s = 0; s < subsets; ++s)
     jobs.push_back(extract_subset(mesh, layout, wedge_values, positions_are_float, locked,
-                                  vertex_subset, owned[s], s, round, options));
+                                  vertex_subset, owned[s], s, round, options, groups));
   return jobs;
 }
 
@@ -159,6 +179,10 @@ void validate_subset_job(const SubsetJob& job) {
   if (job.global_vertex.size() != m.vertex_count() || job.owned.size() != m.vertex_count() ||
       job.locked.size() != m.vertex_count())
     throw_invalid(name + "per-vertex arrays disagree with the mesh");
+  if (!job.copy_group.empty() && job.copy_group.size() != m.vertex_count())
+    throw_invalid(name + "copy groups disagree with the mesh");
+  for (uint32_t g : job.copy_group)
+    if (g != kNoId && g >= m.vertex_count()) throw_invalid(name + "copy group out of range");
   if (job.global_face.size() != m.face_count()) throw_invalid(name + "face map size");
   if (job.global_wedge.size() != m.wedge_count()) throw_invalid(name + "wedge map size");
   if (!m.face_wedges.empty() && m.face_wedges.size() != m.face_count())

@@ -22,6 +22,7 @@
 #include "mesh/mesh.h"
 #include "parallel/edge_keys.h"
 #include "simplify/collapse_mesh.h"
+#include "simplify/copy_groups.h"
 #include "simplify/module_state.h"
 #include "simplify/simplifier.h"
 #include "simplify/simplify.h"
@@ -77,8 +78,12 @@ struct SubsetJob {
   std::vector<FaceId> global_face;      // local face -> id in the whole mesh
   std::vector<WedgeId> global_wedge;    // local wedge -> id (empty without attributes)
   std::vector<uint8_t> owned;           // per local vertex: 1 if the subset owns it, 0: halo
-  std::vector<uint8_t> locked;          // per local vertex: a repair copy (never moves)
-  uint64_t owned_faces = 0;             // faces whose three vertices are owned
+  std::vector<uint8_t> locked;          // per local vertex: a repair copy (only seams move it)
+  // Per local vertex: its group of copies (copy_groups.h), named by the group's first vertex in
+  // the job, when every live copy of the group is in the job (the job makes seam collapses of
+  // those); kNoId otherwise (a copy whose group continues outside the job stays). Empty: none.
+  std::vector<uint32_t> copy_group;
+  uint64_t owned_faces = 0;  // faces whose three vertices are owned
   SubsetOptions options;
   // The metric's state over the job, in local ids (job_state.h): the master's sample points,
   // curves, wedge classes or quadrics. Empty: the job initialises its metric on its own mesh
@@ -97,13 +102,15 @@ struct SubsetJob {
 // Builds the job of every subset of `vertex_subset` (per global vertex its subset in
 // [0, subsets), ignored for dead vertices) over the live part of `mesh`. `wedge_values` are
 // the current values of the whole mesh's wedges (layout.floats_per_wedge() each; empty
-// without attributes); `locked` per global vertex (may be empty). `options` is copied into
-// every job (target_faces is left for the caller). O(live faces + sum of the jobs' sizes).
+// without attributes); `locked` per global vertex (may be empty); `groups` the whole mesh's
+// copy groups (null: none). `options` is copied into every job (target_faces is left for the
+// caller). O(live faces + sum of the jobs' sizes).
 std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const AttributeLayout& layout,
                                        const std::vector<float>& wedge_values,
                                        bool positions_are_float, const std::vector<uint8_t>& locked,
                                        const std::vector<uint32_t>& vertex_subset, uint32_t subsets,
-                                       uint32_t round, const SubsetOptions& options);
+                                       uint32_t round, const SubsetOptions& options,
+                                       const CopyGroups* groups = nullptr);
 
 // The two steps of extract_subsets, for a caller that builds the jobs concurrently: the live
 // vertices of each subset, in id order (checked against the mesh, O(vertices)), then one
@@ -116,7 +123,7 @@ SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout
                          const std::vector<uint8_t>& locked,
                          const std::vector<uint32_t>& vertex_subset,
                          const std::vector<VertexId>& owned, uint32_t subset, uint32_t round,
-                         const SubsetOptions& options);
+                         const SubsetOptions& options, const CopyGroups* groups = nullptr);
 
 // Checks what a job can check on its own: sizes agree, local ids in range, global ids
 // strictly increasing, every face touches an owned vertex. Throws Error(kInvalidInput)

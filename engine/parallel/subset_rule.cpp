@@ -60,6 +60,11 @@ class SubsetPriority : public PriorityWrapper {
     if (!free_[a] || !free_[b]) return false;
     return inner_.evaluate(mesh, a, b, out, costing);
   }
+  bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                     CollapseCandidate& out, Costing costing) override {
+    if (!free_[vs] || !free_[vt]) return false;
+    return inner_.evaluate_seam(mesh, vs, vt, at, out, costing);
+  }
 
  private:
   std::vector<uint8_t> free_;

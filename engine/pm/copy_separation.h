@@ -1,8 +1,10 @@
 // How far apart the repair's copies of one input vertex are at a level of detail. The repair
 // splits a non-manifold input vertex into copies, one per sheet meeting there
-// (ProgressiveMesh::vertex_copies); locked copies never move, so the sheets meet at every
-// level, while with SimplifyOptions::free_copies they simplify like any vertex and the sheets
-// may part at coarse levels (cracks). This measures the parting.
+// (ProgressiveMesh::vertex_copies); by default the copies move and leave together (seam
+// collapses, simplify/copy_groups.h), so the sheets meet at every level but inside one seam
+// collapse's records and for a copy left behind in a part too small to shrink, while with
+// SimplifyOptions::free_copies they simplify like any vertex and the sheets may part at coarse
+// levels (cracks). This measures the parting.
 #pragma once
 
 #include <cstddef>

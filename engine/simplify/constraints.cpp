@@ -19,6 +19,7 @@ class LockedVertices : public ConstraintModule {
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces&) const override {
     if (locked_.empty()) return true;
+    if (c.seam) return true;  // the simplifier keeps each group at one place
     if (locked_[c.vt]) return false;
     return !locked_[c.vs] || c.position == mesh.position(c.vs);
   }
@@ -69,15 +70,32 @@ class ComponentMinimum : public ConstraintModule {
   }
   bool allows(const CollapseMesh&, const CollapseCandidate& c, const EdgeFaces&) const override {
     const uint32_t comp = component_[c.vs];
-    if (closed_[comp]) return count_[comp] > 4u;
-    const bool may_vanish = may_vanish_ && comp != largest_ && !touching_[comp];
-    return count_[comp] > (may_vanish ? 2u : 3u);
+    return count_[comp] > smallest(comp);
+  }
+  void drop_too_small(const CollapseMesh&,
+                      std::vector<CollapseCandidate>& collapses) const override {
+    std::vector<std::pair<uint32_t, uint32_t>> made;  // (component, collapses kept in it)
+    std::erase_if(collapses, [&](const CollapseCandidate& c) {
+      const uint32_t comp = component_[c.vs];
+      auto it =
+          std::find_if(made.begin(), made.end(), [&](const auto& m) { return m.first == comp; });
+      if (it == made.end()) it = made.insert(made.end(), {comp, 0u});
+      if (count_[comp] - it->second <= smallest(comp)) return true;
+      ++it->second;
+      return false;
+    });
   }
   void collapsed(const CollapseMesh&, const CollapseCandidate& c) override {
     --count_[component_[c.vs]];
   }
 
  private:
+  // A collapse in component comp needs more live vertices than this.
+  uint32_t smallest(uint32_t comp) const {
+    if (closed_[comp]) return 4;
+    return may_vanish_ && comp != largest_ && !touching_[comp] ? 2 : 3;
+  }
+
   // The component of the largest area (the first of equals): the one kept whatever the cost.
   uint32_t largest_component(const CollapseMesh& mesh) const {
     std::vector<double> area(count_.size(), 0.0);

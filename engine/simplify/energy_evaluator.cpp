@@ -46,15 +46,16 @@ double EnergyEvaluator::corners_moved(FaceId f) {
 }
 
 bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                               CollapseCandidate& out, Costing costing) {
+                               CollapseCandidate& out, Costing costing, EnergySeam seam) {
   ++costings_;
-  const Survivor survivor = choose_survivor(mesh, a, b);
+  const Survivor survivor = choose_survivor(mesh, a, b, seam.keep);
   if (!survivor.possible) return false;
   out.vs = survivor.keep_b ? b : a;
   out.vt = survivor.keep_b ? a : b;
   StarSums sums = gather_star(mesh, a, b);
   if (scratch_.star.empty())  // no face left around either end: a component's last faces
-    return module_.options_.components_may_vanish && evaluate_removal(mesh, a, b, survivor, out);
+    return module_.options_.components_may_vanish &&
+           evaluate_removal(mesh, a, b, survivor, seam.at, out);
   const StarPoints points = gather_star_points(link_fan(sums, a, b));
   const Before before = energy_before(mesh, a, b, points.by_moments);
   Placing placing;
@@ -65,7 +66,7 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   placing.pa = mesh.position(a);
   placing.pb = mesh.position(b);
   set_star_terms(sums, points.points_around);
-  place(mesh, out, survivor, placing, costing);
+  place(mesh, out, survivor, placing, costing, seam.at);
   const Placement& chosen = choose_placement();
   out.position = chosen.v;
   out.cost = chosen.energy - before.distance_sq - before.curves_sq;
@@ -78,7 +79,8 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
 }
 
 bool EnergyEvaluator::evaluate_removal(const CollapseMesh& mesh, VertexId a, VertexId b,
-                                       const Survivor& survivor, CollapseCandidate& out) {
+                                       const Survivor& survivor, const Vec3* at,
+                                       CollapseCandidate& out) {
   // The points: those of the faces removed and the samples still parked at a and b.
   double before = 0;
   Vec3 sum{};
@@ -115,9 +117,9 @@ bool EnergyEvaluator::evaluate_removal(const CollapseMesh& mesh, VertexId a, Ver
     return priced;
   };
   const bool round = module_.options_.round_to_float;
-  Vec3 v = mesh.position(out.vs);
+  Vec3 v = at ? *at : mesh.position(out.vs);
   Priced best = price(v, nullptr);
-  if (!survivor.fixed) {
+  if (!survivor.fixed && !at) {
     // From the points' centroid, one least-squares step with the curves' model there.
     const Vec3 centroid = points.empty() ? scale(add(mesh.position(a), mesh.position(b)), 0.5)
                                          : scale(sum, 1.0 / double(points.size()));
@@ -157,11 +159,12 @@ EnergyEvaluator::Springs EnergyEvaluator::springs_of(double points_around) const
 }
 
 void EnergyEvaluator::place(const CollapseMesh& mesh, const CollapseCandidate& out,
-                            const Survivor& survivor, const Placing& placing, Costing costing) {
+                            const Survivor& survivor, const Placing& placing, Costing costing,
+                            const Vec3* at) {
   scratch_.placed = 0;
   Fit fit;
-  if (survivor.fixed) {
-    measure(placing, mesh.position(out.vs), fit);
+  if (survivor.fixed || at) {
+    measure(placing, at ? *at : mesh.position(out.vs), fit);
     return;
   }
   const Vec3 mid =
@@ -274,9 +277,10 @@ double EnergyEvaluator::attribute_change(const Placing& placing, const Placement
 }
 
 EnergyEvaluator::Survivor EnergyEvaluator::choose_survivor(const CollapseMesh& mesh, VertexId a,
-                                                           VertexId b) const {
-  const bool locked_a = !module_.locked_.empty() && module_.locked_[a];
-  const bool locked_b = !module_.locked_.empty() && module_.locked_[b];
+                                                           VertexId b, VertexId keep) const {
+  // With `keep`, no end is locked.
+  const bool locked_a = keep == kNoId && !module_.locked_.empty() && module_.locked_[a];
+  const bool locked_b = keep == kNoId && !module_.locked_.empty() && module_.locked_[b];
   if (locked_a && locked_b) return {};
   const bool boundary_a = mesh.is_boundary(a), boundary_b = mesh.is_boundary(b);
   // Discontinuity curves (boundaries, creases, seams): a vertex on a curve does not leave
@@ -292,7 +296,9 @@ EnergyEvaluator::Survivor EnergyEvaluator::choose_survivor(const CollapseMesh& m
   // Which end survives: a locked end, else the end on a curve, else a corner, else the
   // smaller id.
   bool keep_b;
-  if (locked_a || locked_b) {
+  if (keep != kNoId) {
+    keep_b = keep == b;
+  } else if (locked_a || locked_b) {
     keep_b = locked_b;
   } else if (curve_a != curve_b) {
     keep_b = curve_b;

@@ -37,6 +37,13 @@ struct EnergyFacePoint {
   uint32_t id = 0;
 };
 
+// A seam collapse's costing (EnergyEvaluator::evaluate): the end that survives, and its place
+// (null: where the evaluator places it best).
+struct EnergySeam {
+  VertexId keep = kNoId;
+  const Vec3* at = nullptr;
+};
+
 class EnergyEvaluator {
  public:
   explicit EnergyEvaluator(const EnergyPriority& module) : module_(module) {}
@@ -45,8 +52,10 @@ class EnergyEvaluator {
 
   // PriorityModule::evaluate for the energy: costs the collapse of {a, b}, choosing the
   // survivor and its place; false when it cannot be placed (both ends locked, no star).
+  // With seam.keep (a or b; PriorityModule::evaluate_seam): that end survives, locked or not,
+  // at *seam.at when given.
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing);
+                Costing costing, EnergySeam seam = {});
   uint64_t costings() const { return costings_; }
 
   // The per-face caches. reset: none known, for faces up to `face_capacity`. forget: face f's
@@ -106,13 +115,13 @@ class EnergyEvaluator {
 
   // evaluate()'s steps, in order. Each fills the scratch members it names.
   // 1. Which end survives, and whether its place is fixed (a locked end, an end on a curve the
-  //    other is not on, a corner, or a change of the curves' topology); not possible when both
-  //    ends are locked.
+  //    other is not on, a corner, or a change of the curves' topology); `keep` survives, placed
+  //    by those rules but for locks; not possible when both ends are locked (without `keep`).
   struct Survivor {
     bool possible = false;
     bool keep_b = false, fixed = false, topology = false, boundary_a = false, boundary_b = false;
   };
-  Survivor choose_survivor(const CollapseMesh& mesh, VertexId a, VertexId b) const;
+  Survivor choose_survivor(const CollapseMesh& mesh, VertexId a, VertexId b, VertexId keep) const;
   // 2. The star (scratch_: star, lists, edge_faces, joined, a_side_faces, origin), and
   //    the sums over its faces before the collapse: the area-weighted planes, the faces'
   //    normals and normal.corner, twice the area, about scratch_.origin.
@@ -157,7 +166,7 @@ class EnergyEvaluator {
     Vec3 pa{}, pb{};
   };
   void place(const CollapseMesh& mesh, const CollapseCandidate& out, const Survivor& survivor,
-             const Placing& placing, Costing costing);
+             const Placing& placing, Costing costing, const Vec3* at);
   void measure(const Placing& placing, const Vec3& v, Fit& fit);
   Vec3 solve(const Placing& placing, const Fit& fit, const Vec3& from);
   // 7. The lowest energy among the placements that fold no face (the face-geometry constraint
@@ -179,7 +188,7 @@ class EnergyEvaluator {
   // the surviving vertex: each costs its squared distance to it (the curves' samples theirs to
   // the segments left), and the vertex goes where their sum is least, unless its place is fixed.
   bool evaluate_removal(const CollapseMesh& mesh, VertexId a, VertexId b, const Survivor& survivor,
-                        CollapseCandidate& out);
+                        const Vec3* at, CollapseCandidate& out);
 
   // The measures and solves the steps share.
   void gather_face(FaceId f, int home);

@@ -66,6 +66,7 @@
 // build's jobs (energy_state_transfer.cpp).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -159,6 +160,11 @@ class EnergyPriority : public PriorityModule {
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override {
     return evaluator_.evaluate(mesh, a, b, out, costing);
+  }
+  bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                     CollapseCandidate& out, Costing costing) override {
+    return evaluator_.evaluate(mesh, std::min(vs, vt), std::max(vs, vt), out, costing,
+                               EnergySeam{vs, at});
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override { return evaluator_.costings(); }

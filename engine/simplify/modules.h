@@ -19,6 +19,8 @@ struct CollapseCandidate {
   Vec3 position{};
   double cost = 0;   // priority: smaller collapses first; units are the module's own
   double error = 0;  // geometric error of the collapse in model units (for cutting a PM)
+  // One of a seam collapse's collapses (copy_groups.h): vs and vt may be locked copies.
+  bool seam = false;
   Vec3 vs_before{};  // where vs was: set when the collapse is performed (or replayed)
   // Filled by PriorityModule::collapsed when the module changed wedge values (E_scalar): the
   // wedges and their new values, floats_per_wedge each.
@@ -51,6 +53,13 @@ class PriorityModule {
   // write the module's working memory and caches (a module serves one thread at a time).
   virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                         Costing costing) = 0;
+  // Costs the collapse of vt into vs, whether or not either end is locked: one collapse of a
+  // seam collapse (copy_groups.h). vs goes to *at when given, else where the module places it
+  // best. false: it cannot be costed (the default: a module that takes no part in seams).
+  virtual bool evaluate_seam(const CollapseMesh&, VertexId /*vs*/, VertexId /*vt*/,
+                             const Vec3* /*at*/, CollapseCandidate&, Costing) {
+    return false;
+  }
   // Called after the mesh performed `done`, to update the module's state. `edge` names the two
   // faces the collapse removed (now dead); done.vs_before where vs was (vt keeps its position
   // in the mesh). The module may refine done.error with what it learns from the performed
@@ -87,6 +96,10 @@ class PriorityWrapper : public PriorityModule {
                 Costing costing) override {
     return inner_.evaluate(mesh, a, b, out, costing);
   }
+  bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                     CollapseCandidate& out, Costing costing) override {
+    return inner_.evaluate_seam(mesh, vs, vt, at, out, costing);
+  }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done,
                  const EdgeFaces& edge) override {
     inner_.collapsed(mesh, done, edge);
@@ -107,12 +120,18 @@ class ConstraintModule {
   // Whether the answer depends on the edge {vs, vt} only: not on which end survives nor on
   // the placement. Such a rule can veto an edge before any costing.
   virtual bool topological() const { return false; }
+  // For a seam collapse (Simplifier::join_copies): removes from `collapses` those this rule
+  // would veto once the ones before them were made because their part is at its smallest form
+  // (the component minimum); such a copy stays where it is. A rule that vetoes for other
+  // reasons removes none: its veto stops the whole seam collapse.
+  virtual void drop_too_small(const CollapseMesh&, std::vector<CollapseCandidate>&) const {}
   virtual void collapsed(const CollapseMesh&, const CollapseCandidate&) {}
 };
 
 // The legality rules every collapse obeys (Hoppe 96 section 3, and METHOD.md section 1), in
 // the order they are checked, cheapest first:
-//   locked vertices: a vertex the repair step duplicated is never removed nor moved;
+//   locked vertices: a vertex the repair step duplicated is moved or removed only by a seam
+//     collapse (CollapseCandidate::seam; copy_groups.h);
 //   minimum size: a closed component keeps at least 4 vertices (a tetrahedron), an open one
 //     at least 3 (a triangle); with `components_may_vanish`, an open component may also
 //     collapse its last triangle away (its last vertices stay, faceless), unless it is the one

@@ -3,6 +3,7 @@
 // midpoint when the optimum is ill-conditioned or lands far from the edge).
 #include "simplify/quadric_priority.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "simplify/vec_math.h"
@@ -41,6 +42,33 @@ void QuadricPriority::initialize(const CollapseMesh& mesh) {
   }
 }
 
+Vec3 QuadricPriority::place(const Quadric& q, const Vec3& pa, const Vec3& pb) const {
+  const Vec3 mid = scale(add(pa, pb), 0.5);
+  const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
+  Vec3 best;
+  bool placed = q.minimizer(best);
+  if (placed) {
+    // An optimum far from the edge comes from a nearly flat quadric; it folds the mesh.
+    const Vec3 d = sub(best, mid);
+    placed = dot(d, d) <= 4.0 * edge_sq;
+  }
+  if (placed && options_.round_to_float) {
+    for (double& c : best) c = round_to_float(c);
+  }
+  if (!placed) {
+    best = pa;
+    double best_cost = q.evaluate(pa);
+    Vec3 mid_placed = mid;
+    if (options_.round_to_float)
+      for (double& c : mid_placed) c = round_to_float(c);
+    for (const Vec3& p : {pb, mid_placed}) {
+      const double cost = q.evaluate(p);
+      if (cost < best_cost) best_cost = cost, best = p;
+    }
+  }
+  return best;
+}
+
 bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                                CollapseCandidate& out, Costing) {
   ++costings_;
@@ -49,38 +77,24 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   if (locked_a && locked_b) return false;
   Quadric q = quadrics_[a];
   q += quadrics_[b];
-  const Vec3& pa = mesh.position(a);
-  const Vec3& pb = mesh.position(b);
   out.vs = (locked_b || (!locked_a && b < a)) ? b : a;
   out.vt = out.vs == a ? b : a;
-  if (locked_a || locked_b) {
-    out.position = mesh.position(out.vs);
-  } else {
-    const Vec3 mid = scale(add(pa, pb), 0.5);
-    const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
-    Vec3 best;
-    bool placed = q.minimizer(best);
-    if (placed) {
-      // An optimum far from the edge comes from a nearly flat quadric; it folds the mesh.
-      const Vec3 d = sub(best, mid);
-      placed = dot(d, d) <= 4.0 * edge_sq;
-    }
-    if (placed && options_.round_to_float) {
-      for (double& c : best) c = round_to_float(c);
-    }
-    if (!placed) {
-      best = pa;
-      double best_cost = q.evaluate(pa);
-      Vec3 mid_placed = mid;
-      if (options_.round_to_float)
-        for (double& c : mid_placed) c = round_to_float(c);
-      for (const Vec3& p : {pb, mid_placed}) {
-        const double cost = q.evaluate(p);
-        if (cost < best_cost) best_cost = cost, best = p;
-      }
-    }
-    out.position = best;
-  }
+  out.position =
+      locked_a || locked_b ? mesh.position(out.vs) : place(q, mesh.position(a), mesh.position(b));
+  out.cost = std::max(0.0, q.evaluate(out.position));
+  out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
+  return std::isfinite(out.cost);
+}
+
+bool QuadricPriority::evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt,
+                                    const Vec3* at, CollapseCandidate& out, Costing) {
+  ++costings_;
+  Quadric q = quadrics_[std::min(vs, vt)];
+  q += quadrics_[std::max(vs, vt)];
+  out.vs = vs;
+  out.vt = vt;
+  out.position =
+      at ? *at : place(q, mesh.position(std::min(vs, vt)), mesh.position(std::max(vs, vt)));
   out.cost = std::max(0.0, q.evaluate(out.position));
   out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
   return std::isfinite(out.cost);

@@ -28,6 +28,8 @@ class QuadricPriority : public PriorityModule {
   void initialize(const CollapseMesh& mesh) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override;  // (both costings alike: it is cheap)
+  bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                     CollapseCandidate& out, Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override { return costings_; }
 
@@ -49,6 +51,9 @@ class QuadricPriority : public PriorityModule {
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 
  private:
+  // Where the collapse of the edge (pa, pb) with quadric q puts its survivor.
+  Vec3 place(const Quadric& q, const Vec3& pa, const Vec3& pb) const;
+
   uint64_t costings_ = 0;
   std::vector<uint8_t> locked_;
   QuadricOptions options_;

@@ -40,8 +40,7 @@ void Simplifier::push_edge(VertexId a, VertexId b) {
 bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   if (a > b) std::swap(a, b);
   CollapseCandidate candidate;
-  ++stats_.evaluations;
-  if (!priority_.evaluate(mesh_, a, b, candidate, Costing::kQueue)) {
+  if (!cost_edge(a, b, candidate, Costing::kQueue)) {
     // Refused (a job's subset rule or cost ceiling, locked ends): once its star changes it is
     // deferred to the end of the queue, not costed at once to be refused again.
     if (defer_) remember_key(a, b, std::numeric_limits<float>::infinity());
@@ -212,6 +211,190 @@ CollapseRecord Simplifier::perform(CollapseCandidate c, const EdgeFaces& edge) {
   return r;
 }
 
+void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits& limits) {
+  ++version_[vs];
+  mesh_.neighbors(vs, ring_);
+  ++collapses_;
+  star_changed_at_[vs] = star_changed_at_[vt] = collapses_;
+  for (VertexId n : ring_) star_changed_at_[n] = collapses_;
+  // Edges vetoed earlier around the changed star may be legal now: cost them again, after
+  // the edges of vs. All are taken off the lists first: a push may veto its edge again, onto
+  // the lists (screening).
+  rejected_[vt].clear();
+  rejected_[vs].clear();
+  retry_.clear();
+  for (VertexId n : ring_) {
+    auto& list = rejected_[n];
+    for (VertexId other : list) {
+      if (other == vs || !mesh_.vertex_alive(other)) continue;
+      // The edge is pushed once, from this side: forget it on the other side too.
+      auto& mirror = rejected_[other];
+      mirror.erase(std::remove(mirror.begin(), mirror.end(), n), mirror.end());
+      retry_.emplace_back(n, other);
+    }
+    list.clear();
+  }
+  const bool defer = defer_ && mesh_.live_faces() > limits.defer_above_faces;
+  for (VertexId n : ring_)
+    if (!(defer && defer_edge(vs, n))) push_edge(vs, n);
+  for (const auto& [n, other] : retry_) retry_edge(n, other);
+}
+
+bool Simplifier::cost_edge(VertexId a, VertexId b, CollapseCandidate& out, Costing costing) {
+  if (groups_ && groups_->is_copy(a) && groups_->is_copy(b)) return cost_seam(a, b, out, costing);
+  ++stats_.evaluations;
+  return priority_.evaluate(mesh_, a, b, out, costing);
+}
+
+bool Simplifier::pair_seam(uint32_t from, uint32_t into) {
+  seam_pairs_.clear();
+  for (VertexId copy : groups_->of(from)) {
+    if (!mesh_.vertex_alive(copy)) continue;
+    if (seam_pairs_.size() == kMaxSeamCopies) return false;
+    mesh_.neighbors(copy, seam_ring_);
+    VertexId partner = kNoId;
+    for (VertexId n : seam_ring_)
+      if (groups_->group[n] == into) partner = std::min(partner, n);
+    if (partner == kNoId) return false;
+    seam_pairs_.push_back({partner, copy});
+  }
+  // Copies in parts too small to shrink stay.
+  std::vector<CollapseCandidate>& pairs = seam_planned_;
+  pairs.assign(seam_pairs_.size(), CollapseCandidate{});
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    pairs[i].vs = seam_pairs_[i].vs;
+    pairs[i].vt = seam_pairs_[i].vt;
+    pairs[i].position = mesh_.position(pairs[i].vs);
+    pairs[i].seam = true;
+  }
+  for (const auto& module : constraints_) module->drop_too_small(mesh_, pairs);
+  seam_pairs_.clear();
+  for (const CollapseCandidate& c : pairs) seam_pairs_.push_back({c.vs, c.vt});
+  return !seam_pairs_.empty() && rings_apart();
+}
+
+bool Simplifier::all_survive(uint32_t into) const {
+  for (VertexId copy : groups_->of(into))
+    if (mesh_.vertex_alive(copy) && std::none_of(seam_pairs_.begin(), seam_pairs_.end(),
+                                                 [&](const SeamPair& p) { return p.vs == copy; }))
+      return false;
+  return true;
+}
+
+bool Simplifier::rings_apart() {
+  if (seam_mark_.size() < mesh_.vertex_capacity()) seam_mark_.assign(mesh_.vertex_capacity(), 0);
+  if (seam_stamp_ > UINT32_MAX - 2 * kMaxSeamCopies) {
+    std::fill(seam_mark_.begin(), seam_mark_.end(), 0);
+    seam_stamp_ = 0;
+  }
+  const uint32_t base = seam_stamp_;
+  seam_stamp_ += uint32_t(seam_pairs_.size());
+  for (size_t i = 0; i < seam_pairs_.size(); ++i) {
+    const uint32_t mine = base + uint32_t(i) + 1;
+    for (VertexId end : {seam_pairs_[i].vs, seam_pairs_[i].vt}) {
+      mesh_.neighbors(end, seam_ring_);
+      seam_ring_.push_back(end);
+      for (VertexId v : seam_ring_) {
+        if (seam_mark_[v] > base && seam_mark_[v] != mine) return false;
+        seam_mark_[v] = mine;
+      }
+    }
+  }
+  return true;
+}
+
+bool Simplifier::cost_seam_at(const Vec3& at, Costing costing, CollapseCandidate& out) {
+  double cost = 0, error = 0;
+  for (size_t i = 0; i < seam_pairs_.size(); ++i) {
+    CollapseCandidate c;
+    ++stats_.evaluations;
+    if (!priority_.evaluate_seam(mesh_, seam_pairs_[i].vs, seam_pairs_[i].vt, &at, c, costing))
+      return false;
+    cost += c.cost;
+    error = std::max(error, c.error);
+    if (i == 0) out = std::move(c);
+  }
+  out.cost = cost;
+  out.error = error;
+  out.seam = true;
+  return std::isfinite(cost);
+}
+
+bool Simplifier::cost_seam(VertexId a, VertexId b, CollapseCandidate& out, Costing costing) {
+  const uint32_t group_a = groups_->group[a], group_b = groups_->group[b];
+  bool found = false;
+  std::vector<Vec3>& places = seam_places_;
+  for (const auto& [from, into] : {std::pair{group_a, group_b}, std::pair{group_b, group_a}}) {
+    if (from == into || !pair_seam(from, into)) continue;
+    // Where the survivors are; and when every copy of `into` survives, where the pairs'
+    // collapses would each put it (the first's only for a queue key).
+    places.assign(1, mesh_.position(seam_pairs_[0].vs));
+    if (all_survive(into)) {
+      const size_t free_places = costing == Costing::kQueue ? 1 : seam_pairs_.size();
+      for (size_t i = 0; i < free_places; ++i) {
+        CollapseCandidate c;
+        ++stats_.evaluations;
+        if (priority_.evaluate_seam(mesh_, seam_pairs_[i].vs, seam_pairs_[i].vt, nullptr, c,
+                                    costing) &&
+            std::find(places.begin(), places.end(), c.position) == places.end())
+          places.push_back(c.position);
+      }
+    }
+    for (const Vec3& place : places) {
+      CollapseCandidate c;
+      if (!cost_seam_at(place, costing, c) || (found && !(c.cost < out.cost))) continue;
+      out = std::move(c);
+      found = true;
+    }
+  }
+  return found;
+}
+
+bool Simplifier::perform_seam(const CollapseCandidate& seam, const SimplifierLimits& limits,
+                              std::vector<CollapseRecord>& records) {
+  const uint32_t from = groups_->group[seam.vt], into = groups_->group[seam.vs];
+  if (!pair_seam(from, into)) return false;
+  const std::vector<SeamPair> pairs = seam_pairs_;
+  const Vec3 place = seam.position;
+  // The survivors move only all together.
+  if (place != mesh_.position(pairs[0].vs) && !all_survive(into)) return false;
+  // Each collapse legal on the mesh as it is (a veto is remembered on that edge, whose star
+  // changing costs the seam again).
+  std::vector<CollapseCandidate>& planned = seam_planned_;
+  planned.assign(pairs.size(), CollapseCandidate{});
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    CollapseCandidate& c = planned[i];
+    c.vs = pairs[i].vs;
+    c.vt = pairs[i].vt;
+    c.position = place;
+    c.seam = true;
+    if (!legal(c, mesh_.edge_faces(c.vs, c.vt))) {
+      reject(c.vs, c.vt);
+      return false;
+    }
+  }
+
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    // Costed on the mesh the earlier collapses left (the records' errors), checked again.
+    CollapseCandidate c;
+    ++stats_.evaluations;
+    const bool placed =
+        priority_.evaluate_seam(mesh_, pairs[i].vs, pairs[i].vt, &place, c, Costing::kPerform);
+    c.seam = true;
+    c.cost = seam.cost;  // the records of one seam collapse stay together when merged by cost
+    const EdgeFaces edge = mesh_.edge_faces(pairs[i].vs, pairs[i].vt);
+    if (!placed || !legal(c, edge)) {
+      if (i == 0) return false;
+      ++stats_.seams_split;
+      break;
+    }
+    records.push_back(perform(c, edge));
+    requeue_around(c.vs, c.vt, limits);
+  }
+  ++stats_.seam_collapses;
+  return true;
+}
+
 void Simplifier::begin_run(const SimplifierLimits& limits) {
   stats_ = {};
   priority_.initialize(mesh_);
@@ -286,8 +469,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   const uint64_t total = start_faces > limits.target_faces ? start_faces - limits.target_faces : 0;
   std::vector<CollapseRecord> records;
   records.reserve(mesh_.live_vertices());
-  std::vector<VertexId> ring;
-  std::vector<std::pair<VertexId, VertexId>> retry;
+  size_t next_report = 1024;  // records made when progress is next reported
   stats_.stop_reason = "no legal collapse left";
 
   while (!heap_.empty()) {
@@ -334,9 +516,12 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
         reject(entry.a, entry.b);
         continue;
       }
-      ++stats_.evaluations;
-      if (!priority_.evaluate(mesh_, entry.a, entry.b, candidate, Costing::kPerform)) continue;
+      if (!cost_edge(entry.a, entry.b, candidate, Costing::kPerform)) continue;
     }
+    // A seam collapse's first pair may be another edge than the entry's.
+    if (candidate.seam &&
+        !(std::minmax(candidate.vs, candidate.vt) == std::minmax(entry.a, entry.b)))
+      topology_checked = false;
     const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
     if (edge.left == kNoId && edge.right == kNoId) {  // a re-costed edge that is gone
       ++stats_.stale;
@@ -370,36 +555,18 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       requeued_[edge_key(entry.a, entry.b)] = {collapses_, std::move(candidate)};
       continue;
     }
-    records.push_back(perform(candidate, edge));
-    const VertexId vs = candidate.vs;
-    ++version_[vs];
-    mesh_.neighbors(vs, ring);
-    ++collapses_;
-    star_changed_at_[vs] = star_changed_at_[candidate.vt] = collapses_;
-    for (VertexId n : ring) star_changed_at_[n] = collapses_;
-    // Edges vetoed earlier around the changed star may be legal now: cost them again, after
-    // the edges of vs. All are taken off the lists first: a push may veto its edge again, onto
-    // the lists (screening).
-    rejected_[candidate.vt].clear();
-    rejected_[vs].clear();
-    retry.clear();
-    for (VertexId n : ring) {
-      auto& list = rejected_[n];
-      for (VertexId other : list) {
-        if (other == vs || !mesh_.vertex_alive(other)) continue;
-        // The edge is pushed once, from this side: forget it on the other side too.
-        auto& mirror = rejected_[other];
-        mirror.erase(std::remove(mirror.begin(), mirror.end(), n), mirror.end());
-        retry.emplace_back(n, other);
+    if (candidate.seam) {
+      if (!perform_seam(candidate, limits, records)) {
+        ++stats_.rejected;
+        continue;
       }
-      list.clear();
+    } else {
+      records.push_back(perform(candidate, edge));
+      requeue_around(candidate.vs, candidate.vt, limits);
     }
-    const bool defer = defer_ && mesh_.live_faces() > limits.defer_above_faces;
-    for (VertexId n : ring)
-      if (!(defer && defer_edge(vs, n))) push_edge(vs, n);
-    for (const auto& [n, other] : retry) retry_edge(n, other);
 
-    if ((records.size() & 1023) == 0) {
+    if (records.size() >= next_report) {
+      next_report = records.size() + 1024;
       // Progress first: a caller may cancel from its callback (a worker polling its call).
       if (progress) progress(std::min<uint64_t>(start_faces - mesh_.live_faces(), total), total);
       if (cancel) cancel->check();

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "simplify/collapse_mesh.h"
+#include "simplify/copy_groups.h"
 #include "simplify/modules.h"
 #include "simplify/quad_heap.h"
 #include "util/progress.h"
@@ -124,10 +125,14 @@ struct SimplifierStats {
   // With a costly priority module: edges the topological rules vetoed before any costing
   // (retried after their star changed, or on top of the queue: those count as rejected too).
   uint64_t screened = 0;
-  uint64_t deferred = 0;      // edges queued below their last key instead of costed at once
-  uint64_t compactions = 0;   // passes dropping the queue's stale entries at once
-  uint64_t over_ceiling = 0;  // popped edges whose cost was above SimplifierLimits::max_cost
-  std::string stop_reason;    // why the loop ended
+  uint64_t deferred = 0;        // edges queued below their last key instead of costed at once
+  uint64_t compactions = 0;     // passes dropping the queue's stale entries at once
+  uint64_t over_ceiling = 0;    // popped edges whose cost was above SimplifierLimits::max_cost
+  uint64_t seam_collapses = 0;  // performed (join_copies), each one record per copy removed
+  // Seam collapses stopped midway: an earlier copy's collapse made a later one's illegal (the
+  // group's remaining copies leave in a later seam collapse).
+  uint64_t seams_split = 0;
+  std::string stop_reason;  // why the loop ended
 };
 
 class Simplifier {
@@ -141,6 +146,20 @@ class Simplifier {
   std::vector<CollapseRecord> run(const SimplifierLimits& limits, const ProgressCallback& progress,
                                   const CancelToken* cancel);
   const SimplifierStats& stats() const { return stats_; }
+  // Seam collapses (copy_groups.h): an edge between copies of two groups (which the modules
+  // treat as locked, so never collapse) is costed and collapsed as a whole: every live copy of
+  // one group collapses into a copy of the other adjacent to it. The survivors stay where they
+  // are, or, when every copy of their group is one, all go to one place: the one of least
+  // summed cost (PriorityModule::evaluate_seam) among where they are and where each
+  // collapse alone would put its survivor. The cheaper way round is taken. A copy in a part
+  // too small to shrink (ConstraintModule::drop_too_small) stays where it is, beside the seam.
+  // Legal when the collapses' rings (both ends and their neighbours) are apart, so that none
+  // changes what another's legality reads, and each is legal on the mesh before the first
+  // (each is checked again before it is made). Its records follow one another; a run does not
+  // stop between them, not even at its target. A group of more than kMaxSeamCopies live
+  // copies stays. Off (null) by default; `groups` must outlive the run.
+  void join_copies(const CopyGroups* groups) { groups_ = groups; }
+  static constexpr size_t kMaxSeamCopies = 16;
   // After run(): the edges still waiting in the queue to be costed (deferred, neither end
   // changed since), with the key they were deferred from, sorted by (a, b). Empty when the run
   // did not defer.
@@ -196,6 +215,31 @@ class Simplifier {
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
              bool topology_checked = false) const;
   CollapseRecord perform(CollapseCandidate candidate, const EdgeFaces& edge);
+  // After a collapse with survivor vs: the versions and star marks, the vetoed edges around
+  // the changed star retried, the edges around vs queued again.
+  void requeue_around(VertexId vs, VertexId vt, const SimplifierLimits& limits);
+  // The module's costing of edge {a, b}, or the seam collapse's between their groups.
+  bool cost_edge(VertexId a, VertexId b, CollapseCandidate& out, Costing costing);
+  struct SeamPair {
+    VertexId vs, vt;
+  };
+  // Every live copy of group `from` (as vt) with the copy of group `into` adjacent to it of
+  // the smallest id (as vs), into seam_pairs_, but for copies in parts too small to shrink
+  // (ConstraintModule::drop_too_small: they stay); false when a copy has no such neighbour,
+  // when there are too many copies or none to collapse, or when the rings are not apart.
+  bool pair_seam(uint32_t from, uint32_t into);
+  // Whether every live copy of group `into` is a survivor in seam_pairs_.
+  bool all_survive(uint32_t into) const;
+  // Whether seam_pairs_' rings (both ends and their neighbours) are apart.
+  bool rings_apart();
+  // The seam_pairs_' collapses with the survivors at `at`: their summed cost, the largest
+  // error, the first's candidate.
+  bool cost_seam_at(const Vec3& at, Costing costing, CollapseCandidate& out);
+  bool cost_seam(VertexId a, VertexId b, CollapseCandidate& out, Costing costing);
+  // Performs the seam collapse `seam` names (its first pair and place); false, and nothing
+  // done, when one of its collapses is illegal on the mesh as it is.
+  bool perform_seam(const CollapseCandidate& seam, const SimplifierLimits& limits,
+                    std::vector<CollapseRecord>& records);
 
   CollapseMesh& mesh_;
   PriorityModule& priority_;
@@ -217,6 +261,14 @@ class Simplifier {
   // 3 per face: the key of the edge from corner k; NaN: none yet, infinite: refused
   std::vector<float> face_keys_;
   uint32_t collapses_ = 0;
+  const CopyGroups* groups_ = nullptr;
+  std::vector<SeamPair> seam_pairs_;
+  std::vector<Vec3> seam_places_;
+  std::vector<CollapseCandidate> seam_planned_;
+  std::vector<uint32_t> seam_mark_;  // per vertex: the pair whose ring holds it (rings_apart)
+  uint32_t seam_stamp_ = 0;
+  std::vector<VertexId> ring_, seam_ring_;
+  std::vector<std::pair<VertexId, VertexId>> retry_;
   SimplifierStats stats_;
 };
 

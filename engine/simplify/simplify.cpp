@@ -111,6 +111,9 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   std::unique_ptr<PriorityModule> priority = make_priority_module(options, mesh, locked);
   Simplifier simplifier(working, *priority,
                         standard_constraints(locked, {}, !options.keep_components));
+  // Locked copies leave the mesh group by group (seam collapses), the sheets meeting still.
+  const CopyGroups groups = options.free_copies ? CopyGroups{} : copy_groups(repaired);
+  if (!groups.empty()) simplifier.join_copies(&groups);
   SimplifierLimits limits;
   limits.target_faces = target_face_count(mesh.face_count(), options);
   if (options.defer_recosting) limits.defer_above_faces = defer_recosting_line(mesh.face_count());
@@ -132,10 +135,11 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   }
   spdlog::debug(
       "simplified {} -> {} faces in {:.3f} s ({} collapses, {} vetoed, {} screened, {} "
-      "evaluations, {} deferred, {} requeued; {})",
+      "evaluations, {} deferred, {} requeued, {} seam collapses ({} split); {})",
       mesh.face_count(), pm.base.face_count(), seconds, simplifier.stats().collapses,
       simplifier.stats().rejected, simplifier.stats().screened, simplifier.stats().evaluations,
-      simplifier.stats().deferred, simplifier.stats().requeued, simplifier.stats().stop_reason);
+      simplifier.stats().deferred, simplifier.stats().requeued, simplifier.stats().seam_collapses,
+      simplifier.stats().seams_split, simplifier.stats().stop_reason);
   return pm;
 }
 

@@ -47,11 +47,13 @@ struct SimplifyOptions {
   uint64_t seed = 1;        // of the randomised steps (the energy's extra points)
   bool keep_order = false;  // store the input's vertex and face order in the PM
   // The repair splits a non-manifold input vertex into copies, one per sheet meeting there.
-  // false: the copies never move (locked_vertices), so the sheets meet at every level, and on
-  // a mesh with many copies they and their edges are what remains at coarse levels (the
-  // simplification stops above the target). true: they simplify like any vertex, and the
-  // sheets part at coarse levels (cracks, often far wider than the level's distance error:
-  // pm/copy_separation.h measures them). Full resolution is exact either way.
+  // false: the copies move and leave only together (locked_vertices, seam collapses:
+  // copy_groups.h), so the sheets meet at every level but inside one seam collapse's records;
+  // a copy in a part too small to shrink stays behind, and where the copies' collapses cannot
+  // all be made (a mesh with many copies) they and their edges are what remains at coarse
+  // levels (the simplification stops above the target). true: they simplify like any vertex,
+  // and the sheets part at coarse levels (cracks, often far wider than the level's distance
+  // error: pm/copy_separation.h measures them). Full resolution is exact either way.
   bool free_copies = false;
   // true: every connected component keeps at least a triangle (a closed one a tetrahedron) at
   // every level. false: an open component's last triangle collapses away when its turn comes
@@ -90,8 +92,8 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
 void check_simplify_options(const SimplifyOptions& options);
 void check_energy_tuning(const EnergyTuning& energy);
 // Per vertex of repaired.mesh: 1 when the repair step made copies of its input vertex (such
-// vertices never move, so that the copies of one input vertex never crack apart); all 0 with
-// `free_copies` (SimplifyOptions::free_copies).
+// vertices move and leave only in seam collapses, copy_groups.h, so that the copies of one
+// input vertex do not crack apart); all 0 with `free_copies` (SimplifyOptions::free_copies).
 std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired, bool free_copies = false);
 class PriorityModule;
 // The priority module of options.metric for `mesh` (per vertex `locked`). reference_diagonal:

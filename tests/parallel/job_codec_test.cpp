@@ -114,6 +114,7 @@ void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& 
   ASSERT_EQ(a.global_wedge, b.global_wedge) << what;
   ASSERT_EQ(a.owned, b.owned) << what;
   ASSERT_EQ(a.locked, b.locked) << what;
+  ASSERT_EQ(a.copy_group, b.copy_group) << what;
   ASSERT_EQ(a.owned_faces, b.owned_faces) << what;
   const SubsetOptions &o = a.options, &p = b.options;
   ASSERT_TRUE(o.metric == p.metric && same_bits(o.samples_per_face, p.samples_per_face) &&
@@ -227,15 +228,23 @@ TEST(JobCodec, JobsRecordsAndSummariesComeBackBitForBit) {
     const char* mesh;
     const char* metric;
   };
-  // Colours (a wedge per vertex), texture seams (several per vertex), no attributes.
-  for (const Case& c : {Case{"pymeshlab-colored-airplane-11k.ply", "energy"},
-                        Case{"pymeshlab-colored-airplane-11k.ply", "quadric"},
-                        Case{"pymeshlab-bunny-textured-10k.obj", "energy"},
-                        Case{"pymeshlab-bunny-textured-10k.obj", "quadric"},
-                        Case{"stratocaster-9k.ply", "energy"}}) {
+  // Colours (a wedge per vertex), texture seams (several per vertex), no attributes, copies of
+  // non-manifold vertices (seam collapses).
+  for (const Case& c :
+       {Case{"pymeshlab-colored-airplane-11k.ply", "energy"},
+        Case{"cad-cycloidal-43k.ply", "energy"}, Case{"cad-cycloidal-43k.ply", "quadric"},
+        Case{"pymeshlab-colored-airplane-11k.ply", "quadric"},
+        Case{"pymeshlab-bunny-textured-10k.obj", "energy"},
+        Case{"pymeshlab-bunny-textured-10k.obj", "quadric"},
+        Case{"stratocaster-9k.ply", "energy"}}) {
     std::vector<SubsetJob> jobs = jobs_of(c.mesh, c.metric, 4);
-    const SubsetJob& job = jobs[1];
     const std::string what = std::string(c.mesh) + " " + c.metric;
+    // The CAD part's first job holding a whole group of copies.
+    const bool copies = std::string(c.mesh).starts_with("cad");
+    const auto with_copies = std::find_if(jobs.begin(), jobs.end(),
+                                          [](const SubsetJob& j) { return !j.copy_group.empty(); });
+    ASSERT_EQ(with_copies != jobs.end(), copies) << what;
+    const SubsetJob& job = copies ? *with_copies : jobs[1];
     ASSERT_FALSE(job.state.empty()) << what;
     const std::string bytes = encode_subset_job(job);
     const SubsetJob decoded = decode_subset_job(bytes);
@@ -379,27 +388,27 @@ TEST(JobCodec, HugeCountsAreRefusedBeforeAllocating) {
   // A job of 3 vertices and 2^40 faces, and one of 2^40 vertices.
   std::string message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(6);  // the codec's version
+    out.u8(7);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), uint64_t(3), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 faces"), std::string::npos) << message;
   EXPECT_NE(message.find("subset job: byte "), std::string::npos) << message;
   message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(6);  // the codec's version
+    out.u8(7);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 vertices"), std::string::npos) << message;
   message = message_of(Kind::kRecords, [&](ByteWriter& out) {
     out.bytes("PPCR", 4);
-    out.u8(6);
+    out.u8(7);  // the codec's version
     out.varint(kHuge);
   });
   EXPECT_NE(message.find("1099511627776 records"), std::string::npos) << message;
   // A summary whose energy state claims 2^40 faces.
   message = message_of(Kind::kSummary, [&](ByteWriter& out) {
     out.bytes("PPSS", 4);
-    out.u8(6);
+    out.u8(7);  // the codec's version
     out.varint(0);
     out.varint(0);
     out.u8(2);  // energy

@@ -97,10 +97,9 @@ Ratios compare(const std::string& name, const RepairedMesh& repaired,
 }
 
 // The CAD part's worst cell is guarded at 1.5: its 2% level is below its legal minimum (about
-// 3k faces: locked copies of non-manifold vertices), so it is the base, whose last hundred
-// collapses, the dearest legal ones, double its error; which of them remain moves with the
-// rounds (measured: 1.03-1.08 at p = 4-16; over rounds and border settings it has ranged up to
-// 1.46).
+// 2.1k faces: copies of non-manifold vertices whose seam collapses are vetoed), so it is the
+// base, whose last hundred collapses, the dearest legal ones, double its error; which of them
+// remain moves with the rounds (measured: 1.00-1.04 at p = 2-8, 1.46 at p = 16).
 TEST(ParallelQuality, QuadricLevelsMatchTheSequentialOnes) {
   for (const char* name :
        {"cad-cycloidal-43k.ply", "gmsh-aneurysm-20k.stl.gz", "pymeshlab-bunny-textured-10k.obj"}) {

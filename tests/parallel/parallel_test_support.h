@@ -12,6 +12,7 @@
 #include "mesh/repair.h"
 #include "parallel/edge_keys.h"
 #include "parallel/job_state.h"
+#include "parallel/parallel_build.h"
 #include "parallel/subset_job.h"
 #include "parallel/subset_rule.h"
 #include "partition/partition.h"
@@ -24,6 +25,18 @@ namespace parapm::testing {
 
 inline RepairedMesh repaired_test_mesh(const std::string& name) {
   return repair_mesh(read_mesh(test_data(name)));
+}
+
+// The sequential build at p = 1, else the parallel build on p subsets, with rounds down to
+// subsets of `min_subset_faces` (small drawn meshes get rounds too).
+inline ProgressiveMesh build_with_subsets(const RepairedMesh& repaired,
+                                          const SimplifyOptions& options, uint32_t p,
+                                          uint64_t min_subset_faces) {
+  if (p == 1) return build_progressive_mesh(repaired, options);
+  ParallelOptions parallel;
+  parallel.subsets = p;
+  parallel.min_subset_faces = min_subset_faces;
+  return build_progressive_mesh_parallel(repaired, options, parallel);
 }
 
 inline std::string pm_bytes(const ProgressiveMesh& pm) {
@@ -39,17 +52,20 @@ struct RoundZero {
   RoundZero(const std::string& name, const SimplifyOptions& options, uint32_t p)
       : repaired(repaired_test_mesh(name)),
         locked(locked_vertices(repaired)),
+        groups(copy_groups(repaired)),
         whole(repaired.mesh),
         master(make_priority_module(options, repaired.mesh, locked)) {
     const Mesh& mesh = repaired.mesh;
     master->initialize(whole);
     const Partition partition = partition_mesh(mesh, p);
-    jobs = extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
-                           partition.vertex_subset, p, 0, subset_options_of(options, mesh));
+    jobs =
+        extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                        partition.vertex_subset, p, 0, subset_options_of(options, mesh), &groups);
     for (SubsetJob& job : jobs) job.state = export_job_state(*master, job);
   }
   RepairedMesh repaired;
   std::vector<uint8_t> locked;
+  CopyGroups groups;
   CollapseMesh whole;
   std::unique_ptr<PriorityModule> master;
   std::vector<SubsetJob> jobs;

@@ -13,7 +13,7 @@
 
 #include "drawn_meshes.h"
 #include "mesh/repaired_input.h"
-#include "parallel/parallel_build.h"
+#include "parallel_test_support.h"
 #include "pm/levels.h"
 #include "pm/mesh_compare.h"
 #include "pm/pm_cursor.h"
@@ -36,11 +36,7 @@ uint32_t components_with_faces(const Mesh& level) {
 }
 
 ProgressiveMesh build(const RepairedMesh& repaired, const SimplifyOptions& options, uint32_t p) {
-  if (p == 1) return build_progressive_mesh(repaired, options);
-  ParallelOptions parallel;
-  parallel.subsets = p;
-  parallel.min_subset_faces = 100;  // rounds on this small scene too
-  return build_progressive_mesh_parallel(repaired, options, parallel);
+  return build_with_subsets(repaired, options, p, 100);  // rounds on this small scene too
 }
 
 TEST(VanishingComponents, SmallOpenPartsVanishAndComeBackExactly) {

@@ -105,6 +105,49 @@ TEST(Legality, LockedVertexIsNeverRemoved) {
   EXPECT_EQ(veto(octahedron(), 2, 0, locked), "");
 }
 
+// A seam collapse's collapse (CollapseCandidate::seam) may remove and move locked copies: the
+// simplifier keeps each group of copies at one place.
+TEST(Legality, SeamCollapseMayRemoveAndMoveALockedCopy) {
+  std::vector<uint8_t> locked(6, 0);
+  locked[0] = locked[2] = 1;
+  CollapseMesh cm(octahedron());
+  auto modules = standard_constraints(locked);
+  for (auto& m : modules) m->initialize(cm);
+  CollapseCandidate c;
+  c.vs = 0;
+  c.vt = 2;
+  c.position = {0.5, 0.5, 0};
+  const EdgeFaces edge = cm.edge_faces(0, 2);
+  EXPECT_FALSE(modules[0]->allows(cm, c, edge)) << modules[0]->name();
+  c.seam = true;
+  for (auto& m : modules) EXPECT_TRUE(m->allows(cm, c, edge)) << m->name();
+}
+
+// drop_too_small: of a seam collapse's collapses, those in a component that would fall below
+// its smallest form once the ones before them were made stay out; the others go on.
+TEST(Legality, SeamCollapsesInAComponentTooSmallToShrinkAreDropped) {
+  // A lone triangle (vertices 0-2) and a strip of two triangles (3-6, four vertices).
+  const Mesh m =
+      make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 0, 0}, {6, 0, 0}, {5, 1, 0}, {6, 1, 0}},
+                {{0, 1, 2}, {3, 4, 5}, {4, 6, 5}});
+  CollapseMesh cm(m);
+  auto modules = standard_constraints({});
+  for (auto& mod : modules) mod->initialize(cm);
+  auto collapse = [&](VertexId vs, VertexId vt) {
+    CollapseCandidate c;
+    c.vs = vs;
+    c.vt = vt;
+    c.position = cm.position(vs);
+    c.seam = true;
+    return c;
+  };
+  std::vector<CollapseCandidate> collapses{collapse(0, 1), collapse(3, 4), collapse(5, 6)};
+  for (auto& mod : modules) mod->drop_too_small(cm, collapses);
+  // The triangle is at its smallest form; the strip affords one collapse, not two.
+  ASSERT_EQ(collapses.size(), 1u);
+  EXPECT_EQ(collapses[0].vt, 4u);
+}
+
 //     c           Moving b onto a' (far left of a) flips face (b, d, c)... here we collapse
 //    /|\          d into a, which drags the fan around d across the edge b-c.
 //   a-b-d  flat strip below: faces (a,b,c), (b,d,c), (a,e,b), (b,e,d)

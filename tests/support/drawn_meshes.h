@@ -108,6 +108,37 @@ inline Mesh ground_with_patches(int patches, uint64_t seed = 1) {
   return m;
 }
 
+// `sheets` open sheets meeting along one line, as the pages of a book along its spine: the
+// spine runs along x (`length` segments of 1, waving gently in y), and sheet k leaves it at
+// the angle 2 pi k / sheets, `width` quads of 1 wide, bending as it goes. With three sheets or
+// more, every spine edge is non-manifold (the repair splits each spine vertex into one copy
+// per sheet).
+inline Mesh book_of_sheets(int sheets, int length, int width) {
+  Mesh m;
+  auto spine = [](int i) { return Vec3{double(i), 0.2 * std::sin(0.7 * i), 0}; };
+  for (int i = 0; i <= length; ++i) m.positions.push_back(spine(i));
+  for (int k = 0; k < sheets; ++k) {
+    const double angle = 2 * M_PI * k / sheets;
+    const double c = std::cos(angle), s = std::sin(angle);
+    const auto first = VertexId(m.positions.size());
+    for (int j = 1; j <= width; ++j)
+      for (int i = 0; i <= length; ++i) {
+        const double bend = 0.3 * j * j / width;  // along the sheet's normal (-s, c)
+        const Vec3 base = spine(i);
+        m.positions.push_back({base[0], base[1] + j * c - bend * s, base[2] + j * s + bend * c});
+      }
+    auto at = [&](int i, int j) {
+      return j == 0 ? VertexId(i) : first + VertexId((j - 1) * (length + 1) + i);
+    };
+    for (int j = 0; j < width; ++j)
+      for (int i = 0; i < length; ++i) {
+        m.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+        m.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+  }
+  return m;
+}
+
 // A unit sphere (`rings` x `segments`, a multiple of `chart`) whose texture coordinates come
 // in charts of chart x chart quads, each with wedges of its own: UV seams everywhere, as a
 // texture atlas has them. Closed, genus 0.
