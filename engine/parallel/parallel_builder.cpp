@@ -678,6 +678,8 @@ void ParallelBuilder::run_subsets(Round& r) {
   const bool draw_early = rs.round == 0 && parallel_.early_partition;
   std::vector<std::function<void()>> beside_jobs;
   if (draw_early) beside_jobs.push_back(draw_round_one);
+  // The master costs nothing while the jobs run: its caches make way for theirs.
+  master_->release_caches();
   const Beside timed_jobs = run_beside(
       parallel_.threads, [&] { r.results = runner_->run(r.jobs, cancel_); }, beside_jobs);
   r.jobs.clear();

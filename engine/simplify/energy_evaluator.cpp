@@ -33,6 +33,7 @@ Vec3 rounded(Vec3 v, bool to_float) {
 }  // namespace
 
 void EnergyEvaluator::reset(size_t face_capacity) {
+  released_capacity_ = 0;
   moments_.assign(face_capacity, PointMoments{});
   moments_ready_.assign(face_capacity, 0);
   own_.assign(face_capacity, OwnError{});
@@ -40,13 +41,30 @@ void EnergyEvaluator::reset(size_t face_capacity) {
 }
 
 double EnergyEvaluator::corners_moved(FaceId f) {
+  if (released_capacity_) {
+    double max_distance_sq = 0;
+    for (const FacePoint& p : module_.face_points_[f])
+      max_distance_sq = std::max(max_distance_sq, p.distance_sq);
+    return max_distance_sq;
+  }
   moments_of(f);
   moments_ready_[f] = 1;
   return max_distance_sq_[f];
 }
 
+void EnergyEvaluator::release() {
+  if (released_capacity_ || moments_.empty()) return;
+  released_capacity_ = moments_.size();
+  // (Swapped with empty ones: assigning {} would keep their capacity.)
+  std::vector<PointMoments>().swap(moments_);
+  std::vector<uint8_t>().swap(moments_ready_);
+  std::vector<OwnError>().swap(own_);
+  std::vector<double>().swap(max_distance_sq_);
+}
+
 bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                                CollapseCandidate& out, Costing costing, EnergySeam seam) {
+  if (released_capacity_) reset(released_capacity_);
   ++costings_;
   const Survivor survivor = choose_survivor(mesh, a, b, seam.keep);
   if (!survivor.possible) return false;

@@ -61,9 +61,15 @@ class EnergyEvaluator {
   // The per-face caches. reset: none known, for faces up to `face_capacity`. forget: face f's
   // points or corners changed. corners_moved: f keeps its points (their moments stay valid)
   // but its corners moved; returns the largest stored squared distance of its points.
+  // release: frees them (105 bytes per face; a parallel build's master while the jobs run),
+  // until the next evaluate, which starts them anew: they are functions of the points and
+  // corners, so no costing changes.
   void reset(size_t face_capacity);
-  void forget(FaceId f) { moments_ready_[f] = 0; }
+  void forget(FaceId f) {
+    if (!moments_ready_.empty()) moments_ready_[f] = 0;
+  }
   double corners_moved(FaceId f);
+  void release();
 
  private:
   using FacePoint = EnergyFacePoint;
@@ -252,6 +258,7 @@ class EnergyEvaluator {
   std::vector<OwnError> own_;
   // Per face: the largest stored squared distance of its points (kept with its moments).
   std::vector<double> max_distance_sq_;
+  size_t released_capacity_ = 0;  // the face capacity to reset to (release); 0: not released
 };
 
 }  // namespace parapm

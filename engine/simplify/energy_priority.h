@@ -168,6 +168,7 @@ class EnergyPriority : public PriorityModule {
   }
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override { return evaluator_.costings(); }
+  void release_caches() override { evaluator_.release(); }
 
   // State export/import for the parallel construction (module_state.h). export_local: the
   // state of a job's faces and vertices (maps: its local -> global ids; the points on its

@@ -80,6 +80,9 @@ class PriorityModule {
   // build's modules it is the build's work in costings, the figure the parallel build's work
   // is compared with the sequential one's by, free of the machine's timing noise.
   virtual uint64_t costings() const { return 0; }
+  // Frees what the module can rebuild when it next costs an edge (caches), without changing
+  // any costing: the parallel build's master while the jobs of a round run.
+  virtual void release_caches() {}
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every
@@ -91,6 +94,7 @@ class PriorityWrapper : public PriorityModule {
   std::string name() const override { return inner_.name(); }
   bool costly() const override { return inner_.costly(); }
   uint64_t costings() const override { return inner_.costings(); }
+  void release_caches() override { inner_.release_caches(); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override {

@@ -325,6 +325,65 @@ TEST(EnergyCosting, ARequeuedEdgeKeepsItsCostingWhileItsStarStays) {
 // The energy's initialisation parts (its sharp curves, its points and the rest) run side by side
 // in the parallel build; in any order and on other threads, they give the module initialize()
 // gives: the same collapses, bit for bit, on meshes with creases and with attribute seams.
+// release_caches (the parallel build's master while its jobs run) changes no costing: a module
+// whose caches were released, then followed through more collapses, costs every edge as one
+// that kept them, bit for bit.
+TEST(EnergyCosting, ReleasedCachesChangeNoCosting) {
+  const RepairedMesh repaired =
+      repair_mesh(read_mesh(testing::test_data("cad-featuretype-3k.stl")));
+  const Mesh& mesh = repaired.mesh;
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh kept_mesh(mesh), released_mesh(mesh);
+  EnergyPriority kept(locked, EnergyOptions{}), released(locked, EnergyOptions{});
+  Simplifier kept_run(kept_mesh, kept, standard_constraints(locked));
+  Simplifier released_run(released_mesh, released, standard_constraints(locked));
+  SimplifierLimits limits;
+  limits.target_faces = mesh.face_count() / 2;
+  kept_run.run(limits, {}, nullptr);
+  released_run.run(limits, {}, nullptr);
+  // Both modules have costed edges and filled their caches; one forgets them, and both follow
+  // the same further collapses (collapsed() moves corners and points with the caches released).
+  released.release_caches();
+  auto rules = standard_constraints(locked);
+  for (const auto& rule : rules) rule->initialize(kept_mesh);
+  size_t collapses = 0;
+  for_each_edge(kept_mesh, [&](VertexId a, VertexId b) {
+    if (collapses >= 20 || !kept_mesh.vertex_alive(a) || !kept_mesh.vertex_alive(b)) return;
+    CollapseCandidate c;
+    if (!kept.evaluate(kept_mesh, a, b, c, Costing::kPerform)) return;
+    const EdgeFaces edge = kept_mesh.edge_faces(c.vs, c.vt);
+    for (const auto& rule : rules)
+      if (!rule->allows(kept_mesh, c, edge)) return;
+    std::vector<double> errors;  // the records' error bounds, refined by collapsed()
+    for (const auto& pair : {std::pair{&kept_mesh, &kept}, std::pair{&released_mesh, &released}}) {
+      CollapseCandidate done = c;
+      done.vs_before = pair.first->position(c.vs);
+      const EdgeFaces faces = pair.first->edge_faces(c.vs, c.vt);
+      pair.first->collapse(c.vs, c.vt, c.position, faces);
+      pair.second->collapsed(*pair.first, done, faces);
+      errors.push_back(done.error);
+    }
+    EXPECT_EQ(errors[0], errors[1]);
+    for (const auto& rule : rules) rule->collapsed(kept_mesh, c);
+    if (collapses++ == 10) released.release_caches();
+  });
+  ASSERT_GT(collapses, 10u);
+  size_t compared = 0;
+  for_each_edge(kept_mesh, [&](VertexId a, VertexId b) {
+    for (Costing costing : {Costing::kQueue, Costing::kPerform}) {
+      CollapseCandidate x, y;
+      const bool placed = kept.evaluate(kept_mesh, a, b, x, costing);
+      ASSERT_EQ(released.evaluate(released_mesh, a, b, y, costing), placed);
+      if (!placed) continue;
+      EXPECT_EQ(x.vs, y.vs);
+      EXPECT_EQ(x.position, y.position);
+      EXPECT_EQ(x.cost, y.cost) << a << "-" << b;
+      ++compared;
+    }
+  });
+  EXPECT_GT(compared, 1000u);
+}
+
 TEST(EnergyPriority, InitializationPartsSideBySideEqualInitialize) {
   // Keeps the state its parts made: the simplifier would initialise the module again.
   class Initialized : public PriorityWrapper {
