@@ -34,10 +34,11 @@ Vec3 rounded(Vec3 v, bool to_float) {
 
 void EnergyEvaluator::reset(size_t face_capacity) {
   released_capacity_ = 0;
-  moments_.assign(face_capacity, PointMoments{});
-  moments_ready_.assign(face_capacity, 0);
-  own_.assign(face_capacity, OwnError{});
-  max_distance_sq_.assign(face_capacity, 0);
+  // Zeroed pages, given memory as faces are first costed (most of a master's never are).
+  moments_.assign_zeroed(face_capacity);
+  moments_ready_.assign_zeroed(face_capacity);
+  own_.assign_zeroed(face_capacity);
+  max_distance_sq_.assign_zeroed(face_capacity);
 }
 
 double EnergyEvaluator::corners_moved(FaceId f) {
@@ -55,11 +56,10 @@ double EnergyEvaluator::corners_moved(FaceId f) {
 void EnergyEvaluator::release() {
   if (released_capacity_ || moments_.empty()) return;
   released_capacity_ = moments_.size();
-  // (Swapped with empty ones: assigning {} would keep their capacity.)
-  std::vector<PointMoments>().swap(moments_);
-  std::vector<uint8_t>().swap(moments_ready_);
-  std::vector<OwnError>().swap(own_);
-  std::vector<double>().swap(max_distance_sq_);
+  moments_.clear();
+  moments_ready_.clear();
+  own_.clear();
+  max_distance_sq_.clear();
 }
 
 bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,

@@ -23,6 +23,7 @@
 #include "simplify/point_projection.h"
 #include "simplify/quadric.h"
 #include "simplify/sharp_curves.h"
+#include "util/zeroed_array.h"
 
 namespace parapm {
 
@@ -251,13 +252,13 @@ class EnergyEvaluator {
 
   // Per face, the moments of the points projecting onto it (computed when first needed,
   // forgotten when its point list changes).
-  std::vector<PointMoments> moments_;
+  ZeroedArray<PointMoments> moments_;
   // 0: nothing known, 1: moments_, 2: moments_ and own_ (a face's corners move only in a
   // performed collapse, which resets this to 0, or to 1 when the face keeps its points).
-  std::vector<uint8_t> moments_ready_;
-  std::vector<OwnError> own_;
+  ZeroedArray<uint8_t> moments_ready_;
+  ZeroedArray<OwnError> own_;
   // Per face: the largest stored squared distance of its points (kept with its moments).
-  std::vector<double> max_distance_sq_;
+  ZeroedArray<double> max_distance_sq_;
   size_t released_capacity_ = 0;  // the face capacity to reset to (release); 0: not released
 };
 
