@@ -191,6 +191,14 @@ class FaceGeometry : public ConstraintModule {
 
 }  // namespace
 
+std::vector<std::unique_ptr<ConstraintModule>> neighbourhood_constraints() {
+  std::vector<std::unique_ptr<ConstraintModule>> modules;
+  modules.push_back(std::make_unique<BoundaryRule>());
+  modules.push_back(std::make_unique<LinkCondition>());
+  modules.push_back(std::make_unique<FaceGeometry>());
+  return modules;
+}
+
 std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
     const std::vector<uint8_t>& locked, std::shared_ptr<const std::vector<uint32_t>> components,
     bool components_may_vanish) {

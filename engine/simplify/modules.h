@@ -153,4 +153,9 @@ std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
     std::shared_ptr<const std::vector<uint32_t>> components = {},
     bool components_may_vanish = false);
 
+// The standard rules that read only the faces around the edge's ends (boundary, link
+// condition, geometry): what a seam collapse's trial on a copy of those faces checks
+// (Simplifier::join_copies).
+std::vector<std::unique_ptr<ConstraintModule>> neighbourhood_constraints();
+
 }  // namespace parapm

@@ -270,7 +270,7 @@ bool Simplifier::pair_seam(uint32_t from, uint32_t into) {
   for (const auto& module : constraints_) module->drop_too_small(mesh_, pairs);
   seam_pairs_.clear();
   for (const CollapseCandidate& c : pairs) seam_pairs_.push_back({c.vs, c.vt});
-  return !seam_pairs_.empty() && rings_apart();
+  return !seam_pairs_.empty();
 }
 
 bool Simplifier::all_survive(uint32_t into) const {
@@ -299,6 +299,49 @@ bool Simplifier::rings_apart() {
         seam_mark_[v] = mine;
       }
     }
+  }
+  return true;
+}
+
+bool Simplifier::seam_holds_in_turn(const Vec3& place) {
+  // The faces around every end: all that the neighbourhood rules read of each collapse, and
+  // all the earlier collapses change of it.
+  std::vector<FaceId>& faces = seam_faces_;
+  faces.clear();
+  for (const SeamPair& p : seam_pairs_)
+    for (VertexId end : {p.vs, p.vt})
+      faces.insert(faces.end(), mesh_.faces_of(end).begin(), mesh_.faces_of(end).end());
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  Mesh local;
+  std::vector<std::pair<VertexId, VertexId>> ids;  // (mesh id, local id), sorted by mesh id
+  auto local_id = [&](VertexId v) {
+    const auto at = std::lower_bound(ids.begin(), ids.end(), std::pair{v, VertexId(0)});
+    return at != ids.end() && at->first == v ? at->second : kNoId;
+  };
+  for (FaceId f : faces)
+    for (VertexId v : mesh_.face(f))
+      if (local_id(v) == kNoId) {
+        ids.insert(std::lower_bound(ids.begin(), ids.end(), std::pair{v, VertexId(0)}),
+                   {v, VertexId(local.positions.size())});
+        local.positions.push_back(mesh_.position(v));
+      }
+  for (FaceId f : faces) {
+    const Triangle& t = mesh_.face(f);
+    local.faces.push_back({local_id(t[0]), local_id(t[1]), local_id(t[2])});
+  }
+  CollapseMesh trial(local);
+  if (seam_rules_.empty()) seam_rules_ = neighbourhood_constraints();
+  for (const SeamPair& p : seam_pairs_) {
+    CollapseCandidate c;
+    c.vs = local_id(p.vs);
+    c.vt = local_id(p.vt);
+    c.position = place;
+    c.seam = true;
+    const EdgeFaces edge = trial.edge_faces(c.vs, c.vt);
+    for (const auto& rule : seam_rules_)
+      if (!rule->allows(trial, c, edge)) return false;
+    trial.collapse(c.vs, c.vt, c.position, edge);
   }
   return true;
 }
@@ -373,6 +416,12 @@ bool Simplifier::perform_seam(const CollapseCandidate& seam, const SimplifierLim
       return false;
     }
   }
+  // Where one collapse can change what another's rules read, they are tried in turn first.
+  const bool in_turn = !rings_apart();
+  if (in_turn && !seam_holds_in_turn(place)) {
+    reject(pairs[0].vs, pairs[0].vt);
+    return false;
+  }
 
   for (size_t i = 0; i < pairs.size(); ++i) {
     // Costed on the mesh the earlier collapses left (the records' errors), checked again.
@@ -392,6 +441,7 @@ bool Simplifier::perform_seam(const CollapseCandidate& seam, const SimplifierLim
     requeue_around(c.vs, c.vt, limits);
   }
   ++stats_.seam_collapses;
+  stats_.seams_in_turn += in_turn;
   return true;
 }
 

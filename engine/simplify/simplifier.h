@@ -129,6 +129,7 @@ struct SimplifierStats {
   uint64_t compactions = 0;     // passes dropping the queue's stale entries at once
   uint64_t over_ceiling = 0;    // popped edges whose cost was above SimplifierLimits::max_cost
   uint64_t seam_collapses = 0;  // performed (join_copies), each one record per copy removed
+  uint64_t seams_in_turn = 0;   // of those, tried in turn first (their rings overlap)
   // Seam collapses stopped midway: an earlier copy's collapse made a later one's illegal (the
   // group's remaining copies leave in a later seam collapse).
   uint64_t seams_split = 0;
@@ -153,10 +154,11 @@ class Simplifier {
   // summed cost (PriorityModule::evaluate_seam) among where they are and where each
   // collapse alone would put its survivor. The cheaper way round is taken. A copy in a part
   // too small to shrink (ConstraintModule::drop_too_small) stays where it is, beside the seam.
-  // Legal when the collapses' rings (both ends and their neighbours) are apart, so that none
-  // changes what another's legality reads, and each is legal on the mesh before the first
-  // (each is checked again before it is made). Its records follow one another; a run does not
-  // stop between them, not even at its target. A group of more than kMaxSeamCopies live
+  // Legal when each collapse is legal on the mesh before the first and, unless their rings
+  // (both ends and their neighbours) are apart, so that none changes what another's rules
+  // read, when they pass the neighbourhood rules made in turn on a copy of the faces around
+  // their ends (each is checked again before it is made). Its records follow one another; a run
+  // does not stop between them, not even at its target. A group of more than kMaxSeamCopies live
   // copies stays. Off (null) by default; `groups` must outlive the run.
   void join_copies(const CopyGroups* groups) { groups_ = groups; }
   static constexpr size_t kMaxSeamCopies = 16;
@@ -226,12 +228,16 @@ class Simplifier {
   // Every live copy of group `from` (as vt) with the copy of group `into` adjacent to it of
   // the smallest id (as vs), into seam_pairs_, but for copies in parts too small to shrink
   // (ConstraintModule::drop_too_small: they stay); false when a copy has no such neighbour,
-  // when there are too many copies or none to collapse, or when the rings are not apart.
+  // or when there are too many copies or none to collapse.
   bool pair_seam(uint32_t from, uint32_t into);
   // Whether every live copy of group `into` is a survivor in seam_pairs_.
   bool all_survive(uint32_t into) const;
-  // Whether seam_pairs_' rings (both ends and their neighbours) are apart.
+  // Whether seam_pairs_' rings (both ends and their neighbours) are apart: then no collapse
+  // changes what another's rules read.
   bool rings_apart();
+  // Whether seam_pairs_' collapses, made one after the other with the survivors at `place`,
+  // each pass the neighbourhood rules: tried on a copy of the faces around their ends.
+  bool seam_holds_in_turn(const Vec3& place);
   // The seam_pairs_' collapses with the survivors at `at`: their summed cost, the largest
   // error, the first's candidate.
   bool cost_seam_at(const Vec3& at, Costing costing, CollapseCandidate& out);
@@ -266,6 +272,8 @@ class Simplifier {
   std::vector<Vec3> seam_places_;
   std::vector<CollapseCandidate> seam_planned_;
   std::vector<uint32_t> seam_mark_;  // per vertex: the pair whose ring holds it (rings_apart)
+  std::vector<FaceId> seam_faces_;
+  std::vector<std::unique_ptr<ConstraintModule>> seam_rules_;  // neighbourhood_constraints()
   uint32_t seam_stamp_ = 0;
   std::vector<VertexId> ring_, seam_ring_;
   std::vector<std::pair<VertexId, VertexId>> retry_;

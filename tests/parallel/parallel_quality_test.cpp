@@ -7,7 +7,8 @@
 //
 // What is asserted, per mesh and metric, as regression guards with a margin over the figures
 // measured now: the median RMS ratio over the (p, level) cells within 10% (measured: 1.00-1.03),
-// the median of the 10% cells alone (the level the rounds hand over at) within 10% (0.98-1.02),
+// the median of the 10% cells alone (the level the rounds hand over at) within 10% (0.98-1.02;
+// the CAD part 15%, below),
 // the worst cell under RMS 1.35 (1.12; the CAD part 1.5 and the energy's pooled cells 1.6, below)
 // and Hausdorff 2.6 (1.87). Issue 5's target, every cell within 5% (RMS) and 10% (Hausdorff),
 // is not met on these small meshes (at p = 16 the bunny's subsets hold 600 faces); it is on the
@@ -50,9 +51,10 @@ struct Ratios {
   }
 };
 
-void expect_near_sequential(const Ratios& r, const std::string& name, double worst_rms = 1.35) {
+void expect_near_sequential(const Ratios& r, const std::string& name, double worst_rms = 1.35,
+                            double handover_rms = 1.10) {
   EXPECT_LE(median(r.rms), 1.10) << name;
-  EXPECT_LE(median(r.handover_rms), 1.10) << name << ": the rounds' last level is uneven";
+  EXPECT_LE(median(r.handover_rms), handover_rms) << name << ": the rounds' last level is uneven";
   EXPECT_LE(r.worst_rms, worst_rms) << name;
   EXPECT_LE(r.worst_hausdorff, 2.6) << name;
 }
@@ -99,14 +101,18 @@ Ratios compare(const std::string& name, const RepairedMesh& repaired,
 // The CAD part's worst cell is guarded at 1.5: its 2% level is below its legal minimum (about
 // 2.1k faces: copies of non-manifold vertices whose seam collapses are vetoed), so it is the
 // base, whose last hundred collapses, the dearest legal ones, double its error; which of them
-// remain moves with the rounds (measured: 1.00-1.04 at p = 2-8, 1.46 at p = 16).
+// remain moves with the rounds (measured: 1.00-1.03 at p = 2-8, 1.46 at p = 16). Its 10% cells
+// (the rounds' last level), at 1.15: the seam collapses that make its sequential 10% level a
+// third closer to the input than locked copies did, the rounds make only where a group's
+// copies and their rings lie free inside one job (measured: 0.99-1.20, median 1.13).
 TEST(ParallelQuality, QuadricLevelsMatchTheSequentialOnes) {
   for (const char* name :
        {"cad-cycloidal-43k.ply", "gmsh-aneurysm-20k.stl.gz", "pymeshlab-bunny-textured-10k.obj"}) {
     SimplifyOptions options;
     options.target_ratio = 0.01;
+    const bool cad = name == std::string("cad-cycloidal-43k.ply");
     expect_near_sequential(compare(name, repaired_test_mesh(name), options, {2, 4, 8, 16}), name,
-                           name == std::string("cad-cycloidal-43k.ply") ? 1.5 : 1.35);
+                           cad ? 1.5 : 1.35, cad ? 1.15 : 1.10);
   }
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
@@ -10,6 +11,7 @@
 #include "drawn_meshes.h"
 #include "io/mesh_io.h"
 #include "mesh/repair.h"
+#include "simplify/copy_groups.h"
 #include "simplify/quadric_priority.h"
 #include "simplify/simplifier.h"
 #include "simplify/simplify.h"
@@ -430,6 +432,46 @@ TEST(Simplifier, ACostCeilingTakesTheCollapsesBelowItInOrder) {
     if (std::string(metric) == "quadric") {  // nothing deferred: every cheaper collapse taken
       EXPECT_GE(limited.size(), first_above);
     }
+  }
+}
+
+// Seam collapses whose rings overlap (a fin standing on a plane, along a line that ends inside
+// it: near the line's ends the plane's two sides share the survivor) are tried in turn first,
+// and none stops halfway: at the end every group's live copies (but those of parts too small
+// to shrink) are at one place, with either metric.
+TEST(Simplifier, SeamCollapsesWithOverlappingRingsAreTriedInTurn) {
+  const RepairedMesh repaired = repair_mesh(testing::plane_with_fin(16, 3, 12, 3));
+  ASSERT_GT(repaired.report.vertex_copies_added, 10u);
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const CopyGroups groups = copy_groups(repaired);
+  for (const char* metric : {"quadric", "energy"}) {
+    SimplifyOptions options;
+    options.metric = metric;
+    CollapseMesh cm(repaired.mesh);
+    const std::unique_ptr<PriorityModule> priority =
+        make_priority_module(options, repaired.mesh, locked);
+    Simplifier simplifier(cm, *priority, standard_constraints(locked));
+    simplifier.join_copies(&groups);
+    SimplifierLimits limits;
+    limits.target_faces = 40;
+    simplifier.run(limits, {}, nullptr);
+    const SimplifierStats& stats = simplifier.stats();
+    EXPECT_GT(stats.seams_in_turn, 0u) << metric;
+    EXPECT_GT(stats.seam_collapses, stats.seams_in_turn) << metric;
+    EXPECT_EQ(stats.seams_split, 0u) << metric;
+    size_t apart = 0;
+    for (uint32_t g = 0; g + 1 < groups.offsets.size(); ++g) {
+      const Vec3* place = nullptr;
+      for (VertexId copy : groups.of(g)) {
+        if (!cm.vertex_alive(copy)) continue;
+        if (!place) place = &cm.position(copy);
+        apart += cm.position(copy) != *place;
+      }
+    }
+    EXPECT_EQ(apart, 0u) << metric << ": copies of a group apart";
+    std::printf("%s: %zu faces left, %llu seam collapses, %llu of them tried in turn\n", metric,
+                cm.live_faces(), (unsigned long long)stats.seam_collapses,
+                (unsigned long long)stats.seams_in_turn);
   }
 }
 

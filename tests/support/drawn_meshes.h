@@ -139,6 +139,41 @@ inline Mesh book_of_sheets(int sheets, int length, int width) {
   return m;
 }
 
+// A square plane (z = 0, n x n quads of 1, waving gently) with a fin standing on it along
+// part of its middle row (columns first..last, `height` quads of 1 up, bending as it goes):
+// the line is non-manifold (the plane's two sides and the fin meet there), and it ends inside
+// the plane, whose sides join around its ends.
+inline Mesh plane_with_fin(int n, int first, int last, int height) {
+  Mesh m;
+  auto plane = [&](int i, int j) {
+    return Vec3{double(i), double(j), 0.05 * std::sin(0.9 * i) * std::cos(0.7 * j)};
+  };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) m.positions.push_back(plane(i, j));
+  auto at = [n](int i, int j) { return VertexId(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      m.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      m.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  const int row = n / 2;
+  const auto fin = VertexId(m.positions.size());
+  for (int k = 1; k <= height; ++k)
+    for (int i = first; i <= last; ++i) {
+      const Vec3 base = plane(i, row);
+      m.positions.push_back({base[0], base[1] + 0.1 * k * k / height, base[2] + k});
+    }
+  auto up = [&](int i, int k) {
+    return k == 0 ? at(i, row) : fin + VertexId((k - 1) * (last - first + 1) + (i - first));
+  };
+  for (int k = 0; k < height; ++k)
+    for (int i = first; i < last; ++i) {
+      m.faces.push_back({up(i, k), up(i + 1, k), up(i + 1, k + 1)});
+      m.faces.push_back({up(i, k), up(i + 1, k + 1), up(i, k + 1)});
+    }
+  return m;
+}
+
 // A unit sphere (`rings` x `segments`, a multiple of `chart`) whose texture coordinates come
 // in charts of chart x chart quads, each with wedges of its own: UV seams everywhere, as a
 // texture atlas has them. Closed, genus 0.
