@@ -403,12 +403,10 @@ bool Simplifier::perform_seam(const CollapseCandidate& seam, const SimplifierLim
   if (place != mesh_.position(pairs[0].vs) && !all_survive(into)) return false;
   // Each collapse legal on the mesh as it is (a veto is remembered on that edge, whose star
   // changing costs the seam again).
-  std::vector<CollapseCandidate>& planned = seam_planned_;
-  planned.assign(pairs.size(), CollapseCandidate{});
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    CollapseCandidate& c = planned[i];
-    c.vs = pairs[i].vs;
-    c.vt = pairs[i].vt;
+  for (const SeamPair& p : pairs) {
+    CollapseCandidate c;
+    c.vs = p.vs;
+    c.vt = p.vt;
     c.position = place;
     c.seam = true;
     if (!legal(c, mesh_.edge_faces(c.vs, c.vt))) {
