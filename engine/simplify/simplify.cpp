@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "simplify/copy_groups.h"
 #include "simplify/energy_priority.h"
 #include "simplify/pm_builder.h"
 #include "simplify/quadric_priority.h"
@@ -57,16 +58,10 @@ void check_simplify_options(const SimplifyOptions& options) {
 }
 
 std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired, bool free_copies) {
-  const Mesh& mesh = repaired.mesh;
-  std::vector<uint8_t> locked(mesh.vertex_count(), 0);
-  if (repaired.input_vertex.empty() || free_copies) return locked;
-  std::vector<uint32_t> uses(mesh.vertex_count(), 0);
-  for (VertexId in : repaired.input_vertex) {
-    if (in >= uses.size()) uses.resize(size_t(in) + 1, 0);
-    ++uses[in];
-  }
-  for (VertexId v = 0; v < mesh.vertex_count(); ++v)
-    if (uses[repaired.input_vertex[v]] > 1) locked[v] = 1;
+  std::vector<uint8_t> locked(repaired.mesh.vertex_count(), 0);
+  if (free_copies) return locked;
+  const CopyGroups groups = copy_groups(repaired);
+  for (VertexId v : groups.members) locked[v] = 1;
   return locked;
 }
 
