@@ -24,7 +24,7 @@ struct SimplifyArgs {
   uint64_t faces = 0;
   double ratio = 0;
   std::string metric = "quadric";
-  double samples_per_face = 0;
+  double samples_per_face = SimplifyOptions{}.samples_per_face;
   double crease_angle = 60;
   double attribute_weight = 0.01;
   EnergyTuning energy;
@@ -232,7 +232,8 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--samples-per-face", args->samples_per_face,
                   "Energy metric: extra points drawn on the input per face, by area, beyond "
-                  "one per vertex")
+                  "one per vertex: they measure the surface between the vertices (0: the "
+                  "vertices only, about a fifth faster, coarser levels less faithful)")
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   cmd->add_option("--crease-angle", args->crease_angle,

@@ -33,7 +33,7 @@ namespace parapm {
 // whole mesh knows).
 struct SubsetOptions {
   std::string metric = "quadric";  // "quadric" or "energy"
-  double samples_per_face = 0;
+  double samples_per_face = 1;
   double crease_angle_degrees = 60;
   double attribute_weight = 0.01;
   EnergyTuning energy;

@@ -24,6 +24,12 @@ bool has_plane(double n_sq, const Vec3& q0, const Vec3& q1, const Vec3& q2) {
   return n_sq > 1e-12 * dot(e1, e1) * dot(e2, e2) && n_sq > 0;
 }
 
+// Whether two faces' normals (any length) are parallel within about a degree.
+bool in_one_plane(const Vec3& n, const Vec3& m) {
+  const double c = dot(n, m);
+  return c > 0 && c * c > 0.9997 * dot(n, n) * dot(m, m);
+}
+
 Vec3 rounded(Vec3 v, bool to_float) {
   if (to_float)
     for (double& c : v) c = round_to_float(c);
@@ -74,7 +80,7 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   if (scratch_.star.empty())  // no face left around either end: a component's last faces
     return module_.options_.components_may_vanish &&
            evaluate_removal(mesh, a, b, survivor, seam.at, out);
-  const StarPoints points = gather_star_points(link_fan(sums, a, b));
+  const StarPoints points = gather_star_points(mesh, link_fan(sums, a, b));
   const Before before = energy_before(mesh, a, b, points.by_moments);
   Placing placing;
   placing.by_moments = points.by_moments;
@@ -89,7 +95,7 @@ bool EnergyEvaluator::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   out.position = chosen.v;
   out.cost = chosen.energy - before.distance_sq - before.curves_sq;
   out.error = std::sqrt(chosen.max_distance_sq);
-  if (points.by_moments) out.cost += moment_rim_change(mesh, chosen.v);
+  if (points.by_moments) out.cost += moment_rim_change(mesh, chosen.v, points.reprojected);
   if (module_.scalar_.enabled()) out.cost += attribute_change(placing, chosen);
   // Penalised, not forbidden (Hoppe 96), at a price per point of the star.
   if (survivor.topology) out.cost += module_.topology_price_ * std::max(1.0, points.points_around);
@@ -436,23 +442,24 @@ double EnergyEvaluator::link_fan(const StarSums& sums, VertexId a, VertexId b) {
   return parked_around;
 }
 
-EnergyEvaluator::StarPoints EnergyEvaluator::gather_star_points(double parked_around) {
+EnergyEvaluator::StarPoints EnergyEvaluator::gather_star_points(const CollapseMesh& mesh,
+                                                                double parked_around) {
   // How many points the star holds: the faces' counts are their moments' (kept per face).
   size_t in_faces = 0;
   for (const auto& list : scratch_.lists) in_faces += module_.face_points_[list.first].size();
   const size_t total = in_faces + scratch_.parked_ends.size();
   const double points_around = double(total) + parked_around;
-  const size_t cap = std::max<uint32_t>(1, module_.options_.max_points_per_evaluation);
   // A star with more points than cap is placed and costed on its faces' point moments, in
   // O(faces) whatever its points (moment_solve, moment_distance_after): late collapses cover
   // hundreds of points. A smaller one projects each point, exactly. With E_scalar the points
   // are gathered either way: the attributes need where each one lands.
+  const size_t cap = std::max<uint32_t>(1, module_.options_.max_points_per_evaluation);
   const bool by_moments = total > cap;
   scratch_.point_weight = 1;
   const size_t sampled = module_.options_.max_sampled_points;
   auto gather_all = [&] {
     for (const auto& [f, home] : scratch_.lists)
-      gather_face(f, home < 0 ? scratch_.edge_face_homes[-2 - home] : home);
+      gather_face(mesh, f, home < 0 ? scratch_.edge_face_homes[-2 - home] : home);
     scratch_.points.insert(scratch_.points.end(), scratch_.parked_ends.begin(),
                            scratch_.parked_ends.end());
     scratch_.homes.insert(scratch_.homes.end(), scratch_.parked_end_homes.begin(),
@@ -480,7 +487,10 @@ EnergyEvaluator::StarPoints EnergyEvaluator::gather_star_points(double parked_ar
       scratch_.point_weight = double(total) / double(scratch_.points.size());
     }
   }
-  return {by_moments, points_around};
+  const uint32_t reprojection_cap = module_.options_.max_points_per_reprojection;
+  const bool reprojected =
+      module_.scalar_.enabled() || reprojection_cap == 0 || in_faces <= reprojection_cap;
+  return {by_moments, points_around, reprojected};
 }
 
 void EnergyEvaluator::set_star_terms(StarSums& sums, double points_around) {
@@ -506,14 +516,21 @@ void EnergyEvaluator::set_star_terms(StarSums& sums, double points_around) {
   }
 }
 
-void EnergyEvaluator::gather_face(FaceId f, int home) {
+void EnergyEvaluator::gather_face(const CollapseMesh& mesh, FaceId f, int home) {
   const auto& list = module_.face_points_[f];
   const size_t first = scratch_.points.size();
   scratch_.points.insert(scratch_.points.end(), list.begin(), list.end());
   scratch_.homes.insert(scratch_.homes.end(), list.size(), home);
-  if (module_.drift_[f] != 0)  // rare: a face left with its points by a rich star's collapse
+  // Rare, and the star is small (costed point by point). The drift's bound would do for an
+  // error but not for the energy before the collapse: inflated, it would make every collapse
+  // that measures these points again look cheap.
+  if (module_.drift_[f] != 0) {
+    const Triangle& t = mesh.face(f);
+    const Vec3 &q0 = mesh.position(t[0]), &q1 = mesh.position(t[1]), &q2 = mesh.position(t[2]);
     for (size_t i = first; i < scratch_.points.size(); ++i)
-      scratch_.points[i].distance_sq = module_.bounded_distance_sq(f, scratch_.points[i]);
+      scratch_.points[i].distance_sq =
+          project_on_triangle(scratch_.points[i].position, q0, q1, q2).distance_sq;
+  }
 }
 
 const PointMoments& EnergyEvaluator::moments_of(FaceId f) {
@@ -535,7 +552,7 @@ const EnergyEvaluator::OwnError& EnergyEvaluator::own_error_of(const CollapseMes
   if (moments_ready_[f] != 2) {
     const Triangle& t = mesh.face(f);
     const Vec3 &q0 = mesh.position(t[0]), &q1 = mesh.position(t[1]), &q2 = mesh.position(t[2]);
-    own_[f] = {plane_distance_sq(f, q0, q1, q2), rim_sq(f, q0, q1, q2)};
+    own_[f] = {plane_distance_sq(f, q0, q1, q2), rim_sq(f, q0, q1, q2, RimAround::kOwn)};
     moments_ready_[f] = 2;
   }
   return own_[f];
@@ -558,11 +575,11 @@ double EnergyEvaluator::plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& 
 
 // A lower bound of how far face f's points lie outside the triangle (q0, q1, q2) within its
 // plane, which the plane distances leave out: count x (the mean's in-plane distance)^2, since
-// the squared distance to a convex set is convex (Jensen). With `star_face` (after the
-// collapse, q0 the moving vertex) the mean may also lie on the faces beside it in the fan,
-// as a point may move there. 0 for a thin triangle (measured exactly by plane_distance_sq).
+// the squared distance to a convex set is convex (Jensen), with the mean also tried on the
+// faces `around` it (RimAround), where a point may move. 0 for a thin triangle (measured
+// exactly by plane_distance_sq).
 double EnergyEvaluator::rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2,
-                               int star_face) {
+                               RimAround around, int star_face, const CollapseMesh* mesh) {
   const PointMoments& m = moments_of(f);
   if (m.count == 0) return 0;
   const Vec3 n = triangle_normal(q0, q1, q2);
@@ -577,27 +594,74 @@ double EnergyEvaluator::rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const V
   const double h = dot(n, w);
   const double h_sq = h * h / n_sq;
   double closest = project_on_triangle(m.mean, q0, q1, q2).distance_sq;
-  if (star_face >= 0)
-    for (const int beside : {scratch_.star[star_face].next, scratch_.star[star_face].previous})
-      if (beside >= 0 && closest > h_sq)
-        closest = std::min(closest, project_on_triangle(m.mean, q0, scratch_.star[beside].p1,
-                                                        scratch_.star[beside].p2)
-                                        .distance_sq);
+  auto try_triangle = [&](const Vec3& t0, const Vec3& t1, const Vec3& t2) {
+    if (closest > h_sq)
+      closest = std::min(closest, project_on_triangle(m.mean, t0, t1, t2).distance_sq);
+  };
+  const auto& star = scratch_.star;
+  switch (around) {
+    case RimAround::kOwn:
+      break;
+    case RimAround::kBeside:  // q0 is the moving vertex after the collapse
+      for (const int j : {star[star_face].next, star[star_face].previous})
+        if (j >= 0) try_triangle(q0, star[j].p1, star[j].p2);
+      break;
+    case RimAround::kStarAfter:
+      for (size_t j = 0; j < star.size(); ++j)
+        if (int(j) != star_face) try_triangle(q0, star[j].p1, star[j].p2);
+      break;
+    case RimAround::kStarBefore:
+      for (const StarFace& face : star) try_triangle(face.before, face.p1, face.p2);
+      for (const FaceId removed : scratch_.edge_faces)
+        if (removed != kNoId) {
+          const Triangle& t = mesh->face(removed);
+          try_triangle(mesh->position(t[0]), mesh->position(t[1]), mesh->position(t[2]));
+        }
+      break;
+  }
   return closest > h_sq ? m.count * (closest - h_sq) : 0;
 }
 
 // The change of the rim bound (rim_sq) over the star when the moving vertex goes to v. Added
 // to the cost at the chosen placement only: the placements are compared on the planes.
-double EnergyEvaluator::moment_rim_change(const CollapseMesh& mesh, const Vec3& v) {
+double EnergyEvaluator::moment_rim_change(const CollapseMesh& mesh, const Vec3& v,
+                                          bool reprojected) {
+  // A star that is flat, before and after, and whose points the collapse projects again: a
+  // point that leaves its face lands on another at no distance, so the mean is tried on the
+  // whole star, before and after alike. Else on its own face before, and beside it in the fan
+  // after (where a curved star's points may go, and a kept one's stay).
+  Vec3 normal{};
+  bool flat = reprojected;
+  auto same_plane = [&](const Vec3& m) {
+    if (dot(normal, normal) == 0) normal = m;
+    flat = flat && in_one_plane(normal, m);
+  };
+  for (const StarFace& face : scratch_.star) {
+    if (!flat) break;
+    same_plane(triangle_normal(face.before, face.p1, face.p2));
+    same_plane(triangle_normal(v, face.p1, face.p2));
+  }
+  for (const FaceId removed : scratch_.edge_faces)
+    if (flat && removed != kNoId) {
+      const Triangle& t = mesh.face(removed);
+      same_plane(triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2])));
+    }
+  auto before = [&](FaceId f) {
+    if (!flat) return own_error_of(mesh, f).rim_sq;
+    const Triangle& t = mesh.face(f);
+    return rim_sq(f, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]),
+                  RimAround::kStarBefore, -1, &mesh);
+  };
+  const RimAround after = flat ? RimAround::kStarAfter : RimAround::kBeside;
   double change = 0;
   for (size_t j = 0; j < scratch_.star.size(); ++j)
-    change += rim_sq(scratch_.star[j].source, v, scratch_.star[j].p1, scratch_.star[j].p2, int(j)) -
-              own_error_of(mesh, scratch_.star[j].source).rim_sq;
+    change += rim_sq(scratch_.star[j].source, v, scratch_.star[j].p1, scratch_.star[j].p2, after,
+                     int(j)) -
+              before(scratch_.star[j].source);
   for (int e = 0; e < 2; ++e)
     if (const FaceId f = scratch_.edge_faces[e]; f != kNoId) {
       const StarFace& home = scratch_.star[scratch_.edge_face_homes[e]];
-      change += rim_sq(f, v, home.p1, home.p2, scratch_.edge_face_homes[e]) -
-                own_error_of(mesh, f).rim_sq;
+      change += rim_sq(f, v, home.p1, home.p2, after, scratch_.edge_face_homes[e]) - before(f);
     }
   return change;
 }

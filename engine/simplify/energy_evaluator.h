@@ -149,8 +149,12 @@ class EnergyEvaluator {
   struct StarPoints {
     bool by_moments = false;
     double points_around = 0;  // the points the star holds, its rim's parked half included
+    // The collapse, performed, projects every point of the star again (EnergyPriority::collapsed
+    // leaves a star richer than max_points_per_reprojection its faces' points): a point may
+    // then go to any face of the star.
+    bool reprojected = true;
   };
-  StarPoints gather_star_points(double parked_around);
+  StarPoints gather_star_points(const CollapseMesh& mesh, double parked_around);
   // 5. The energy before the collapse (its points' and its curves'), the springs, and
   //    scratch_.terms: the star's planes and its volume, weighted for points_around points.
   struct Before {
@@ -198,12 +202,19 @@ class EnergyEvaluator {
                         const Vec3* at, CollapseCandidate& out);
 
   // The measures and solves the steps share.
-  void gather_face(FaceId f, int home);
+  // Face f's points into scratch_.points, with their distances to f as it is now (a face left
+  // with its points by a rich star's collapse holds stale ones: EnergyPriority::drift_).
+  void gather_face(const CollapseMesh& mesh, FaceId f, int home);
   const PointMoments& moments_of(FaceId f);
   const OwnError& own_error_of(const CollapseMesh& mesh, FaceId f);
   double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2);
-  double rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2, int star_face = -1);
-  double moment_rim_change(const CollapseMesh& mesh, const Vec3& v);
+  // Where rim_sq tries the mean besides (q0, q1, q2): nowhere; the faces beside star face
+  // `star_face` after the collapse; every face of the star after it; every face of the star
+  // before it (the removed two included, read from `mesh`).
+  enum class RimAround { kOwn, kBeside, kStarAfter, kStarBefore };
+  double rim_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2, RimAround around,
+                int star_face = -1, const CollapseMesh* mesh = nullptr);
+  double moment_rim_change(const CollapseMesh& mesh, const Vec3& v, bool reprojected);
   double exact_distance_sq() const;
   double moment_distance_before(const CollapseMesh& mesh);
   double moment_distance_after(const Vec3& v);

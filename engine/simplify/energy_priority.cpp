@@ -17,6 +17,21 @@
 #include "util/error.h"
 
 namespace parapm {
+namespace {
+
+// The longest edge of face f.
+double face_size(const CollapseMesh& mesh, FaceId f) {
+  const Triangle& t = mesh.face(f);
+  double longest_sq = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 e = sub(mesh.position(t[(k + 1) % 3]), mesh.position(t[k]));
+    longest_sq = std::max(longest_sq, dot(e, e));
+  }
+  return std::sqrt(longest_sq);
+}
+
+}  // namespace
+
 double EnergyPriority::topology_price(double diagonal) {
   const double moved = EnergyPriority::kTopologyPrice * diagonal;
   return moved * moved;
@@ -178,8 +193,15 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
     const Vec3 to_s = sub(done.position, done.vs_before);
     const Vec3 to_t = sub(done.position, mesh.position(done.vt));  // (vt keeps its position)
     const double shift = std::sqrt(std::max(dot(to_s, to_s), dot(to_t, to_t)));
-    for (FaceId f : faces) {
+    for (size_t j = 0; j < faces.size(); ++j) {
+      const FaceId f = faces[j];
       if (face_points_[f].empty()) continue;
+      // A face whose corners have moved by more than a quarter of its size since its points
+      // were projected no longer lies over them: they are projected again.
+      if (drift_[f] + shift > 0.25 * face_size(mesh, f)) {
+        take(f, int(j));
+        continue;
+      }
       // The points are the same (their moments too), the corners not.
       const double stored_sq = evaluator_.corners_moved(f);
       drift_[f] += shift;

@@ -34,8 +34,11 @@
 // points (the last collapses of a large mesh: thousands) only re-projects the points of the
 // two faces it removes and the samples of its vertices, and the other faces keep theirs, their
 // moments still valid: O(faces) again. Such a face's stored distances then lag behind its
-// corners; it keeps a bound of how far they moved (drift_), and every distance read from it
-// is stored distance + drift, an upper bound (the error recorded in the PM stays one).
+// corners; it keeps a bound of how far they moved (drift_), and every distance it reports is
+// stored distance + drift, an upper bound (the error recorded in the PM stays one). Once its
+// corners have moved by a quarter of its size, its points no longer lie over it: the next such
+// collapse projects them again. A costing that projects a face's points measures their
+// distances to it afresh: the bound is an error's, not the energy's.
 //
 // Two terms from Lindstrom and Turk ("Fast and memory efficient polygonal simplification", 98)
 // join Hoppe's, for what one point per vertex does not see: the surface between the points.

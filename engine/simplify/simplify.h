@@ -36,7 +36,10 @@ struct SimplifyOptions {
   // "quadric": Garland-Heckbert quadrics, fast. "energy": Hoppe's mesh-optimisation energy,
   // points sampled on the input measured against the mesh (energy_priority.h).
   std::string metric = "quadric";
-  double samples_per_face = 0;  // energy: extra area-weighted points beyond one per vertex
+  // energy: extra points drawn by area, per face, beyond one per vertex: they see the surface
+  // between the vertices, which the coarse collapses of a flat or sparsely sampled region cut
+  // (docs/DECISIONS.md, "One extra point per face").
+  double samples_per_face = 1;
   // energy: an edge whose faces' normals differ by more is a crease, kept as a curve (E_disc)
   double crease_angle_degrees = 60;
   // energy: E_scalar's weight of attributes (colours, normals, texture coordinates) against

@@ -32,6 +32,9 @@ Round run_round(const std::string& name, const std::string& metric, uint32_t p) 
   round.partition = partition_mesh(mesh, p);
   SubsetOptions options;
   options.metric = metric;
+  // One point per vertex: a job's energy then samples its subset as the whole mesh's does
+  // (expect_interleavings_commute replays the jobs' records on the whole mesh).
+  options.samples_per_face = 0;
   options.reference_diagonal = bounding_box(mesh).diagonal();
   const CollapseMesh whole(mesh);
   round.jobs = extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float,
@@ -193,6 +196,7 @@ void expect_interleavings_commute(const std::string& name, const std::string& me
     CollapseMesh whole(mesh);
     SimplifyOptions options;
     options.metric = metric;
+    options.samples_per_face = 0;  // as the jobs' (run_round)
     auto priority = make_priority_module(options, mesh, locked_vertices(round.repaired));
     priority->initialize(whole);
     ReplayReport report;
