@@ -487,10 +487,7 @@ EnergyEvaluator::StarPoints EnergyEvaluator::gather_star_points(const CollapseMe
       scratch_.point_weight = double(total) / double(scratch_.points.size());
     }
   }
-  const uint32_t reprojection_cap = module_.options_.max_points_per_reprojection;
-  const bool reprojected =
-      module_.scalar_.enabled() || reprojection_cap == 0 || in_faces <= reprojection_cap;
-  return {by_moments, points_around, reprojected};
+  return {by_moments, points_around, module_.reprojects_every_point(in_faces)};
 }
 
 void EnergyEvaluator::set_star_terms(StarSums& sums, double points_around) {

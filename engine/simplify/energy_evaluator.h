@@ -149,9 +149,8 @@ class EnergyEvaluator {
   struct StarPoints {
     bool by_moments = false;
     double points_around = 0;  // the points the star holds, its rim's parked half included
-    // The collapse, performed, projects every point of the star again (EnergyPriority::collapsed
-    // leaves a star richer than max_points_per_reprojection its faces' points): a point may
-    // then go to any face of the star.
+    // The collapse, performed, projects every point of the star again
+    // (EnergyPriority::reprojects_every_point): a point may then go to any face of the star.
     bool reprojected = true;
   };
   StarPoints gather_star_points(const CollapseMesh& mesh, double parked_around);

@@ -152,8 +152,7 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   for (FaceId f : {edge.left, edge.right})
     if (f != kNoId) in_star += face_points_[f].size();
   for (FaceId f : faces) in_star += face_points_[f].size();
-  const uint32_t cap = options_.max_points_per_reprojection;
-  const bool keep_faces = !scalar_.enabled() && cap > 0 && in_star > cap;
+  const bool keep_faces = !reprojects_every_point(in_star);
   auto index_of = [&](VertexId corner) {
     for (size_t j = 0; j < faces.size(); ++j)
       if (corner_of(mesh.face(faces[j]), corner) >= 0) return int(j);

@@ -232,6 +232,12 @@ class EnergyPriority : public PriorityModule {
  private:
   friend class EnergyEvaluator;  // the costing half of the module: reads its state
   using FacePoint = EnergyFacePoint;
+  // Whether a performed collapse whose star's faces hold this many points projects every one
+  // of them again (else it keeps its faces' points where they are: see the top).
+  bool reprojects_every_point(size_t points_on_faces) const {
+    const uint32_t cap = options_.max_points_per_reprojection;
+    return scalar_.enabled() || cap == 0 || points_on_faces <= cap;
+  }
   // kTopologyPrice's price per point for a mesh of this diagonal (the whole mesh's in every
   // subset, so that every job prices alike): (kTopologyPrice x diagonal)^2.
   static double topology_price(double diagonal);
