@@ -286,9 +286,11 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                 "meeting there) simplify like any vertex: coarser levels reach further and stay "
                 "closer to the input, but the sheets part at coarse levels (cracks, far wider "
                 "than the level's distance error: docs/decisions/notebook-2026-11.md). Default: "
-                "the copies move and leave only together, so the sheets stay joined; where "
-                "that cannot be done, they are most of what remains at coarse levels of a "
-                "mesh with many of them");
+                "the copies move and leave only together, so the sheets stay joined (but for "
+                "a part lying on another with no vertex of its own, such as a back face laid "
+                "on a surface, which simplifies freely and may vanish); where that cannot be "
+                "done, they are most of what remains at coarse levels of a mesh with many of "
+                "them");
   cmd->add_flag("--keep-components", args->keep_components,
                 "Keep at least one triangle of every connected component at every level. "
                 "Default: an open component's last triangle collapses away when its cost comes, "

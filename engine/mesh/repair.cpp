@@ -23,6 +23,12 @@
 // output with two faces (say a tetrahedron with a fourth face on one of its edges: the
 // tetrahedron's two faces on that edge stay in one fan at both ends and keep their vertices,
 // only the extra face moves to copies); that closes the chain into a disk, which is fine.
+// The faces laid back to back on a surface that step 4a pairs across a non-manifold edge
+// keep this too: they are faces without their reverse on that edge (its other faces are
+// reverse pairs), or a face F whose every edge holds three faces. A face cut off there has its
+// reverse on every edge of it, so it is joined to its reverse or to nothing: never to a face
+// F (whose edges hold three faces, a flap's edge at least four) nor to the surface, so it
+// shares no fan with a face it was cut from.
 // mesh_checks.h verifies the result independently; the tests run it on every mesh.
 //
 // Cost: counting sorts by vertex, then sorts inside each vertex's bucket (its few faces or
@@ -31,6 +37,7 @@
 #include "mesh/repair.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -316,6 +323,87 @@ VertexId head(const std::vector<Triangle>& faces, uint32_t h) {
   return faces[h / 3][(h % 3 + 1) % 3];
 }
 
+// Faces laid back to back on a surface: a face and its reverse (the same vertices in the
+// opposite order; same-order duplicates are gone by rule 2) make the surface's edges
+// non-manifold, so that cutting every such edge cuts holes and slits into the surface. Two
+// patterns keep the surface joined and cut off only the faces laid on it:
+//  - an edge whose faces are reverse pairs but for two, in opposite directions: those two are
+//    paired (a double-sided flap standing on the surface's edge);
+//  - a face F with its reverse R on every edge of F, each edge holding exactly F, R and one
+//    more face N against F: F is paired with each N, and R, on none, becomes a part of its own
+//    (a back face laid on the surface's face F).
+// `edges` are the halfedges of the non-manifold edges, `offsets` where each edge's begin.
+void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
+                                      const std::vector<uint32_t>& edges,
+                                      const std::vector<uint32_t>& offsets,
+                                      std::vector<uint32_t>& twin) {
+  if (edges.empty()) return;
+  // Each face on a non-manifold edge and its vertex set: reverses share a set.
+  std::vector<std::pair<std::array<VertexId, 3>, uint32_t>> by_vertices;  // (sorted, face)
+  for (uint32_t h : edges) {
+    std::array<VertexId, 3> sorted = faces[h / 3];
+    std::sort(sorted.begin(), sorted.end());
+    by_vertices.emplace_back(sorted, h / 3);
+  }
+  std::sort(by_vertices.begin(), by_vertices.end());
+  by_vertices.erase(std::unique(by_vertices.begin(), by_vertices.end()), by_vertices.end());
+  const auto reverse_of = [&](uint32_t f) {
+    std::array<VertexId, 3> sorted = faces[f];
+    std::sort(sorted.begin(), sorted.end());
+    auto it = std::lower_bound(by_vertices.begin(), by_vertices.end(), std::pair{sorted, 0u});
+    for (; it != by_vertices.end() && it->first == sorted; ++it)
+      if (it->second != f) return it->second;
+    return kNoId;
+  };
+  const auto on_edge = [&](uint32_t e, uint32_t f) {
+    for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i)
+      if (edges[i] / 3 == f) return true;
+    return false;
+  };
+  // Per halfedge on a non-manifold edge, that edge.
+  std::vector<std::pair<uint32_t, uint32_t>> edge_of;
+  for (uint32_t e = 0; e + 1 < offsets.size(); ++e)
+    for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i) edge_of.emplace_back(edges[i], e);
+  std::sort(edge_of.begin(), edge_of.end());
+  const auto edge_at = [&](uint32_t h) {
+    const auto it = std::lower_bound(edge_of.begin(), edge_of.end(), std::pair{h, 0u});
+    return it != edge_of.end() && it->first == h ? it->second : kNoId;
+  };
+
+  for (uint32_t e = 0; e + 1 < offsets.size(); ++e) {
+    uint32_t single[3], count = 0;
+    for (uint32_t i = offsets[e]; i < offsets[e + 1] && count < 3; ++i) {
+      const uint32_t r = reverse_of(edges[i] / 3);
+      if (r == kNoId || !on_edge(e, r)) single[count++] = edges[i];
+    }
+    if (count == 2 && offsets[e + 1] - offsets[e] > 2 &&
+        tail(faces, single[0]) == head(faces, single[1])) {
+      twin[single[0]] = single[1];
+      twin[single[1]] = single[0];
+    }
+  }
+
+  for (const auto& [key, f] : by_vertices) {
+    const uint32_t r = reverse_of(f);
+    if (r == kNoId) continue;
+    uint32_t partner[3];
+    bool laid_on = true;
+    for (uint32_t k = 0; k < 3 && laid_on; ++k) {
+      const uint32_t h = 3 * f + k, e = edge_at(h);
+      laid_on = e != kNoId && offsets[e + 1] - offsets[e] == 3 && on_edge(e, r);
+      if (!laid_on) break;
+      for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i)
+        if (edges[i] / 3 != f && edges[i] / 3 != r) partner[k] = edges[i];
+      laid_on = tail(faces, partner[k]) == head(faces, h);
+    }
+    if (!laid_on) continue;
+    for (uint32_t k = 0; k < 3; ++k) {
+      twin[3 * f + k] = partner[k];
+      twin[partner[k]] = 3 * f + k;
+    }
+  }
+}
+
 std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vertices,
                                  uint64_t* nonmanifold_edges) {
   const size_t halfedges = 3 * faces.size();
@@ -332,6 +420,7 @@ std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vert
       &entries, &starts);
 
   std::vector<uint32_t> twin(halfedges, kNoId);
+  std::vector<uint32_t> cut_halfedges, cut_offsets{0};  // the non-manifold edges' halfedges
   for (size_t v = 0; v < vertices; ++v) {
     const auto begin = entries.begin() + starts[v], end = entries.begin() + starts[v + 1];
     std::sort(begin, end);
@@ -344,10 +433,13 @@ std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vert
         twin[h1] = h0;
       } else if (run_end - run >= 2) {
         ++*nonmanifold_edges;  // cut: its faces stay unpaired
+        for (auto h = run; h != run_end; ++h) cut_halfedges.push_back(uint32_t(*h));
+        cut_offsets.push_back(uint32_t(cut_halfedges.size()));
       }
       run = run_end;
     }
   }
+  pair_faces_beside_their_reverses(faces, cut_halfedges, cut_offsets, twin);
   return twin;
 }
 
@@ -474,7 +566,8 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   // 3. Vertices no face uses go (unless asked to keep them), with their wedges.
   compact(input, filter.kept, options, &out);
 
-  // 4. Cut along the non-manifold edges, then copy each vertex once per extra fan.
+  // 4. Cut along the non-manifold edges (faces laid back to back on a surface are cut off it,
+  // the surface kept joined), then copy each vertex once per extra fan.
   const std::vector<uint32_t> twin =
       pair_edges(out.mesh.faces, out.mesh.vertex_count(), &out.report.nonmanifold_edges);
   split_fans(twin, &out);

@@ -885,7 +885,8 @@ void ParallelBuilder::final_pass() {
   // Components vanish here only: in the jobs and the band passes a lone triangle waits for
   // this pass, which costs it against the whole mesh's coarse collapses.
   Simplifier pass(whole, *continued,
-                  standard_constraints(locked_, whole_components(), !options_.keep_components));
+                  standard_constraints(locked_, whole_components(), !options_.keep_components,
+                                       membrane_vertices(repaired_)));
   if (!copy_groups_.empty()) pass.join_copies(&copy_groups_);
   SimplifierLimits limits;
   limits.target_faces = target_;

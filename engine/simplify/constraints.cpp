@@ -36,8 +36,11 @@ class LockedVertices : public ConstraintModule {
 // another component (mark_touching_components).
 class ComponentMinimum : public ConstraintModule {
  public:
-  ComponentMinimum(std::shared_ptr<const std::vector<uint32_t>> components, bool may_vanish)
-      : given_(std::move(components)), may_vanish_(may_vanish) {}
+  ComponentMinimum(std::shared_ptr<const std::vector<uint32_t>> components, bool may_vanish,
+                   std::vector<uint8_t> on_membrane)
+      : given_(std::move(components)),
+        may_vanish_(may_vanish),
+        on_membrane_(std::move(on_membrane)) {}
   std::string name() const override { return "component-minimum"; }
   bool topological() const override { return true; }
   void initialize(const CollapseMesh& mesh) override {
@@ -111,13 +114,16 @@ class ComponentMinimum : public ConstraintModule {
 
   // Components with a vertex at the same place as another component's: pieces of one surface
   // the input did not weld (a soup of triangles), where a vanishing piece opens a hole in that
-  // surface, not a part leaving the scene. They keep their last triangle.
+  // surface, not a part leaving the scene. They keep their last triangle. A membrane's
+  // vertices lie at other components' places by the repair's making, not as pieces of one
+  // surface: they are left out, so a membrane may vanish.
   void mark_touching_components(const CollapseMesh& mesh) {
     touching_.assign(count_.size(), 0);
     if (count_.size() < 2) return;
     std::vector<std::pair<Vec3, uint32_t>> placed;
     for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
-      if (mesh.vertex_alive(v)) placed.emplace_back(mesh.position(v), component_[v]);
+      if (mesh.vertex_alive(v) && !(v < on_membrane_.size() && on_membrane_[v]))
+        placed.emplace_back(mesh.position(v), component_[v]);
     std::sort(placed.begin(), placed.end());
     for (size_t i = 0; i < placed.size();) {
       size_t end = i + 1;
@@ -132,6 +138,7 @@ class ComponentMinimum : public ConstraintModule {
 
   std::shared_ptr<const std::vector<uint32_t>> given_;
   bool may_vanish_;
+  std::vector<uint8_t> on_membrane_;  // per vertex (may be empty): left out of the touching rule
   std::vector<uint32_t> found_;
   const uint32_t* component_ = nullptr;  // per vertex: given_'s or found_'s
   std::vector<uint32_t> count_;
@@ -201,11 +208,11 @@ std::vector<std::unique_ptr<ConstraintModule>> neighbourhood_constraints() {
 
 std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
     const std::vector<uint8_t>& locked, std::shared_ptr<const std::vector<uint32_t>> components,
-    bool components_may_vanish) {
+    bool components_may_vanish, std::vector<uint8_t> on_membrane) {
   std::vector<std::unique_ptr<ConstraintModule>> modules;
   modules.push_back(std::make_unique<LockedVertices>(locked));
-  modules.push_back(
-      std::make_unique<ComponentMinimum>(std::move(components), components_may_vanish));
+  modules.push_back(std::make_unique<ComponentMinimum>(std::move(components), components_may_vanish,
+                                                       std::move(on_membrane)));
   modules.push_back(std::make_unique<BoundaryRule>());
   modules.push_back(std::make_unique<LinkCondition>());
   modules.push_back(std::make_unique<FaceGeometry>());

@@ -4,6 +4,12 @@
 // into a copy of one neighbouring group in the same step (a seam collapse,
 // Simplifier::join_copies), so that the sheets meet at every level but inside one seam
 // collapse's records.
+// A membrane, a connected part of the mesh whose every vertex is a copy of a vertex of a part
+// that has vertices of its own, and which plugs no hole of such a part (a wall inside a
+// surface, a double-sided flap on it: crude scan reconstructions have hundreds; not the two
+// sides of a double-sided surface, copies of each other, nor faces filling a hole), holds no
+// group: its vertices simplify like any vertex and it may vanish (standard_constraints), and a
+// vertex whose other copies all lie on membranes is no copy.
 #pragma once
 
 #include <cstdint>
@@ -27,8 +33,11 @@ struct CopyGroups {
   }
 };
 
-// The groups of `repaired` (the vertices locked_vertices locks); none without copies.
+// The groups of `repaired` (the vertices locked_vertices locks), membranes left out; none
+// without copies.
 CopyGroups copy_groups(const RepairedMesh& repaired);
+// Per vertex of `repaired`: 1 on a membrane (empty when `repaired` maps no input vertices).
+std::vector<uint8_t> membrane_vertices(const RepairedMesh& repaired);
 // The groups an id per vertex names (kNoId: in none; any other value, not necessarily dense:
 // the vertices sharing it), numbered by their smallest vertex.
 CopyGroups copy_groups_of(std::span<const uint32_t> group_of_vertex);

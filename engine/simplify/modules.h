@@ -139,7 +139,8 @@ class ConstraintModule {
 //   minimum size: a closed component keeps at least 4 vertices (a tetrahedron), an open one
 //     at least 3 (a triangle); with `components_may_vanish`, an open component may also
 //     collapse its last triangle away (its last vertices stay, faceless), unless it is the one
-//     of the largest area or has a vertex where another component has one;
+//     of the largest area or has a vertex where another component has one (vertices flagged in
+//     `on_membrane`, a membrane's (copy_groups.h), do not count: a membrane may vanish);
 //   boundary: an edge between two boundary vertices must itself be a boundary edge;
 //   link condition: vs and vt share no neighbour other than the apexes of the edge's faces;
 //   geometry: no remaining face around vs or vt flips its normal or becomes degenerate.
@@ -151,7 +152,7 @@ class ConstraintModule {
 std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
     const std::vector<uint8_t>& locked,
     std::shared_ptr<const std::vector<uint32_t>> components = {},
-    bool components_may_vanish = false);
+    bool components_may_vanish = false, std::vector<uint8_t> on_membrane = {});
 
 // The standard rules that read only the faces around the edge's ends (boundary, link
 // condition, geometry): what a seam collapse's trial on a copy of those faces checks

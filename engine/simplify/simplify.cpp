@@ -104,8 +104,9 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   const std::vector<uint8_t> locked = locked_vertices(repaired, options.free_copies);
   CollapseMesh working(mesh);
   std::unique_ptr<PriorityModule> priority = make_priority_module(options, mesh, locked);
-  Simplifier simplifier(working, *priority,
-                        standard_constraints(locked, {}, !options.keep_components));
+  Simplifier simplifier(
+      working, *priority,
+      standard_constraints(locked, {}, !options.keep_components, membrane_vertices(repaired)));
   // Locked copies leave the mesh group by group (seam collapses), the sheets meeting still.
   const CopyGroups groups = options.free_copies ? CopyGroups{} : copy_groups(repaired);
   if (!groups.empty()) simplifier.join_copies(&groups);

@@ -437,6 +437,42 @@ TEST(RepairManifold, ThirdFaceOnASpokeOpensTheDisk) {
   expect_faithful_repair(mesh, repaired);
 }
 
+TEST(RepairManifold, AFaceLaidBackToBackOnASurfaceIsCutOffAlone) {
+  // Two tetrahedra glued into a closed bipyramid (faces 0-5), and face 6, the reverse of face
+  // 0, laid on it: each edge of face 0 has three faces (0, 6 and the bipyramid's other face
+  // there). Face 0 stays joined to its neighbours; face 6 alone goes to copies, and the
+  // bipyramid stays closed.
+  const Mesh mesh =
+      make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3, 0.3, 1}, {0.3, 0.3, -1}},
+                {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {1, 0, 4}, {2, 1, 4}, {0, 2, 4}, {0, 3, 1}});
+  const RepairedMesh repaired = repair_in_input_order(mesh);
+  EXPECT_EQ(repaired.report.nonmanifold_edges, 3u);
+  EXPECT_EQ(repaired.report.vertex_copies_added, 3u);
+  EXPECT_EQ(repaired.mesh.faces[0], (Triangle{0, 1, 3}));
+  EXPECT_EQ(repaired.mesh.faces[6], (Triangle{5, 7, 6}));  // copies of 0, 1, 3
+  const TopologyStats stats = topology_stats(repaired.mesh);
+  EXPECT_EQ(stats.components, 2u);
+  EXPECT_EQ(stats.boundary_edges, 3u);  // the laid-on face's only
+  expect_faithful_repair(mesh, repaired);
+}
+
+TEST(RepairManifold, ADoubleSidedFlapOnAnEdgeLeavesTheSurfaceJoined) {
+  // The square (faces 0, 1) with a double-sided flap on its diagonal 0-2: face 2 and its
+  // reverse, face 3. The diagonal has four faces; the square's two stay joined across it, the
+  // flap goes to copies of 0 and 2: a closed pillow of two faces.
+  const Mesh mesh = make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1}},
+                              {{0, 1, 2}, {0, 2, 3}, {0, 2, 4}, {0, 4, 2}});
+  const RepairedMesh repaired = repair_in_input_order(mesh);
+  EXPECT_EQ(repaired.report.nonmanifold_edges, 1u);
+  EXPECT_EQ(repaired.report.vertex_copies_added, 2u);
+  EXPECT_EQ(repaired.mesh.faces[0], (Triangle{0, 1, 2}));
+  EXPECT_EQ(repaired.mesh.faces[1], (Triangle{0, 2, 3}));
+  const TopologyStats stats = topology_stats(repaired.mesh);
+  EXPECT_EQ(stats.components, 2u);
+  EXPECT_EQ(stats.boundary_edges, 4u);  // the square's rim
+  expect_faithful_repair(mesh, repaired);
+}
+
 TEST(RepairManifold, MobiusStripBecomesAnOrientableStrip) {
   // A Möbius strip of k = 4 quads, top row t_i = i, bottom row b_i = 4 + i; the last quad
   // joins column 3 to column 0 with a half twist, so its face (t3, t0, b0) uses edge t0 -> b0

@@ -73,8 +73,8 @@ TEST(FreeCopies, ReachFurtherAndStayLosslessOnACadPart) {
             build_progressive_mesh(repaired, SimplifyOptions{}).base.face_count());
 }
 
-// The 203k dragon: 6247 copies, 65% of its locked 10% level's vertices. Free, its 10% level is
-// closer to the input (the engine's surface distance; metro agrees,
+// The 203k dragon: 5074 copies of its non-manifold vertices. Free, its 10% level is closer to
+// the input (the engine's surface distance; metro agrees,
 // docs/decisions/notebook-2026-11.md).
 TEST(FreeCopies, BringTheDragonsTenthLevelCloser) {
   const std::filesystem::path path = shared_meshes_dir() / "stanford-dragon-res2-203k.ply.gz";

@@ -40,6 +40,28 @@ inline Mesh uv_sphere(int rings, int segments, double ripple = 0) {
   return m;
 }
 
+// A UV sphere (uv_sphere) with back faces laid on it: the reverse (the same vertices in the
+// opposite order) of every `every`-th face that shares no vertex with a face chosen before
+// (stanford-dragon-res3 has about 160 such). With `open_hole`, the first chosen face is left
+// out, so that its back face alone fills the hole.
+inline Mesh uv_sphere_with_back_faces(int rings, int segments, int every, bool open_hole = false) {
+  const Mesh sphere = uv_sphere(rings, segments);
+  std::vector<bool> used(sphere.positions.size(), false);
+  std::vector<Triangle> backs;
+  for (size_t f = 0; f < sphere.faces.size(); f += size_t(every)) {
+    const Triangle& t = sphere.faces[f];
+    if (used[t[0]] || used[t[1]] || used[t[2]]) continue;
+    for (VertexId v : t) used[v] = true;
+    backs.push_back({t[0], t[2], t[1]});
+  }
+  Mesh m = sphere;
+  if (open_hole)
+    m.faces.erase(
+        std::find(m.faces.begin(), m.faces.end(), Triangle{backs[0][0], backs[0][2], backs[0][1]}));
+  m.faces.insert(m.faces.end(), backs.begin(), backs.end());
+  return m;
+}
+
 // Numbers uniform in [lo, hi) from a seed (splitmix64): where the drawn scenes put their parts.
 class SeededUniform {
  public:
