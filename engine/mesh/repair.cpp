@@ -23,12 +23,15 @@
 // output with two faces (say a tetrahedron with a fourth face on one of its edges: the
 // tetrahedron's two faces on that edge stay in one fan at both ends and keep their vertices,
 // only the extra face moves to copies); that closes the chain into a disk, which is fine.
-// The faces laid back to back on a surface that step 4a pairs across a non-manifold edge
-// keep this too: they are faces without their reverse on that edge (its other faces are
+// Two of the pairings step 4a makes across a non-manifold edge for faces laid back to back
+// keep this too: they join faces without their reverse on that edge (its other faces are
 // reverse pairs), or a face F whose every edge holds three faces. A face cut off there has its
 // reverse on every edge of it, so it is joined to its reverse or to nothing: never to a face
 // F (whose edges hold three faces, a flap's edge at least four) nor to the surface, so it
-// shares no fan with a face it was cut from.
+// shares no fan with a face it was cut from. The third, side with side across an edge of two
+// reverse pairs, does not: through a fold (two double-sided triangles on one edge) a side can
+// come round to the other at both ends of the edge, so step 4 checks the split and makes it
+// again without that pairing around the faces that share a halfedge.
 // mesh_checks.h verifies the result independently; the tests run it on every mesh.
 //
 // Cost: counting sorts by vertex, then sorts inside each vertex's bucket (its few faces or
@@ -325,10 +328,13 @@ VertexId head(const std::vector<Triangle>& faces, uint32_t h) {
 
 // Faces laid back to back on a surface: a face and its reverse (the same vertices in the
 // opposite order; same-order duplicates are gone by rule 2) make the surface's edges
-// non-manifold, so that cutting every such edge cuts holes and slits into the surface. Two
+// non-manifold, so that cutting every such edge cuts holes and slits into the surface. Three
 // patterns keep the surface joined and cut off only the faces laid on it:
 //  - an edge whose faces are reverse pairs but for two, in opposite directions: those two are
 //    paired (a double-sided flap standing on the surface's edge);
+//  - an edge of exactly two reverse pairs (a double-sided surface): each face is paired with
+//    the face against it that is not its reverse, each side with itself, unless the edge's
+//    halfedges are marked in `sides_apart`;
 //  - a face F with its reverse R on every edge of F, each edge holding exactly F, R and one
 //    more face N against F: F is paired with each N, and R, on none, becomes a part of its own
 //    (a back face laid on the surface's face F).
@@ -336,6 +342,7 @@ VertexId head(const std::vector<Triangle>& faces, uint32_t h) {
 void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
                                       const std::vector<uint32_t>& edges,
                                       const std::vector<uint32_t>& offsets,
+                                      const std::vector<uint8_t>& sides_apart,
                                       std::vector<uint32_t>& twin) {
   if (edges.empty()) return;
   // Each face on a non-manifold edge and its vertex set: reverses share a set.
@@ -381,6 +388,28 @@ void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
       twin[single[0]] = single[1];
       twin[single[1]] = single[0];
     }
+    // Two reverse pairs: each side of a double-sided surface paired with itself (the first
+    // face with the face against it that is not its reverse), unless kept apart.
+    if (count == 0 && offsets[e + 1] - offsets[e] == 4 &&
+        std::none_of(edges.begin() + offsets[e], edges.begin() + offsets[e + 1],
+                     [&](uint32_t h) { return sides_apart[h]; })) {
+      const uint32_t h0 = edges[offsets[e]], r0 = reverse_of(h0 / 3);
+      uint32_t hr = kNoId, across = kNoId, other = kNoId;
+      for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i) {
+        const uint32_t h = edges[i];
+        if (h / 3 == r0)
+          hr = h;
+        else if (h != h0)
+          (tail(faces, h) == head(faces, h0) ? across : other) = h;
+      }
+      if (hr != kNoId && across != kNoId && other != kNoId &&
+          tail(faces, other) == head(faces, hr)) {
+        twin[h0] = across;
+        twin[across] = h0;
+        twin[hr] = other;
+        twin[other] = hr;
+      }
+    }
   }
 
   for (const auto& [key, f] : by_vertices) {
@@ -405,6 +434,7 @@ void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
 }
 
 std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vertices,
+                                 const std::vector<uint8_t>& sides_apart,
                                  uint64_t* nonmanifold_edges) {
   const size_t halfedges = 3 * faces.size();
   // Group the halfedges of each undirected edge: bucket by the lower end, holding
@@ -439,7 +469,7 @@ std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vert
       run = run_end;
     }
   }
-  pair_faces_beside_their_reverses(faces, cut_halfedges, cut_offsets, twin);
+  pair_faces_beside_their_reverses(faces, cut_halfedges, cut_offsets, sides_apart, twin);
   return twin;
 }
 
@@ -542,6 +572,52 @@ void split_fans(const std::vector<uint32_t>& twin, RepairedMesh* out) {
   }
 }
 
+// The faces that share a halfedge with another face (none in a manifold).
+std::vector<FaceId> faces_sharing_a_halfedge(const std::vector<Triangle>& faces) {
+  std::vector<std::pair<uint64_t, FaceId>> halfedges;
+  halfedges.reserve(3 * faces.size());
+  for (FaceId f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k)
+      halfedges.emplace_back(uint64_t(faces[f][k]) << 32 | faces[f][(k + 1) % 3], f);
+  std::sort(halfedges.begin(), halfedges.end());
+  std::vector<FaceId> shared;
+  for (size_t i = 0; i + 1 < halfedges.size(); ++i)
+    if (halfedges[i].first == halfedges[i + 1].first) {
+      shared.push_back(halfedges[i].second);
+      shared.push_back(halfedges[i + 1].second);
+    }
+  return shared;
+}
+
+// Step 4. Pairing each side of a double-sided surface with itself can bring a side round to
+// the other through a fold (two double-sided triangles on one edge), which leaves two faces
+// on one halfedge after the split: the edges of those faces keep their sides apart and the
+// split is made again, at most a few times before every side is kept apart (the pairings left
+// then cannot make such a pair: this file's opening comment).
+void split_keeping_sides_apart_where_needed(RepairedMesh* out) {
+  constexpr int kTries = 8;
+  std::vector<uint8_t> sides_apart(3 * out->mesh.faces.size(), 0);
+  for (int attempt = 0;; ++attempt) {
+    RepairedMesh split = *out;
+    split.report.nonmanifold_edges = 0;
+    split_fans(pair_edges(split.mesh.faces, split.mesh.vertex_count(), sides_apart,
+                          &split.report.nonmanifold_edges),
+               &split);
+    const std::vector<FaceId> shared = faces_sharing_a_halfedge(split.mesh.faces);
+    if (shared.empty()) {
+      *out = std::move(split);
+      return;
+    }
+    if (attempt + 1 >= kTries) {
+      if (attempt >= kTries) throw_internal("repair: the split left a non-manifold edge");
+      std::fill(sides_apart.begin(), sides_apart.end(), 1);
+      continue;
+    }
+    for (FaceId f : shared)
+      for (uint32_t k = 0; k < 3; ++k) sides_apart[3 * f + k] = 1;
+  }
+}
+
 }  // namespace
 
 RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
@@ -567,10 +643,9 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   compact(input, filter.kept, options, &out);
 
   // 4. Cut along the non-manifold edges (faces laid back to back on a surface are cut off it,
-  // the surface kept joined), then copy each vertex once per extra fan.
-  const std::vector<uint32_t> twin =
-      pair_edges(out.mesh.faces, out.mesh.vertex_count(), &out.report.nonmanifold_edges);
-  split_fans(twin, &out);
+  // the surface kept joined; the two sides of a double-sided surface each kept joined), then
+  // copy each vertex once per extra fan.
+  split_keeping_sides_apart_where_needed(&out);
 
   // 5. Neighbours on the surface become neighbours in memory.
   if (options.spatial_order) order_spatially(out);

@@ -20,14 +20,18 @@
 //  4. Non-manifold edges and vertices. An undirected edge is manifold when it has one face,
 //     or two faces that use it in opposite directions; the mesh is cut along every other edge
 //     (three or more faces, or two in the same direction): faces across it are not
-//     neighbours, with two exceptions for faces laid back to back on a surface (a face and its
-//     reverse, the same vertices in the opposite order), which keep the surface joined and cut
-//     off only what lies on it: an edge whose faces are such pairs but for two, in opposite
-//     directions, keeps those two joined (a double-sided flap on the surface's edge); a face
-//     whose three edges each hold exactly it, its reverse and one face against it stays joined
-//     to those three (its reverse, a back face laid on it, is cut off alone). The faces of
-//     each vertex are then grouped into fans, joined through the vertex's manifold edges
-//     (and those pairs); the fan holding the vertex's lowest face keeps the vertex, and
+//     neighbours, with three exceptions for faces laid back to back on a surface (a face and
+//     its reverse, the same vertices in the opposite order), which keep the surface joined and
+//     cut off only what lies on it: an edge whose faces are such pairs but for two, in opposite
+//     directions, keeps those two joined (a double-sided flap on the surface's edge); an edge
+//     of exactly two such pairs keeps each face joined to the face against it that is not its
+//     reverse (each side of a double-sided surface joined with itself), unless that makes two
+//     faces share a halfedge after the split (a side folding round to the other), where the
+//     split is made again with those faces' edges cut; a face whose three edges each hold
+//     exactly it, its reverse and one face against it stays joined to those three (its
+//     reverse, a back face laid on it, is cut off alone). The faces of each vertex are then
+//     grouped into fans, joined through the vertex's manifold edges (and those pairs); the fan
+//     holding the vertex's lowest face keeps the vertex, and
 //     each further fan gets a copy appended after all vertices (same position; copies ordered
 //     by original vertex, then by lowest face), with copies of the wedges its corners use
 //     (appended after all wedges). No face is changed other than by naming a copy, and no

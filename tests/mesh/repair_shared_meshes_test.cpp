@@ -157,8 +157,9 @@ TEST(RepairSharedMeshes, EveryMeshBecomesAManifoldThatMergesBack) {
     const RepairReport& report = repaired.report;
     testing::expect_faithful_repair(input, repaired, testing::RepairOrder::kAny);
     if (report.degenerate_faces_removed == 0 && report.duplicate_faces_removed == 0) {
-      // Nothing removed before step 4: the vertices it splits are the ones with several fans.
-      EXPECT_EQ(report.nonmanifold_vertices, before.nonmanifold_vertices);
+      // Nothing removed before step 4: the vertices it splits are among those with several
+      // fans (faces laid back to back stay joined across some non-manifold edges).
+      EXPECT_LE(report.nonmanifold_vertices, before.nonmanifold_vertices);
     }
 
     const RepairedMesh again = repair_mesh(repaired.mesh);

@@ -57,13 +57,7 @@ TEST(Membranes, NotAFaceFillingAHole) {
 // The two sides of a double-sided sheet are copies of each other, neither a membrane: they
 // keep their groups (and move only together).
 TEST(Membranes, NotTheTwoSidesOfADoubleSidedSheet) {
-  Mesh sheet = book_of_sheets(1, 8, 4);
-  const size_t faces = sheet.faces.size();
-  for (size_t f = 0; f < faces; ++f) {
-    const Triangle t = sheet.faces[f];
-    sheet.faces.push_back({t[0], t[2], t[1]});
-  }
-  const RepairedMesh repaired = repair_mesh(sheet);
+  const RepairedMesh repaired = repair_mesh(double_sided(book_of_sheets(1, 8, 4)));
   ASSERT_GT(repaired.report.vertex_copies_added, 0u);
   EXPECT_EQ(flagged(membrane_vertices(repaired)), 0u);
   EXPECT_FALSE(copy_groups(repaired).empty());

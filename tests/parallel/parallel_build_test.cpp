@@ -596,14 +596,22 @@ TEST(ParallelBuild, TheQuadricsSubsetsHoldMoreFaces) {
 }
 
 // A round whose jobs removed less than a tenth of their share ends the rounds (plan_round):
-// on chair-dupfaces-13k every vertex is a locked copy of a non-manifold one, no collapse is
-// legal, and rounds on new partitions would only extract and cost the mesh again (three did,
-// at 6-9x the sequential build's CPU). One round, then the final pass, and the sequential
-// build's PM.
+// on a scene of 4096 closed tetrahedra every part is at its minimum, no collapse is legal,
+// and rounds on new partitions would only extract and cost the mesh again (on such a mesh
+// three did, at 6-9x the sequential build's CPU). One round, then the final pass, and the
+// sequential build's PM.
 TEST(ParallelBuild, AStuckMeshEndsTheRounds) {
-  const std::filesystem::path path = testing::shared_meshes_dir() / "chair-dupfaces-13k.obj";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/meshes is not present";
-  const RepairedMesh repaired = repair_mesh(read_mesh(path.string()));
+  Mesh scene;
+  for (int i = 0; i < 4096; ++i) {
+    const double x = 2.0 * (i % 64), y = 2.0 * (i / 64);
+    const auto base = VertexId(scene.positions.size());
+    for (const Vec3& corner : {Vec3{x, y, 0}, Vec3{x + 1, y, 0}, Vec3{x, y + 1, 0}, Vec3{x, y, 1}})
+      scene.positions.push_back(corner);
+    for (const Triangle& t :
+         {Triangle{0, 2, 1}, Triangle{0, 1, 3}, Triangle{1, 2, 3}, Triangle{2, 0, 3}})
+      scene.faces.push_back({base + t[0], base + t[1], base + t[2]});
+  }
+  const RepairedMesh repaired = repair_mesh(scene);
   const SimplifyOptions options = metric_options("energy", 0.01);
   ParallelOptions parallel;  // the defaults: 3 scheduled rounds at p = 4
   parallel.subsets = 4;

@@ -75,6 +75,30 @@ TEST(SeamCollapses, SheetsMeetingOnALineSimplifyTogether) {
   }
 }
 
+// A double-sided sheet (every face laid back to back with its reverse): the repair keeps each
+// side joined, the two sides meeting at the rim, and the copies of the inside vertices (a
+// front and a back one) leave together, so the sides simplify as one and never part.
+TEST(SeamCollapses, TheTwoSidesOfADoubleSidedSheetSimplifyTogether) {
+  const RepairedMesh repaired = repair_mesh(double_sided(book_of_sheets(1, kLength, kWidth)));
+  ASSERT_GT(repaired.report.vertex_copies_added, 0u);
+  const Mesh input = repaired_input(repaired);
+  for (const char* metric : {"quadric", "energy"}) {
+    for (uint32_t p : {1u, 4u}) {
+      const std::string what = std::string(metric) + " p=" + std::to_string(p);
+      SimplifyOptions options;
+      options.metric = metric;
+      options.target_faces = 40;
+      const ProgressiveMesh pm = build_with_subsets(repaired, options, p, 50);
+      std::printf("%s: double-sided sheet, base %zu faces (input %zu)\n", what.c_str(),
+                  pm.base.face_count(), input.face_count());
+      EXPECT_LE(pm.base.face_count(), 40u) << what;
+      EXPECT_EQ(copy_separation(pm, 0).parted, 0u) << what << ": the sides meet";
+      const MeshDifference restored = compare_meshes_exact(restore_input(pm), input, false);
+      EXPECT_TRUE(restored.equal) << what << ": " << restored.first_difference;
+    }
+  }
+}
+
 // With free copies the sheets simplify apart (no seam collapses): the base parts them.
 TEST(SeamCollapses, NotWithFreeCopies) {
   const RepairedMesh repaired = repair_mesh(book_of_sheets(kSheets, kLength, kWidth));

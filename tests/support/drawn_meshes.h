@@ -40,6 +40,17 @@ inline Mesh uv_sphere(int rings, int segments, double ripple = 0) {
   return m;
 }
 
+// `mesh` made double-sided: every face followed, after all of them, by its reverse (the same
+// vertices in the opposite order), as exporters that write both sides of a thin part do.
+inline Mesh double_sided(Mesh mesh) {
+  const size_t faces = mesh.faces.size();
+  for (size_t f = 0; f < faces; ++f) {
+    const Triangle t = mesh.faces[f];
+    mesh.faces.push_back({t[0], t[2], t[1]});
+  }
+  return mesh;
+}
+
 // A UV sphere (uv_sphere) with back faces laid on it: the reverse (the same vertices in the
 // opposite order) of every `every`-th face that shares no vertex with a face chosen before
 // (stanford-dragon-res3 has about 160 such). With `open_hole`, the first chosen face is left
