@@ -125,11 +125,12 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   spdlog::debug(
       "round {} subset {} simplified {}->{} faces ({} owned, {} free vertices) in {:.3f} s"
-      " ({:.3f} s CPU; {} collapses, {} evaluations, {} deferred, {} keys reused; {})",
+      " ({:.3f} s CPU; {} collapses, {} seam collapses, {} evaluations, {} deferred, {} keys "
+      "reused; {})",
       job.round, job.subset, result.faces, working.live_faces(), result.owned_faces,
       result.free_vertices, result.wall_seconds, result.cpu_seconds, result.stats.collapses,
-      result.stats.evaluations, result.stats.deferred, result.keys_reused,
-      result.stats.stop_reason);
+      result.stats.seam_collapses, result.stats.evaluations, result.stats.deferred,
+      result.keys_reused, result.stats.stop_reason);
   return result;
 }
 
