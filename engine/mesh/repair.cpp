@@ -334,17 +334,20 @@ VertexId head(const std::vector<Triangle>& faces, uint32_t h) {
 //    paired (a double-sided flap standing on the surface's edge);
 //  - an edge of exactly two reverse pairs (a double-sided surface): each face is paired with
 //    the face against it that is not its reverse, each side with itself, unless the edge's
-//    halfedges are marked in `sides_apart`;
+//    halfedges are marked in `sides_apart` (empty: none is);
 //  - a face F with its reverse R on every edge of F, each edge holding exactly F, R and one
 //    more face N against F: F is paired with each N, and R, on none, becomes a part of its own
 //    (a back face laid on the surface's face F).
 // `edges` are the halfedges of the non-manifold edges, `offsets` where each edge's begin.
-void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
+// Returns whether the second pattern paired any edge (only it can leave a split that is not a
+// manifold: this file's opening comment).
+bool pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
                                       const std::vector<uint32_t>& edges,
                                       const std::vector<uint32_t>& offsets,
                                       const std::vector<uint8_t>& sides_apart,
                                       std::vector<uint32_t>& twin) {
-  if (edges.empty()) return;
+  if (edges.empty()) return false;
+  bool sides_paired = false;
   // Each face on a non-manifold edge and its vertex set: reverses share a set.
   std::vector<std::pair<std::array<VertexId, 3>, uint32_t>> by_vertices;  // (sorted, face)
   for (uint32_t h : edges) {
@@ -392,7 +395,7 @@ void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
     // face with the face against it that is not its reverse), unless kept apart.
     if (count == 0 && offsets[e + 1] - offsets[e] == 4 &&
         std::none_of(edges.begin() + offsets[e], edges.begin() + offsets[e + 1],
-                     [&](uint32_t h) { return sides_apart[h]; })) {
+                     [&](uint32_t h) { return !sides_apart.empty() && sides_apart[h]; })) {
       const uint32_t h0 = edges[offsets[e]], r0 = reverse_of(h0 / 3);
       uint32_t hr = kNoId, across = kNoId, other = kNoId;
       for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i) {
@@ -408,6 +411,7 @@ void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
         twin[across] = h0;
         twin[hr] = other;
         twin[other] = hr;
+        sides_paired = true;
       }
     }
   }
@@ -431,11 +435,13 @@ void pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
       twin[partner[k]] = 3 * f + k;
     }
   }
+  return sides_paired;
 }
 
+// `sides_paired`: whether the sides of a double-sided surface were paired across an edge.
 std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vertices,
                                  const std::vector<uint8_t>& sides_apart,
-                                 uint64_t* nonmanifold_edges) {
+                                 uint64_t* nonmanifold_edges, bool* sides_paired) {
   const size_t halfedges = 3 * faces.size();
   // Group the halfedges of each undirected edge: bucket by the lower end, holding
   // (higher end << 32 | halfedge), and sort each bucket (ties by halfedge id).
@@ -469,7 +475,8 @@ std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vert
       run = run_end;
     }
   }
-  pair_faces_beside_their_reverses(faces, cut_halfedges, cut_offsets, sides_apart, twin);
+  *sides_paired =
+      pair_faces_beside_their_reverses(faces, cut_halfedges, cut_offsets, sides_apart, twin);
   return twin;
 }
 
@@ -591,28 +598,32 @@ std::vector<FaceId> faces_sharing_a_halfedge(const std::vector<Triangle>& faces)
 
 // Step 4. Pairing each side of a double-sided surface with itself can bring a side round to
 // the other through a fold (two double-sided triangles on one edge), which leaves two faces
-// on one halfedge after the split: the edges of those faces keep their sides apart and the
-// split is made again, at most a few times before every side is kept apart (the pairings left
-// then cannot make such a pair: this file's opening comment).
+// on one halfedge after the split: then the edges of those faces keep their sides apart and
+// the split is made again, at most a few times before every side is kept apart. Without such
+// a pairing the split is a manifold by construction (this file's opening comment) and is made
+// once, unchecked.
 void split_keeping_sides_apart_where_needed(RepairedMesh* out) {
   constexpr int kTries = 8;
-  std::vector<uint8_t> sides_apart(3 * out->mesh.faces.size(), 0);
-  for (int attempt = 0;; ++attempt) {
+  std::vector<uint8_t> sides_apart;  // per halfedge; empty: none kept apart
+  for (int attempt = 1;; ++attempt) {
+    uint64_t nonmanifold_edges = 0;
+    bool sides_paired = false;
+    const std::vector<uint32_t> twin = pair_edges(out->mesh.faces, out->mesh.vertex_count(),
+                                                  sides_apart, &nonmanifold_edges, &sides_paired);
+    out->report.nonmanifold_edges = nonmanifold_edges;
+    if (!sides_paired) {
+      split_fans(twin, out);
+      return;
+    }
     RepairedMesh split = *out;
-    split.report.nonmanifold_edges = 0;
-    split_fans(pair_edges(split.mesh.faces, split.mesh.vertex_count(), sides_apart,
-                          &split.report.nonmanifold_edges),
-               &split);
+    split_fans(twin, &split);
     const std::vector<FaceId> shared = faces_sharing_a_halfedge(split.mesh.faces);
     if (shared.empty()) {
       *out = std::move(split);
       return;
     }
-    if (attempt + 1 >= kTries) {
-      if (attempt >= kTries) throw_internal("repair: the split left a non-manifold edge");
-      std::fill(sides_apart.begin(), sides_apart.end(), 1);
-      continue;
-    }
+    sides_apart.resize(3 * out->mesh.faces.size(), 0);
+    if (attempt == kTries) std::fill(sides_apart.begin(), sides_apart.end(), 1);
     for (FaceId f : shared)
       for (uint32_t k = 0; k < 3; ++k) sides_apart[3 * f + k] = 1;
   }

@@ -321,8 +321,9 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
   target_ = target_face_count(input_faces_, options);
   handover_ = std::max<uint64_t>(
       target_, uint64_t(std::llround(requested.handover_ratio * double(input_faces_))));
-  locked_ = locked_vertices(repaired, options.free_copies);
-  if (!options.free_copies) copy_groups_ = copy_groups(repaired);
+  on_membrane_ = membrane_vertices(repaired);
+  if (!options.free_copies) copy_groups_ = copy_groups(repaired, on_membrane_);
+  locked_ = locked_vertices(copy_groups_, mesh_.vertex_count());
   defer_line_ = defer_recosting_line(input_faces_);
   // After two scheduled rounds (a ratio of 0.32 at the default handover), an extra round at
   // the scheduled ratio would need 3.2 x the floor per subset to start, and mid-sized meshes
@@ -884,9 +885,9 @@ void ParallelBuilder::final_pass() {
   std::unique_ptr<PriorityModule> continued = without_initialize(*master_queue_);
   // Components vanish here only: in the jobs and the band passes a lone triangle waits for
   // this pass, which costs it against the whole mesh's coarse collapses.
-  Simplifier pass(whole, *continued,
-                  standard_constraints(locked_, whole_components(), !options_.keep_components,
-                                       membrane_vertices(repaired_)));
+  Simplifier pass(
+      whole, *continued,
+      standard_constraints(locked_, whole_components(), !options_.keep_components, on_membrane_));
   if (!copy_groups_.empty()) pass.join_copies(&copy_groups_);
   SimplifierLimits limits;
   limits.target_faces = target_;

@@ -108,6 +108,7 @@ class ParallelBuilder {
   uint64_t input_faces_ = 0, target_ = 0, handover_ = 0;
   uint64_t defer_line_ = 0;  // above it, edges are costed when they reach the top
   std::vector<uint8_t> locked_;
+  std::vector<uint8_t> on_membrane_;  // membrane_vertices: free to vanish in the final pass
   CopyGroups
       copy_groups_;  // (copy_groups.h) joined by seam collapses in the jobs and the final pass
   // Extra rounds past the handover keep the scheduled rounds' ratio per round, or three

@@ -94,12 +94,15 @@ std::vector<uint8_t> membrane_vertices(const RepairedMesh& repaired) {
 }
 
 CopyGroups copy_groups(const RepairedMesh& repaired) {
+  return copy_groups(repaired, membrane_vertices(repaired));
+}
+
+CopyGroups copy_groups(const RepairedMesh& repaired, const std::vector<uint8_t>& on_membrane) {
   const size_t vertices = repaired.mesh.vertex_count();
   if (repaired.input_vertex.size() != vertices) return {};
   std::vector<uint32_t> uses = uses_of_input_vertices(repaired);
   // A membrane's vertices drop out of the count, so that a vertex whose other copies all lie on
   // membranes is no copy either.
-  const std::vector<uint8_t> on_membrane = membrane_vertices(repaired);
   for (VertexId v = 0; v < vertices; ++v)
     if (on_membrane[v]) --uses[repaired.input_vertex[v]];
   std::vector<uint32_t> input_of_copy(vertices, kNoId);

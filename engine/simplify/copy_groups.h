@@ -36,6 +36,8 @@ struct CopyGroups {
 // The groups of `repaired` (the vertices locked_vertices locks), membranes left out; none
 // without copies.
 CopyGroups copy_groups(const RepairedMesh& repaired);
+// The same with its membranes given (membrane_vertices(repaired)).
+CopyGroups copy_groups(const RepairedMesh& repaired, const std::vector<uint8_t>& on_membrane);
 // Per vertex of `repaired`: 1 on a membrane (empty when `repaired` maps no input vertices).
 std::vector<uint8_t> membrane_vertices(const RepairedMesh& repaired);
 // The groups an id per vertex names (kNoId: in none; any other value, not necessarily dense:

@@ -58,9 +58,12 @@ void check_simplify_options(const SimplifyOptions& options) {
 }
 
 std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired, bool free_copies) {
-  std::vector<uint8_t> locked(repaired.mesh.vertex_count(), 0);
-  if (free_copies) return locked;
-  const CopyGroups groups = copy_groups(repaired);
+  return locked_vertices(free_copies ? CopyGroups{} : copy_groups(repaired),
+                         repaired.mesh.vertex_count());
+}
+
+std::vector<uint8_t> locked_vertices(const CopyGroups& groups, size_t vertices) {
+  std::vector<uint8_t> locked(vertices, 0);
   for (VertexId v : groups.members) locked[v] = 1;
   return locked;
 }
@@ -100,15 +103,16 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   const Mesh& mesh = repaired.mesh;
 
   // Vertices the repair step duplicated (non-manifold input) stay where they are, so that the
-  // copies of one input vertex never drift apart and open a crack (unless free_copies).
-  const std::vector<uint8_t> locked = locked_vertices(repaired, options.free_copies);
+  // copies of one input vertex never drift apart and open a crack (unless free_copies); they
+  // leave the mesh group by group (seam collapses), the sheets meeting still.
+  std::vector<uint8_t> on_membrane = membrane_vertices(repaired);
+  const CopyGroups groups = options.free_copies ? CopyGroups{} : copy_groups(repaired, on_membrane);
+  const std::vector<uint8_t> locked = locked_vertices(groups, mesh.vertex_count());
   CollapseMesh working(mesh);
   std::unique_ptr<PriorityModule> priority = make_priority_module(options, mesh, locked);
   Simplifier simplifier(
       working, *priority,
-      standard_constraints(locked, {}, !options.keep_components, membrane_vertices(repaired)));
-  // Locked copies leave the mesh group by group (seam collapses), the sheets meeting still.
-  const CopyGroups groups = options.free_copies ? CopyGroups{} : copy_groups(repaired);
+      standard_constraints(locked, {}, !options.keep_components, std::move(on_membrane)));
   if (!groups.empty()) simplifier.join_copies(&groups);
   SimplifierLimits limits;
   limits.target_faces = target_face_count(mesh.face_count(), options);

@@ -94,10 +94,14 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
 // Throws Error(kInvalidInput) for an unknown metric or an option out of range.
 void check_simplify_options(const SimplifyOptions& options);
 void check_energy_tuning(const EnergyTuning& energy);
+struct CopyGroups;
 // Per vertex of repaired.mesh: 1 when the repair step made copies of its input vertex (such
 // vertices move and leave only in seam collapses, copy_groups.h, so that the copies of one
 // input vertex do not crack apart); all 0 with `free_copies` (SimplifyOptions::free_copies).
 std::vector<uint8_t> locked_vertices(const RepairedMesh& repaired, bool free_copies = false);
+// The same from the groups already found: per vertex of a mesh of `vertices` vertices, 1 for
+// the members of `groups`.
+std::vector<uint8_t> locked_vertices(const CopyGroups& groups, size_t vertices);
 class PriorityModule;
 // The priority module of options.metric for `mesh` (per vertex `locked`). reference_diagonal:
 // the scale energy costs are measured against; 0 means mesh's own bounding-box diagonal (a
