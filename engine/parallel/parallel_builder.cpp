@@ -628,8 +628,10 @@ void ParallelBuilder::extract_jobs(Round& r) {
     const auto ts = std::chrono::steady_clock::now();
     if (!sample_in_tasks) {
       const double sample_start = thread_cpu_seconds();
+      Simplifier master_costs(*whole_, *master_, {});
+      if (!copy_groups_.empty()) master_costs.join_copies(&copy_groups_);
       for (size_t i = 0; i < jobs.size(); ++i)
-        samples[i] = sample_on_master(jobs[i], sampled[i], whole, *master_);
+        samples[i] = sample_on_master(jobs[i], sampled[i], master_costs, *master_);
       rs.share_seconds += thread_cpu_seconds() - sample_start;
       for (const SubsetSample& s : samples) master_sample_costings_ += s.costings;
     }

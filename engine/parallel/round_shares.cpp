@@ -7,6 +7,8 @@
 
 #include "parallel/simplify_subset.h"
 #include "simplify/collapse_mesh.h"
+#include "simplify/copy_groups.h"
+#include "simplify/simplifier.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -48,13 +50,18 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
     memo->reset(keys);
   }
   PriorityModule& costing = memo ? static_cast<PriorityModule&>(*memo) : *module;
+  const CopyGroups groups = copy_groups_of(job.copy_group);
+  Simplifier seams(local, costing, {});
+  if (!groups.empty()) seams.join_copies(&groups);
   const size_t carried = keys.size();
   for (const auto& [a, b] : sampled.edges) {
     CollapseCandidate c;
-    const bool placed = costing.evaluate(local, a, b, c, Costing::kQueue);
+    const bool placed = seams.queue_cost(a, b, c);
     out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
+    // A seam collapse's cost is no key of the module's, which cannot place the edge.
+    const bool seam = groups.is_copy(a) && groups.is_copy(b);
     if (carry_keys)
-      keys.push_back({a, b, placed ? c.cost : std::numeric_limits<double>::quiet_NaN()});
+      keys.push_back({a, b, placed && !seam ? c.cost : std::numeric_limits<double>::quiet_NaN()});
   }
   out.costings = module->costings();
   // Carried keys answered the edges they cover: those came back the same.
@@ -63,15 +70,19 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
 }
 
 SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
-                              const CollapseMesh& whole, PriorityModule& master) {
+                              Simplifier& master_costs, const PriorityModule& master) {
   SubsetSample out;
   out.inner_edges = edges.inner_edges;
   const uint64_t costings_before = master.costings();
   out.costs.reserve(edges.edges.size());
+  auto job_group = [&](VertexId v) { return job.copy_group.empty() ? kNoId : job.copy_group[v]; };
   for (const auto& [a, b] : edges.edges) {
+    // Two locked copies whose groups are not both the job's: no collapse the job can make.
+    const bool seam_elsewhere = !job.locked.empty() && job.locked[a] && job.locked[b] &&
+                                (job_group(a) == kNoId || job_group(b) == kNoId);
     CollapseCandidate c;
     const bool placed =
-        master.evaluate(whole, job.global_vertex[a], job.global_vertex[b], c, Costing::kQueue);
+        !seam_elsewhere && master_costs.queue_cost(job.global_vertex[a], job.global_vertex[b], c);
     out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
   }
   out.costings = master.costings() - costings_before;

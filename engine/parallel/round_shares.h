@@ -10,6 +10,7 @@
 
 #include "parallel/edge_keys.h"
 #include "parallel/subset_job.h"
+#include "simplify/simplifier.h"
 
 namespace parapm {
 
@@ -45,7 +46,7 @@ constexpr uint64_t kSampledEdgesPerSubset = 1024;
 struct SubsetSample {
   uint64_t inner_edges = 0;
   uint64_t costings = 0;      // edges the sample's module costed (the carried keys answer others)
-  std::vector<double> costs;  // infinite: the module could not place the edge
+  std::vector<double> costs;  // infinite: no collapse of the edge could be costed
 };
 
 // The edges a subset's sample costs: every stride-th of its inner edges with two free ends
@@ -60,21 +61,25 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 // The sample of a job's subset (a job with the master's state: Error(kInternal) otherwise),
 // costed by the job's own module, imported from the job's state as simplify_subset imports
 // it, so that the subsets' samples are costed side by side (in the extraction's tasks), not
-// one after the other on the master's critical path.
+// one after the other on the master's critical path. An edge between copies of two groups is
+// costed as the seam collapse the job would make of it (Simplifier::queue_cost): a subset
+// whose copies simplify only by seam collapses is as cheap as they are.
 // `free`: free_vertices of the job. `keys` (with carry_keys): the job's carried keys (local
 // ids, sorted), which answer the edges they cover; the sampled edges join them, so that the
 // job does not cost them again (its module costs them alike: same state).
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
                            std::vector<EdgeKey>& keys);
 
-// The same sample costed by the master's module on the whole mesh (`edges` from
-// sampled_edges(job, ...), translated to global ids): the costs the job's own module would
-// give (its state is the master's, job_state.h), without building the job's mesh and module a
-// second time. For a cheap metric (PriorityModule::costly() false: the quadric, whose sampled
-// costs never travel as keys), for which those copies cost more than the costings. Not
-// thread-safe (the master's module); out.costings counts the master's costings of it.
+// The same sample costed on the whole mesh by `master_costs`, a Simplifier over it with the
+// master's module and the build's copy groups (`edges` from sampled_edges(job, ...),
+// translated to global ids; a seam collapse only between groups that are the job's): the
+// costs the job's own module would give (its state is the master's, job_state.h), without
+// building the job's mesh and module a second time. For a
+// cheap metric (PriorityModule::costly() false: the quadric, whose sampled costs never travel
+// as keys), for which those copies cost more than the costings. Not thread-safe (the master's
+// module); out.costings counts the master's costings of it.
 SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
-                              const CollapseMesh& whole, PriorityModule& master);
+                              Simplifier& master_costs, const PriorityModule& master);
 
 // The round's costs from its subsets' samples (one per job, in order), each sampled edge
 // standing for its subset's inner edges over its sampled ones; `remove`: the faces the round

@@ -6,6 +6,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/mesh_io.h"
@@ -50,14 +51,20 @@ inline std::string pm_bytes(const ProgressiveMesh& pm) {
 // target, no keys: the test sets them).
 struct RoundZero {
   RoundZero(const std::string& name, const SimplifyOptions& options, uint32_t p)
-      : repaired(repaired_test_mesh(name)),
+      : RoundZero(repaired_test_mesh(name), options, p) {}
+  RoundZero(RepairedMesh input, const SimplifyOptions& options, uint32_t p)
+      : repaired(std::move(input)),
         locked(locked_vertices(repaired)),
         groups(copy_groups(repaired)),
         whole(repaired.mesh),
         master(make_priority_module(options, repaired.mesh, locked)) {
     const Mesh& mesh = repaired.mesh;
     master->initialize(whole);
-    const Partition partition = partition_mesh(mesh, p);
+    Partition partition = partition_mesh(mesh, p);
+    // As the build's partitions do, all the copies of a group in one subset.
+    for (VertexId v = 0; v < mesh.vertex_count(); ++v)
+      if (groups.is_copy(v))
+        partition.vertex_subset[v] = partition.vertex_subset[groups.of(groups.group[v])[0]];
     jobs =
         extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
                         partition.vertex_subset, p, 0, subset_options_of(options, mesh), &groups);

@@ -3,15 +3,19 @@
 // drawn from it, each sampled edge weighted by the edges it stands for.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <vector>
 
+#include "drawn_meshes.h"
 #include "parallel/round_shares.h"
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_rule.h"
 #include "parallel_test_support.h"
+#include "simplify/copy_groups.h"
+#include "simplify/simplifier.h"
 
 namespace parapm {
 namespace {
@@ -98,8 +102,9 @@ TEST(RoundShares, TheMasterCostsTheSampleAsTheJobsModuleDoes) {
         const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
         std::vector<EdgeKey> no_keys;
         const SubsetSample own = sample_subset(job, free, false, no_keys);
+        Simplifier master_costs(round.whole, *round.master, {});
         const SubsetSample master =
-            sample_on_master(job, sampled_edges(job, free), round.whole, *round.master);
+            sample_on_master(job, sampled_edges(job, free), master_costs, *round.master);
         EXPECT_EQ(master.inner_edges, own.inner_edges) << what;
         ASSERT_FALSE(own.costs.empty()) << what;
         ASSERT_EQ(master.costs.size(), own.costs.size()) << what;
@@ -108,6 +113,49 @@ TEST(RoundShares, TheMasterCostsTheSampleAsTheJobsModuleDoes) {
         EXPECT_EQ(master.costings, master.costs.size()) << what;
       }
     }
+}
+
+// An edge between copies of two groups, which the module alone cannot place, is sampled at the
+// cost of the seam collapse the job would make of it (Simplifier::queue_cost), by the job's
+// module and by the master alike: a subset of a double-sided sheet, whose copies simplify
+// only by seam collapses, samples as cheap as it is, and is asked for its share of the faces.
+TEST(RoundShares, AnEdgeBetweenCopiesCostsItsSeamCollapse) {
+  for (const char* metric : {"quadric", "energy"}) {
+    SimplifyOptions options;
+    options.metric = metric;
+    testing::RoundZero round(repair_mesh(testing::double_sided_sheet_beside_a_sphere(24)), options,
+                             2);
+    ASSERT_FALSE(round.groups.empty());
+    Simplifier master_costs(round.whole, *round.master, {});
+    master_costs.join_copies(&round.groups);
+    uint64_t seams = 0, costed = 0;
+    for (SubsetJob& job : round.jobs) {
+      const std::string what = std::string(metric) + " subset " + std::to_string(job.subset);
+      const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+      std::vector<EdgeKey> keys;
+      const SubsetSample own = sample_subset(job, free, true, keys);
+      const SampledEdges edges = sampled_edges(job, free);
+      const SubsetSample master = sample_on_master(job, edges, master_costs, *round.master);
+      ASSERT_EQ(own.costs.size(), edges.edges.size()) << what;
+      ASSERT_EQ(master.costs, own.costs) << what;
+      const CopyGroups groups = copy_groups_of(job.copy_group);
+      for (size_t i = 0; i < edges.edges.size(); ++i) {
+        const auto [a, b] = edges.edges[i];
+        if (!groups.is_copy(a) || !groups.is_copy(b)) continue;
+        ++seams;
+        costed += std::isfinite(own.costs[i]) ? 1 : 0;
+        // Not the module's key: the job's memo must not answer the edge with it.
+        const auto key = std::find_if(keys.begin(), keys.end(),
+                                      [&](const EdgeKey& k) { return k.a == a && k.b == b; });
+        ASSERT_NE(key, keys.end()) << what;
+        EXPECT_TRUE(std::isnan(key->cost)) << what;
+      }
+    }
+    std::printf("%s: %llu of %llu sampled edges between copies costed\n", metric,
+                (unsigned long long)costed, (unsigned long long)seams);
+    EXPECT_GT(seams, 100u) << metric;
+    EXPECT_GE(costed, seams * 95 / 100) << metric;
+  }
 }
 
 // Two subsets: 900 inner edges sampled by 9 costs (1 ... 9, each standing for 100 edges) and

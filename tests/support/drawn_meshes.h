@@ -40,6 +40,26 @@ inline Mesh uv_sphere(int rings, int segments, double ripple = 0) {
   return m;
 }
 
+// A flat unit disc (z = 0) of `rings` rings of `segments` vertices around a centre: a round
+// boundary of `segments` edges.
+inline Mesh disc(int rings, int segments) {
+  Mesh m;
+  m.positions.push_back({0, 0, 0});
+  for (int r = 1; r <= rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const double phi = 2 * M_PI * s / segments, radius = double(r) / rings;
+      m.positions.push_back({radius * std::cos(phi), radius * std::sin(phi), 0});
+    }
+  auto ring = [&](int r, int s) { return VertexId(1 + (r - 1) * segments + (s % segments)); };
+  for (int s = 0; s < segments; ++s) m.faces.push_back({0, ring(1, s), ring(1, s + 1)});
+  for (int r = 1; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      m.faces.push_back({ring(r, s), ring(r + 1, s), ring(r + 1, s + 1)});
+      m.faces.push_back({ring(r, s), ring(r + 1, s + 1), ring(r, s + 1)});
+    }
+  return m;
+}
+
 // `mesh` made double-sided: every face followed, after all of them, by its reverse (the same
 // vertices in the opposite order), as exporters that write both sides of a thin part do.
 inline Mesh double_sided(Mesh mesh) {
@@ -49,6 +69,32 @@ inline Mesh double_sided(Mesh mesh) {
     mesh.faces.push_back({t[0], t[2], t[1]});
   }
   return mesh;
+}
+
+// A gently waving square sheet of n x n quads, made double-sided (the repair gives each inner
+// vertex a front copy and a back copy, joined at the rim), beside a rippled sphere: the sheet
+// simplifies only by seam collapses, cheap ones.
+inline Mesh double_sided_sheet_beside_a_sphere(int n) {
+  Mesh m = double_sided([n] {
+    Mesh sheet;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i)
+        sheet.positions.push_back(
+            {3.0 + 2.0 * i / n, 2.0 * j / n, 0.02 * std::sin(0.5 * i) * std::cos(0.4 * j)});
+    auto at = [n](int i, int j) { return VertexId(j * (n + 1) + i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        sheet.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+        sheet.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+    return sheet;
+  }());
+  const Mesh sphere = uv_sphere(n, 2 * n, 0.1);
+  const auto first = VertexId(m.positions.size());
+  m.positions.insert(m.positions.end(), sphere.positions.begin(), sphere.positions.end());
+  for (const Triangle& t : sphere.faces)
+    m.faces.push_back({t[0] + first, t[1] + first, t[2] + first});
+  return m;
 }
 
 // A UV sphere (uv_sphere) with back faces laid on it: the reverse (the same vertices in the
