@@ -6,13 +6,23 @@
 #include <algorithm>
 #include <cmath>
 
+#include "simplify/back_to_back.h"
 #include "simplify/vec_math.h"
 #include "util/error.h"
 
 namespace parapm {
+namespace {
+
+Vec3 normal_of(const CollapseMesh& mesh, FaceId f) {
+  const Triangle& t = mesh.face(f);
+  return triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+}
+
+}  // namespace
 
 void QuadricPriority::initialize(const CollapseMesh& mesh) {
   quadrics_.assign(mesh.vertex_capacity(), Quadric{});
+  const std::vector<FaceId> twin = mesh.twin_faces();
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     if (!mesh.face_alive(f)) continue;
     const Triangle& t = mesh.face(f);
@@ -23,12 +33,14 @@ void QuadricPriority::initialize(const CollapseMesh& mesh) {
     const Vec3 n = scale(n2, 1.0 / len);
     const Quadric q = Quadric::from_plane(n, -dot(n, p0), 0.5 * len);
     for (VertexId v : t) quadrics_[v] += q;
-    // Boundary edges: the plane through the edge perpendicular to the face keeps the border
-    // from shrinking inwards.
+    // Boundary edges, and edges whose faces lie back to back (back_to_back.h: their planes
+    // are one, blind to the rim moving within it; counted once, from the face holding a->b
+    // with a < b): the plane through the edge perpendicular to the face keeps the border from
+    // shrinking inwards.
     for (int k = 0; k < 3; ++k) {
       const VertexId a = t[k], b = t[(k + 1) % 3];
-      if (!mesh.is_boundary(a) || !mesh.is_boundary(b)) continue;
-      if (mesh.edge_faces(b, a).left != kNoId) continue;  // b->a has a face: interior edge
+      const FaceId across = twin[3 * size_t(f) + k];  // the face holding b->a
+      if (across != kNoId && (b < a || !back_to_back(n2, normal_of(mesh, across)))) continue;
       const Vec3 e = sub(mesh.position(b), mesh.position(a));
       const Vec3 side = cross(e, n);
       const double side_len = length(side);

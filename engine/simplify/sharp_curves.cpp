@@ -5,6 +5,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "simplify/back_to_back.h"
 #include "simplify/point_projection.h"
 #include "simplify/sample_thinning.h"
 #include "util/error.h"
@@ -85,7 +86,11 @@ std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& 
         const Vec3 ng =
             triangle_normal(mesh.position(u[0]), mesh.position(u[1]), mesh.position(u[2]));
         const double lengths = length(nf) * length(ng);
-        if (lengths > 0 && dot(nf, ng) < crease_cos * lengths) creases.emplace_back(a, b);
+        if (back_to_back(nf, ng)) {  // a double-sided sheet's rim: a border, kept as one
+          if (options.boundaries) edges.emplace_back(a, b);
+        } else if (lengths > 0 && dot(nf, ng) < crease_cos * lengths) {
+          creases.emplace_back(a, b);
+        }
       }
     }
   }

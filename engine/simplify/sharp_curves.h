@@ -1,5 +1,6 @@
 // E_disc of Hoppe 96 (section 4.4): the discontinuity curves of the mesh (sharp edges: open
-// boundaries, creases whose dihedral angle exceeds a threshold, attribute seams) sampled on
+// boundaries and the rims of double-sided sheets (back_to_back.h), creases whose dihedral angle
+// exceeds a threshold, attribute seams) sampled on
 // the input, each sample measured against the curves of the current mesh, and the rule that
 // flags a collapse changing the curves' topology (priced by the energy, not forbidden).
 //
@@ -20,8 +21,8 @@ namespace parapm {
 
 struct SharpEdgeOptions {
   double crease_angle_degrees = 60;  // sharp when the face normals differ by more
-  bool boundaries = true;
-  bool seams = true;  // edges across which a corner's wedge changes
+  bool boundaries = true;            // open boundaries, and edges whose faces lie back to back
+  bool seams = true;                 // edges across which a corner's wedge changes
   // A crease of fewer edges than min_crease_edges and shorter than long_crease_diagonals of
   // the bounding-box diagonal is a scan's noise, not kept (1: every crease is); the length
   // clause keeps a coarse mesh's few but long creases (docs/DECISIONS.md, "Creases of fewer than 8

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "drawn_meshes.h"
+#include "mesh/repair.h"
 #include "simplify/energy_priority.h"
 #include "simplify/point_projection.h"
 #include "simplify/sharp_curves.h"
@@ -279,6 +280,26 @@ TEST(SharpCurves, ShortCreasesAreNoiseUnlessLong) {
   EXPECT_EQ(find_sharp_edges(cm, options).size(), 16u);
   options.min_crease_edges = 1;  // every crease
   EXPECT_EQ(find_sharp_edges(cm, options).size(), 20u);
+}
+
+// The rim of a double-sided disc (each face and its reverse; the repair keeps the two sides
+// apart inside and joined along the rim), whose faces lie back to back, is a border as an open
+// boundary is: kept whatever its length (not a crease of 6 edges, short, taken for noise) and
+// whatever the crease angle.
+TEST(SharpCurves, TheRimOfADoubleSidedSheetIsABorder) {
+  const RepairedMesh repaired = repair_mesh(testing::double_sided(testing::disc(2, 6)));
+  const CollapseMesh cm(repaired.mesh);
+  SharpEdgeOptions options;
+  options.long_crease_diagonals = 1;  // the rim is short: a crease of it would be noise
+  options.crease_angle_degrees = 180;
+  const auto edges = find_sharp_edges(cm, options);
+  ASSERT_EQ(edges.size(), 6u);
+  for (const auto& [a, b] : edges) {
+    EXPECT_NEAR(length(cm.position(a)), 1.0, kTight) << "a rim vertex";
+    EXPECT_NEAR(length(cm.position(b)), 1.0, kTight) << "a rim vertex";
+  }
+  options.boundaries = false;
+  EXPECT_TRUE(find_sharp_edges(cm, options).empty());
 }
 
 TEST(SharpCurves, TopologyChangesAreFlagged) {
