@@ -335,6 +335,25 @@ EnergyEvaluator::Survivor EnergyEvaluator::choose_survivor(const CollapseMesh& m
   return {true, keep_b, fixed, topology, boundary_a, boundary_b};
 }
 
+void EnergyEvaluator::add_boundary_planes(const CollapseMesh& mesh, const Triangle& t, int k,
+                                          const Vec3& n, Quadric& planes) const {
+  const VertexId end = t[k];
+  const double weight = module_.options_.star_planes_weight;
+  if (!mesh.is_boundary(end) || weight <= 0) return;
+  const double n_length = length(n);
+  for (const auto& [from, to] : {std::pair{end, t[(k + 1) % 3]}, std::pair{t[(k + 2) % 3], end}}) {
+    if (!mesh.is_boundary(from == end ? to : from)) continue;
+    if (mesh.edge_faces(to, from).left != kNoId) continue;  // an inner edge
+    const Vec3 e = sub(mesh.position(to), mesh.position(from));
+    const Vec3 side = cross(e, n);
+    const double side_length = length(side);
+    if (side_length == 0 || n_length == 0) continue;
+    const Vec3 m = scale(side, 1 / side_length);
+    const double offset = dot(m, sub(mesh.position(from), scratch_.origin));
+    planes += Quadric::from_plane(m, -offset, dot(e, e) / weight);
+  }
+}
+
 EnergyEvaluator::StarSums EnergyEvaluator::gather_star(const CollapseMesh& mesh, VertexId a,
                                                        VertexId b) {
   // The star: every face around a or b; after the collapse those without both ends remain,
@@ -374,8 +393,10 @@ EnergyEvaluator::StarSums EnergyEvaluator::gather_star(const CollapseMesh& mesh,
         normals = add(normals, n);
         offsets += offset;
         area2 += n_length;
-        if (n_length > 0)
+        if (n_length > 0) {
           star_planes += Quadric::from_plane(scale(n, 1 / n_length), -offset / n_length, n_length);
+          add_boundary_planes(mesh, t, k, n, star_planes);
+        }
       }
       if (other_corner >= 0) {
         if (edge_faces < 2) {

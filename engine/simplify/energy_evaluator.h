@@ -140,6 +140,15 @@ class EnergyEvaluator {
     int edge_faces = 0;
   };
   StarSums gather_star(const CollapseMesh& mesh, VertexId a, VertexId b);
+  // The boundary planes of face t's two edges at its corner k (the star's moving end), each
+  // an open boundary edge: the plane through the edge perpendicular to the face (normal n,
+  // any length), weighted |e|^2 / star_planes_weight, so that once the star's planes are
+  // scaled it weighs as the star's own points (not star_planes_weight times as dense) spread
+  // over a right triangle on the edge (legs |e|) would see v leave it. It keeps an open border
+  // from closing in over its hole, which the points (of the input, measured against the level)
+  // do not see.
+  void add_boundary_planes(const CollapseMesh& mesh, const Triangle& t, int k, const Vec3& n,
+                           Quadric& planes) const;
   // 3. The fan's order (StarFace::next, previous), the homes of the removed faces' points
   //    (scratch_.edge_face_homes) and the samples of a and b still parked (scratch_.parked_ends).
   //    Returns the parked samples around the star, each counted half (they sit on its rim).

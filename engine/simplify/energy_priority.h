@@ -48,7 +48,10 @@
 //   the collapse, weighted by area, as points spread over those faces at star_planes_weight
 //   times the density of the star's own points would measure them (a dense sampling's view at
 //   a quadric's price, not per point). It keeps flat and cylindrical patches, which springs
-//   and vertex samples alone bend.
+//   and vertex samples alone bend. With them, the boundary planes of the star's open boundary
+//   edges at the moving end (Garland-Heckbert's, weighed as the star's own points would see
+//   them): the points, of the input measured against the level, do not see a border closing
+//   in over its hole.
 // - volume preservation: the change of enclosed volume, spread over the star's area, costed
 //   as if every point of the star moved by that mean displacement, times volume_weight.
 // Both are quadratic in v: the solves minimise them with the rest (measured:
