@@ -74,10 +74,10 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
 // master's module and the build's copy groups (`edges` from sampled_edges(job, ...),
 // translated to global ids; a seam collapse only between groups that are the job's): the
 // costs the job's own module would give (its state is the master's, job_state.h), without
-// building the job's mesh and module a second time. For a
-// cheap metric (PriorityModule::costly() false: the quadric, whose sampled costs never travel
-// as keys), for which those copies cost more than the costings. Not thread-safe (the master's
-// module); out.costings counts the master's costings of it.
+// building the job's mesh and module a second time. For a cheap metric
+// (PriorityModule::costly() false: the quadric, whose sampled costs never travel as keys), for
+// which those copies cost more than the costings. Not thread-safe (the master's module);
+// out.costings counts the master's costings of it.
 SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
                               Simplifier& master_costs, const PriorityModule& master);
 

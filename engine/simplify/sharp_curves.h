@@ -1,8 +1,8 @@
 // E_disc of Hoppe 96 (section 4.4): the discontinuity curves of the mesh (sharp edges: open
-// boundaries and the rims of double-sided sheets (back_to_back.h), creases whose dihedral angle
-// exceeds a threshold, attribute seams) sampled on
-// the input, each sample measured against the curves of the current mesh, and the rule that
-// flags a collapse changing the curves' topology (priced by the energy, not forbidden).
+// boundaries and the rims of double-sided sheets (back_to_back.h), creases whose dihedral
+// angle exceeds a threshold, attribute seams) sampled on the input, each sample measured
+// against the curves of the current mesh, and the rule that flags a collapse changing the
+// curves' topology (priced by the energy, not forbidden).
 //
 // The curves are kept as a sharp-neighbour list per vertex; a collapse moves vt's sharp
 // edges to vs (the edge (vs, vt) itself disappears). A sample tracks the sharp edge it
