@@ -2,8 +2,8 @@
 // of the input faces and at the sequential base's size, the surface distance of the parallel
 // level to the input (RMS and Hausdorff, both directions, engine/measure) over the sequential
 // level's. Real meshes, all also in ../shared/meshes: a CAD part, a scanned vessel, the
-// textured bunny; p = 2, 4, 8, 16 with quadrics, p = 2, 4 with the energy. Every figure is
-// printed.
+// textured bunny; p = 2, 4, 8, 16 with quadrics, p = 2, 4 with the energy; and a drawn
+// double-sided sheet beside a sphere, p = 2, 4, 8, both metrics. Every figure is printed.
 //
 // What is asserted, per mesh and metric, as regression guards with a margin over the figures
 // measured now: the median RMS ratio over the (p, level) cells within 10% (measured: 1.00-1.03),
