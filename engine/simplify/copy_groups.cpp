@@ -1,10 +1,11 @@
 #include "simplify/copy_groups.h"
 
 #include <algorithm>
-#include <numeric>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
+
+#include "util/union_find.h"
 
 namespace parapm {
 
@@ -12,18 +13,14 @@ namespace {
 
 // Per vertex of `mesh`, its connected component (by shared faces) as a root vertex id.
 std::vector<uint32_t> component_roots(const Mesh& mesh) {
-  std::vector<uint32_t> parent(mesh.vertex_count());
-  std::iota(parent.begin(), parent.end(), 0u);
-  const auto root = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
+  UnionFind sets(mesh.vertex_count());
   for (const Triangle& t : mesh.faces) {
-    parent[root(t[1])] = root(t[0]);
-    parent[root(t[2])] = root(t[0]);
+    sets.unite(t[0], t[1]);
+    sets.unite(t[0], t[2]);
   }
-  for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = root(v);
-  return parent;
+  std::vector<uint32_t> root(mesh.vertex_count());
+  for (uint32_t v = 0; v < root.size(); ++v) root[v] = sets.find(v);
+  return root;
 }
 
 // The boundary edges of `mesh` (a manifold: an edge without the opposite half-edge), each as

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <string>
 
+#include "drawn_meshes.h"
 #include "mesh/mesh_checks.h"
 #include "repair_expectations.h"
 #include "util/error.h"
@@ -479,12 +480,9 @@ TEST(RepairManifold, ADoubleSidedSurfaceKeepsEachSideJoined) {
   // stays joined across the spokes: one closed flat surface, its two sides meeting at the rim,
   // the centre split into a front and a back vertex (cut along every spoke, it would be four
   // closed pillows).
-  Mesh mesh = make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 0}},
-                        {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}});
-  for (int f = 0; f < 4; ++f) {
-    const Triangle t = mesh.faces[f];
-    mesh.faces.push_back({t[0], t[2], t[1]});
-  }
+  const Mesh mesh =
+      testing::double_sided(make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 0}},
+                                      {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}));
   const RepairedMesh repaired = repair_in_input_order(mesh);
   EXPECT_EQ(repaired.report.nonmanifold_edges, 4u);
   EXPECT_EQ(repaired.report.vertex_copies_added, 1u);
