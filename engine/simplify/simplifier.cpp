@@ -135,7 +135,7 @@ bool Simplifier::topologically_legal(VertexId a, VertexId b) const {
 
 bool Simplifier::is_stale(const Entry& entry) const {
   return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
-         version_[entry.a] + version_[entry.b] != (entry.stamp & ~kDeferred);
+         version_[entry.a] + version_[entry.b] != (entry.stamp & kVersions);
 }
 
 void Simplifier::compact_heap() {
@@ -148,6 +148,13 @@ void Simplifier::compact_heap() {
   stats_.stale += before - items.size();
   compacted_size_ = items.size();
   ++stats_.compactions;
+  forget_outdated_requeued();
+}
+
+void Simplifier::forget_outdated_requeued() {
+  std::erase_if(requeued_, [this](const auto& record) {
+    return requeued_outdated(record.first, record.second.first);
+  });
 }
 
 // Each side lists a vetoed edge at most once, so the lists stay as short as the valence.
@@ -157,11 +164,10 @@ void Simplifier::remember_rejected(VertexId v, VertexId other) {
 }
 
 bool Simplifier::take_requeued(const Entry& entry, CollapseCandidate& out) {
-  if (requeued_.empty()) return false;
+  if (!(entry.stamp & kRequeued)) return false;
   const auto it = requeued_.find(edge_key(entry.a, entry.b));
   if (it == requeued_.end()) return false;
-  const bool unchanged = star_changed_at_[entry.a] <= it->second.first &&
-                         star_changed_at_[entry.b] <= it->second.first;
+  const bool unchanged = !requeued_outdated(it->first, it->second.first);
   if (unchanged) {
     out = std::move(it->second.second);
     ++stats_.requeue_reused;
@@ -596,11 +602,13 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       heap_.pop();
       ++stats_.stale;
     }
-    const Entry now{static_cast<float>(candidate.cost), entry.a, entry.b, entry.stamp};
+    const Entry now{static_cast<float>(candidate.cost), entry.a, entry.b, entry.stamp | kRequeued};
     if (!heap_.empty() && heap_.top().cost < now.cost) {
       heap_.push(now);
       ++stats_.requeued;
-      requeued_[edge_key(entry.a, entry.b)] = {collapses_, std::move(candidate)};
+      // (a cheap module costs the edge again for less than keeping its costing takes)
+      if (priority_.costly())
+        requeued_[edge_key(entry.a, entry.b)] = {collapses_, std::move(candidate)};
       continue;
     }
     if (candidate.seam) {

@@ -178,8 +178,11 @@ class Simplifier {
   // 16 bytes, so that more of the heap stays in cache. The stamp is the sum of the two
   // vertices' versions when the entry was pushed: versions only grow, so the sum is unchanged
   // exactly when neither end has changed since. Its top bit marks a deferred entry, whose
-  // edge is to be costed when it comes out (versions count collapses, far below 2^31).
+  // edge is to be costed when it comes out, the next a requeued one, whose costing requeued_
+  // may hold (versions count collapses, far below 2^30).
   static constexpr uint32_t kDeferred = 0x80000000u;
+  static constexpr uint32_t kRequeued = 0x40000000u;
+  static constexpr uint32_t kVersions = ~(kDeferred | kRequeued);
   struct Entry {
     float cost;  // the key
     VertexId a, b;
@@ -268,6 +271,12 @@ class Simplifier {
   // when it comes out again.
   static uint64_t edge_key(VertexId a, VertexId b) { return uint64_t(a) << 32 | b; }
   bool take_requeued(const Entry& entry, CollapseCandidate& out);
+  // Whether a requeued costing is of no more use: the edge's star changed after it.
+  bool requeued_outdated(uint64_t key, uint32_t costed_at) const {
+    return star_changed_at_[VertexId(key >> 32)] > costed_at ||
+           star_changed_at_[VertexId(key & 0xffffffffu)] > costed_at;
+  }
+  void forget_outdated_requeued();
   std::unordered_map<uint64_t, std::pair<uint32_t, CollapseCandidate>> requeued_;
   std::vector<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
   bool defer_ = false;                     // costly() and a limit below SIZE_MAX
