@@ -18,6 +18,12 @@ Vec3 normal_of(const CollapseMesh& mesh, FaceId f) {
   return triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
 }
 
+// An optimum far from the edge comes from a nearly flat quadric; it folds the mesh.
+bool near_edge(const Vec3& p, const Vec3& pa, const Vec3& pb) {
+  const Vec3 d = sub(p, scale(add(pa, pb), 0.5));
+  return dot(d, d) <= 4.0 * dot(sub(pb, pa), sub(pb, pa));
+}
+
 }  // namespace
 
 void QuadricPriority::initialize(const CollapseMesh& mesh) {
@@ -56,14 +62,8 @@ void QuadricPriority::initialize(const CollapseMesh& mesh) {
 
 Vec3 QuadricPriority::place(const Quadric& q, const Vec3& pa, const Vec3& pb) const {
   const Vec3 mid = scale(add(pa, pb), 0.5);
-  const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
   Vec3 best;
-  bool placed = q.minimizer(best);
-  if (placed) {
-    // An optimum far from the edge comes from a nearly flat quadric; it folds the mesh.
-    const Vec3 d = sub(best, mid);
-    placed = dot(d, d) <= 4.0 * edge_sq;
-  }
+  bool placed = q.minimizer(best) && near_edge(best, pa, pb);
   if (placed && options_.round_to_float) {
     for (double& c : best) c = round_to_float(c);
   }
@@ -81,8 +81,34 @@ Vec3 QuadricPriority::place(const Quadric& q, const Vec3& pa, const Vec3& pb) co
   return best;
 }
 
+bool QuadricPriority::place_on_constraints(const CollapseMesh& mesh, VertexId a, VertexId b,
+                                           const Quadric& q, Vec3& out) {
+  const Vec3& pa = mesh.position(a);
+  const Vec3& pb = mesh.position(b);
+  const Vec3 o = scale(add(pa, pb), 0.5);  // (the origin of the sums, for precision)
+  const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
+  PlacementConstraints constraints(o);
+  if (options_.keep_volume) {
+    Vec3 g;
+    double h;
+    star_volume(mesh, a, b, o, star_scratch_, g, h);
+    if (dot(g, g) > 1e-12 * edge_sq * edge_sq) constraints.require(g, h);
+  }
+  Vec3 e1, e2;
+  if (options_.keep_border && (mesh.is_boundary(a) || mesh.is_boundary(b)) &&
+      star_border(mesh, a, b, o, star_scratch_, e1, e2) && dot(e1, e1) > 1e-12 * edge_sq) {
+    // (v - o) x e1 = e2 across e1: (v - o).(e1 x w) = e2.w for two directions w across it.
+    const Vec3 along = scale(e1, 1 / length(e1));
+    Vec3 w1 = std::fabs(along[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    w1 = sub(w1, scale(along, dot(w1, along)));
+    w1 = scale(w1, 1 / length(w1));
+    for (const Vec3& w : {w1, cross(along, w1)}) constraints.require(cross(e1, w), dot(e2, w));
+  }
+  return constraints.minimize(q, out);
+}
+
 bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
-                               CollapseCandidate& out, Costing) {
+                               CollapseCandidate& out, Costing costing) {
   ++costings_;
   const bool locked_a = !locked_.empty() && locked_[a];
   const bool locked_b = !locked_.empty() && locked_[b];
@@ -91,8 +117,27 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
   q += quadrics_[b];
   out.vs = (locked_b || (!locked_a && b < a)) ? b : a;
   out.vt = out.vs == a ? b : a;
-  out.position =
-      locked_a || locked_b ? mesh.position(out.vs) : place(q, mesh.position(a), mesh.position(b));
+  const Vec3& pa = mesh.position(a);
+  const Vec3& pb = mesh.position(b);
+  Vec3 kept;
+  if (locked_a || locked_b) {
+    out.position = mesh.position(out.vs);
+  } else if (!options_.keep_volume && !options_.keep_border) {
+    out.position = place(q, pa, pb);
+  } else if (costing == Costing::kQueue && q.minimizer(kept)) {
+    out.position = kept;  // no placement costs less: a lower bound of the constrained cost
+  } else if (place_on_constraints(mesh, a, b, q, kept) && near_edge(kept, pa, pb)) {
+    // An end that meets the constraints comes out of the solve up to rounding: a corner
+    // stays exactly where it was.
+    const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
+    for (const Vec3* end : {&pa, &pb})
+      if (dot(sub(kept, *end), sub(kept, *end)) <= 1e-18 * edge_sq) kept = *end;
+    out.position = kept;
+    if (options_.round_to_float)
+      for (double& c : out.position) c = round_to_float(c);
+  } else {
+    out.position = place(q, pa, pb);
+  }
   out.cost = std::max(0.0, q.evaluate(out.position));
   out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
   return std::isfinite(out.cost);

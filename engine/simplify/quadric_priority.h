@@ -1,5 +1,10 @@
 // The quadric priority module: Garland & Heckbert 97 plane quadrics, area weighted, with
-// boundary-preserving planes along open edges, optimal placement with a fallback.
+// boundary-preserving planes along open edges, optimal placement with a fallback. The optimum
+// is taken among the placements that keep the volume the edge's star encloses and the area
+// its border edges sweep (Lindstrom-Turk 98's first two constraints, placement_constraints.h):
+// without them a coarse level shrinks where the surface or its outline curves. A queue key is
+// the unconstrained optimum's cost, a lower bound of the constrained cost, which reads the
+// star's faces and is paid only for the edge at the top (Costing).
 #pragma once
 
 #include <cstdint>
@@ -8,6 +13,7 @@
 
 #include "simplify/module_state.h"
 #include "simplify/modules.h"
+#include "simplify/placement_constraints.h"
 #include "simplify/quadric.h"
 #include "simplify/simplifier.h"
 
@@ -18,6 +24,9 @@ struct QuadricOptions {
   // face planes (it is multiplied by the squared edge length to have area units).
   double boundary_weight = 4.0;
   bool round_to_float = false;  // place vertices on float32 coordinates (exact PM storage)
+  // The optimum among the placements that keep the star's volume, and its border's area.
+  bool keep_volume = true;
+  bool keep_border = true;
 };
 
 class QuadricPriority : public PriorityModule {
@@ -27,7 +36,7 @@ class QuadricPriority : public PriorityModule {
   std::string name() const override { return "quadric"; }
   void initialize(const CollapseMesh& mesh) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) override;  // (both costings alike: it is cheap)
+                Costing costing) override;  // kQueue: the unconstrained optimum's cost
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                      CollapseCandidate& out, Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
@@ -53,11 +62,16 @@ class QuadricPriority : public PriorityModule {
  private:
   // Where the collapse of the edge (pa, pb) with quadric q puts its survivor.
   Vec3 place(const Quadric& q, const Vec3& pa, const Vec3& pb) const;
+  // The minimiser of q among the placements that meet the constraints the options ask for
+  // (placement_constraints.h); false where there is none.
+  bool place_on_constraints(const CollapseMesh& mesh, VertexId a, VertexId b, const Quadric& q,
+                            Vec3& out);
 
   uint64_t costings_ = 0;
   std::vector<uint8_t> locked_;
   QuadricOptions options_;
   std::vector<Quadric> quadrics_;
+  StarTermsScratch star_scratch_;  // place_on_constraints's working memory
 };
 
 }  // namespace parapm

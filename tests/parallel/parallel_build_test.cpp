@@ -355,40 +355,34 @@ TEST(ParallelBuild, PartitionsAreDrawnAhead) {
 
 // With one subset nothing is a border: the job is the whole mesh and runs the sequential
 // queue to the handover; the final pass then continues from the same metric state with a
-// fresh queue. A quadric cost depends only on the edge's two ends, whose stamps the queue
-// tracks, so the fresh queue holds the same costs and the PM is the sequential one, byte for
-// byte. An energy cost also depends on the star around the edge: the sequential queue keeps
-// entries whose stars changed since (a known approximation of the driver), the fresh queue
-// re-costs them, so the energy PMs agree exactly up to the handover only, and only without
-// deferred re-costing (with it they part after a few hundred collapses on the airplane: the
-// job's cost ceiling refuses edges that the sequential build keys, so the two defer different
-// edges).
-TEST(ParallelBuild, OneSubsetGivesTheSequentialPm) {
-  for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
-    const RepairedMesh repaired = testing::repaired_test_mesh(name);
-    const SimplifyOptions quadric = metric_options("quadric");
-    EXPECT_TRUE(testing::pm_bytes(build_progressive_mesh_parallel(repaired, quadric, with_p(1))) ==
-                testing::pm_bytes(build_progressive_mesh(repaired, quadric)))
-        << name;
-
-    SimplifyOptions energy = metric_options("energy");
-    energy.defer_recosting = false;
-    ParallelStats stats;
-    const ProgressiveMesh parallel =
-        build_progressive_mesh_parallel(repaired, energy, with_p(1), &stats);
-    const ProgressiveMesh sequential = build_progressive_mesh(repaired, energy);
-    const size_t before_handover = stats.round_stats.at(0).subsets.at(0).collapses;
-    ASSERT_GT(before_handover, parallel.splits.size() / 3);  // a large part of the build
-    ASSERT_GE(sequential.splits.size(), before_handover);
-    // Collapse i is split n - 1 - i.
-    for (size_t i = 0; i < before_handover; ++i) {
-      const VertexSplit& a = parallel.splits[parallel.splits.size() - 1 - i];
-      const VertexSplit& b = sequential.splits[sequential.splits.size() - 1 - i];
-      ASSERT_TRUE(a.vs_after == b.vs_after && a.vt_after == b.vt_after &&
-                  a.vs_before == b.vs_before)
-          << name << ": energy collapse " << i << " of " << before_handover;
+// fresh queue. Both metrics' costs depend on the star around the edge (the quadric's through
+// the constraints its placement meets): the sequential queue keeps entries whose stars changed
+// since (a known approximation of the driver), the fresh queue re-costs them, so the PMs agree
+// exactly up to the handover, the energy's only without deferred re-costing (with it they
+// part after a few hundred collapses on the airplane: the job's cost ceiling refuses edges
+// that the sequential build keys, so the two defer different edges).
+TEST(ParallelBuild, OneSubsetGivesTheSequentialPmUpToTheHandover) {
+  for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"})
+    for (const char* metric : {"quadric", "energy"}) {
+      const RepairedMesh repaired = testing::repaired_test_mesh(name);
+      SimplifyOptions options = metric_options(metric);
+      options.defer_recosting = false;
+      ParallelStats stats;
+      const ProgressiveMesh parallel =
+          build_progressive_mesh_parallel(repaired, options, with_p(1), &stats);
+      const ProgressiveMesh sequential = build_progressive_mesh(repaired, options);
+      const size_t before_handover = stats.round_stats.at(0).subsets.at(0).collapses;
+      ASSERT_GT(before_handover, parallel.splits.size() / 3);  // a large part of the build
+      ASSERT_GE(sequential.splits.size(), before_handover);
+      // Collapse i is split n - 1 - i.
+      for (size_t i = 0; i < before_handover; ++i) {
+        const VertexSplit& a = parallel.splits[parallel.splits.size() - 1 - i];
+        const VertexSplit& b = sequential.splits[sequential.splits.size() - 1 - i];
+        ASSERT_TRUE(a.vs_after == b.vs_after && a.vt_after == b.vt_after &&
+                    a.vs_before == b.vs_before)
+            << name << ": " << metric << " collapse " << i << " of " << before_handover;
+      }
     }
-  }
 }
 
 // The 1999 build's weakness: faces along the borders stayed at full resolution. Each round
@@ -647,7 +641,9 @@ TEST(ParallelBuild, ExtraRoundsStepEvenlyToTheTarget) {
   }
   ASSERT_NE(last_extra, nullptr) << "no extra round: a weak test";
   EXPECT_EQ(last_extra->goal_faces, target);
-  EXPECT_EQ(pm.base.face_count(), target);
+  // (a collapse removes up to two faces: the last may land one below)
+  EXPECT_LE(pm.base.face_count(), target);
+  EXPECT_GE(pm.base.face_count() + 1, target);
   const MeshDifference diff =
       compare_meshes_exact(restore_input(pm), repaired_input(repaired), false);
   EXPECT_TRUE(diff.equal) << diff.first_difference;

@@ -102,10 +102,10 @@ Ratios compare(const std::string& name, const RepairedMesh& repaired,
 // The CAD part's worst cell is guarded at 1.5: its 2% level is below its legal minimum (about
 // 2.1k faces: copies of non-manifold vertices whose seam collapses are vetoed), so it is the
 // base, whose last hundred collapses, the dearest legal ones, double its error; which of them
-// remain moves with the rounds (measured: 1.00-1.03 at p = 2-8, 1.46 at p = 16). Its 10% cells
-// (the rounds' last level), at 1.15: the seam collapses that make its sequential 10% level a
-// third closer to the input than locked copies did, the rounds make only where a group's
-// copies and their rings lie free inside one job (measured: 0.99-1.20, median 1.13).
+// remain moves with the rounds (measured: 0.70-1.09 at p = 2-16). Its 10% cells (the rounds'
+// last level), at 1.15: the seam collapses that make its sequential 10% level a third closer to
+// the input than locked copies did, the rounds make only where a group's copies and their rings
+// lie free inside one job (measured: 1.00-1.19, median 1.07).
 TEST(ParallelQuality, QuadricLevelsMatchTheSequentialOnes) {
   for (const char* name :
        {"cad-cycloidal-43k.ply", "gmsh-aneurysm-20k.stl.gz", "pymeshlab-bunny-textured-10k.obj"}) {

@@ -1,0 +1,134 @@
+#include "simplify/placement_constraints.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "simplify/vec_math.h"
+
+namespace parapm {
+
+void PlacementConstraints::require(Vec3 n, double d) {
+  if (count_ == 3) return;
+  const double before = length(n);
+  if (!(before > 0)) return;
+  for (int j = 0; j < count_; ++j) {
+    const double along = dot(n, rows_[j]);
+    n = sub(n, scale(rows_[j], along));
+    d -= along * rhs_[j];
+  }
+  const double after = length(n);
+  if (!(after > std::sin(M_PI / 180) * before)) return;
+  rows_[count_] = scale(n, 1 / after);
+  rhs_[count_] = d / after;
+  ++count_;
+}
+
+bool PlacementConstraints::minimize(const Quadric& q, Vec3& out) const {
+  if (count_ == 0) return false;
+  // The point of the rows' solutions nearest the origin, then along their null space.
+  Vec3 v0 = origin_;
+  for (int j = 0; j < count_; ++j) v0 = add(v0, scale(rows_[j], rhs_[j]));
+  if (count_ == 3) {
+    out = v0;
+    return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
+  }
+  auto times_a = [&](const Vec3& x) {
+    return Vec3{q.a00 * x[0] + q.a01 * x[1] + q.a02 * x[2],
+                q.a01 * x[0] + q.a11 * x[1] + q.a12 * x[2],
+                q.a02 * x[0] + q.a12 * x[1] + q.a22 * x[2]};
+  };
+  const Vec3 gradient = add(times_a(v0), Vec3{q.b0, q.b1, q.b2});  // half Q's, at v0
+  const double trace = q.a00 + q.a11 + q.a22;
+  if (count_ == 2) {
+    const Vec3 z = cross(rows_[0], rows_[1]);
+    const double zaz = dot(z, times_a(z));
+    if (!(zaz > 1e-9 * trace)) return false;
+    out = add(v0, scale(z, -dot(z, gradient) / zaz));
+  } else {
+    const Vec3& n = rows_[0];
+    Vec3 z1 = std::fabs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    z1 = sub(z1, scale(n, dot(z1, n)));
+    z1 = scale(z1, 1 / length(z1));
+    const Vec3 z2 = cross(n, z1);
+    const Vec3 a1 = times_a(z1), a2 = times_a(z2);
+    const double m00 = dot(z1, a1), m01 = dot(z1, a2), m11 = dot(z2, a2);
+    const double det = m00 * m11 - m01 * m01;
+    if (!(det > 1e-9 * trace * trace)) return false;
+    const double r0 = -dot(z1, gradient), r1 = -dot(z2, gradient);
+    const double y0 = (m11 * r0 - m01 * r1) / det, y1 = (m00 * r1 - m01 * r0) / det;
+    out = add(v0, add(scale(z1, y0), scale(z2, y1)));
+  }
+  return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
+}
+
+void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& origin,
+                 StarTermsScratch& scratch, Vec3& g, double& h) {
+  // A face holding both ends is summed once, from the end whose position comes first.
+  auto& terms = scratch.faces;
+  terms.clear();
+  for (const VertexId end : {a, b}) {
+    const VertexId other = end == a ? b : a;
+    for (const FaceId f : mesh.faces_of(end)) {
+      const Triangle& t = mesh.face(f);
+      const bool vanishes = t[0] == other || t[1] == other || t[2] == other;
+      if (vanishes && mesh.position(other) < mesh.position(end)) continue;
+      if (vanishes && !(mesh.position(end) < mesh.position(other)) && end == b) continue;
+      const int k = corner_of(t, end);
+      terms.push_back({mesh.position(t[(k + 1) % 3]), mesh.position(t[(k + 2) % 3]),
+                       mesh.position(end), vanishes});
+    }
+  }
+  std::sort(terms.begin(), terms.end(),
+            [](const StarTermsScratch::FaceTerm& x, const StarTermsScratch::FaceTerm& y) {
+              return x.p1 != y.p1 ? x.p1 < y.p1 : x.p2 < y.p2;
+            });
+  g = {0, 0, 0};
+  h = 0;
+  for (const auto& term : terms) {
+    const Vec3 c = cross(sub(term.p1, origin), sub(term.p2, origin));
+    h += dot(sub(term.end, origin), c);
+    if (!term.vanishes) g = add(g, c);
+  }
+}
+
+bool star_border(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& origin,
+                 StarTermsScratch& scratch, Vec3& e1, Vec3& e2) {
+  // The border edges at an end: (end, next) where no face of end holds (next, end), and
+  // (previous, end) where none holds (end, previous). One between a and b is listed from a.
+  auto& border = scratch.border;
+  border.clear();
+  for (const VertexId end : {a, b}) {
+    const auto& faces = mesh.faces_of(end);
+    for (const FaceId f : faces) {
+      const Triangle& t = mesh.face(f);
+      const int k = corner_of(t, end);
+      const VertexId next = t[(k + 1) % 3], previous = t[(k + 2) % 3];
+      bool next_has_twin = false, previous_has_twin = false;
+      for (const FaceId other : faces) {
+        const Triangle& u = mesh.face(other);
+        const int j = corner_of(u, end);
+        next_has_twin |= u[(j + 2) % 3] == next;
+        previous_has_twin |= u[(j + 1) % 3] == previous;
+      }
+      if (!next_has_twin && !(end == b && next == a)) border.push_back({end, next});
+      if (!previous_has_twin && !(end == b && previous == a)) border.push_back({previous, end});
+    }
+  }
+  if (border.empty()) return false;
+  std::sort(border.begin(), border.end(), [&](const auto& x, const auto& y) {
+    const Vec3 &x0 = mesh.position(x.first), &y0 = mesh.position(y.first);
+    return x0 != y0 ? x0 < y0 : mesh.position(x.second) < mesh.position(y.second);
+  });
+  e1 = {0, 0, 0};
+  e2 = {0, 0, 0};
+  for (const auto& [p, q] : border) {
+    const Vec3 from = sub(mesh.position(p), origin), to = sub(mesh.position(q), origin);
+    e2 = add(e2, cross(from, to));
+    const bool p_moves = p == a || p == b, q_moves = q == a || q == b;
+    if (p_moves && !q_moves) e1 = add(e1, to);
+    if (q_moves && !p_moves) e1 = sub(e1, from);
+  }
+  return true;
+}
+
+}  // namespace parapm
