@@ -7,6 +7,24 @@
 
 namespace parapm {
 
+namespace {
+
+// A unit vector perpendicular to the unit vector n.
+Vec3 perpendicular(const Vec3& n) {
+  Vec3 w = std::fabs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  w = sub(w, scale(n, dot(w, n)));
+  return scale(w, 1 / length(w));
+}
+
+}  // namespace
+
+void PlacementConstraints::require_cross(const Vec3& e1, const Vec3& e2) {
+  // (v - origin).(e1 x w) = e2.w for two directions w across e1.
+  const Vec3 along = scale(e1, 1 / length(e1));
+  const Vec3 w1 = perpendicular(along);
+  for (const Vec3& w : {w1, cross(along, w1)}) require(cross(e1, w), dot(e2, w));
+}
+
 void PlacementConstraints::require(Vec3 n, double d) {
   if (count_ == 3) return;
   const double before = length(n);
@@ -45,11 +63,8 @@ bool PlacementConstraints::minimize(const Quadric& q, Vec3& out) const {
     if (!(zaz > 1e-9 * trace)) return false;
     out = add(v0, scale(z, -dot(z, gradient) / zaz));
   } else {
-    const Vec3& n = rows_[0];
-    Vec3 z1 = std::fabs(n[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    z1 = sub(z1, scale(n, dot(z1, n)));
-    z1 = scale(z1, 1 / length(z1));
-    const Vec3 z2 = cross(n, z1);
+    const Vec3 z1 = perpendicular(rows_[0]);
+    const Vec3 z2 = cross(rows_[0], z1);
     const Vec3 a1 = times_a(z1), a2 = times_a(z2);
     const double m00 = dot(z1, a1), m01 = dot(z1, a2), m11 = dot(z2, a2);
     const double det = m00 * m11 - m01 * m01;
@@ -93,25 +108,23 @@ void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& o
 
 bool star_border(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& origin,
                  StarTermsScratch& scratch, Vec3& e1, Vec3& e2) {
-  // The border edges at an end: (end, next) where no face of end holds (next, end), and
-  // (previous, end) where none holds (end, previous). One between a and b is listed from a.
+  // The border edges at an end, directed as their faces hold them: (end, next) where no face
+  // holds (next, end), and (previous, end) where none holds (end, previous). One between a and
+  // b is listed from a.
   auto& border = scratch.border;
   border.clear();
   for (const VertexId end : {a, b}) {
-    const auto& faces = mesh.faces_of(end);
-    for (const FaceId f : faces) {
+    if (!mesh.is_boundary(end)) continue;
+    for (const FaceId f : mesh.faces_of(end)) {
       const Triangle& t = mesh.face(f);
       const int k = corner_of(t, end);
       const VertexId next = t[(k + 1) % 3], previous = t[(k + 2) % 3];
-      bool next_has_twin = false, previous_has_twin = false;
-      for (const FaceId other : faces) {
-        const Triangle& u = mesh.face(other);
-        const int j = corner_of(u, end);
-        next_has_twin |= u[(j + 2) % 3] == next;
-        previous_has_twin |= u[(j + 1) % 3] == previous;
+      for (const auto& [from, to] : {std::pair{end, next}, std::pair{previous, end}}) {
+        const VertexId far = from == end ? to : from;
+        if (end == b && far == a) continue;
+        if (mesh.is_boundary(far) && mesh.edge_faces(to, from).left == kNoId)
+          border.push_back({from, to});
       }
-      if (!next_has_twin && !(end == b && next == a)) border.push_back({end, next});
-      if (!previous_has_twin && !(end == b && previous == a)) border.push_back({previous, end});
     }
   }
   if (border.empty()) return false;

@@ -28,6 +28,8 @@ class PlacementConstraints {
   // Adds n.(v - origin) = d unless n lies within a degree of the rows' span (Lindstrom-Turk's
   // alpha-compatibility) or is zero.
   void require(Vec3 n, double d);
+  // The two equations across e1 of (v - origin) x e1 = e2 (e1 not zero).
+  void require_cross(const Vec3& e1, const Vec3& e2);
   int count() const { return count_; }
   // The minimiser of q among the points that meet every row; false where q has none there (no
   // row, or q flat along a direction the rows leave free).

@@ -97,12 +97,7 @@ bool QuadricPriority::place_on_constraints(const CollapseMesh& mesh, VertexId a,
   Vec3 e1, e2;
   if (options_.keep_border && (mesh.is_boundary(a) || mesh.is_boundary(b)) &&
       star_border(mesh, a, b, o, star_scratch_, e1, e2) && dot(e1, e1) > 1e-12 * edge_sq) {
-    // (v - o) x e1 = e2 across e1: (v - o).(e1 x w) = e2.w for two directions w across it.
-    const Vec3 along = scale(e1, 1 / length(e1));
-    Vec3 w1 = std::fabs(along[0]) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    w1 = sub(w1, scale(along, dot(w1, along)));
-    w1 = scale(w1, 1 / length(w1));
-    for (const Vec3& w : {w1, cross(along, w1)}) constraints.require(cross(e1, w), dot(e2, w));
+    constraints.require_cross(e1, e2);
   }
   return constraints.minimize(q, out);
 }

@@ -36,6 +36,18 @@ double covered_area(const CollapseMesh& mesh) {
   return twice / 2;
 }
 
+// `measure` of `mesh` taken down to `faces` faces with `options`, over the input's.
+double after_over_before(const Mesh& mesh, size_t faces, const QuadricOptions& options,
+                         double (*measure)(const CollapseMesh&)) {
+  CollapseMesh working(mesh);
+  const double before = measure(working);
+  QuadricPriority priority({}, options);
+  Simplifier simplifier(working, priority, standard_constraints({}));
+  simplifier.run({faces}, {}, nullptr);
+  EXPECT_EQ(working.live_faces(), faces);
+  return measure(working) / before;
+}
+
 // A sphere taken down to 60 faces: each collapse of a convex surface cuts a little off it, so
 // a level placed at the quadric's free optimum shrinks; kept on the plane of equal volume, the
 // level encloses the input's volume (up to the collapses that fall back to an end or the
@@ -43,16 +55,10 @@ double covered_area(const CollapseMesh& mesh) {
 TEST(QuadricPlacement, ACoarseSphereKeepsItsVolume) {
   const Mesh sphere = testing::uv_sphere(40, 80, 0.15);
   auto volume_ratio = [&](bool keep_volume) {
-    CollapseMesh mesh(sphere);
-    const double before = enclosed_volume(mesh);
     QuadricOptions options;
     options.keep_volume = keep_volume;
     options.keep_border = false;
-    QuadricPriority priority({}, options);
-    Simplifier simplifier(mesh, priority, standard_constraints({}));
-    simplifier.run({60}, {}, nullptr);
-    EXPECT_EQ(mesh.live_faces(), 60u);
-    return enclosed_volume(mesh) / before;
+    return after_over_before(sphere, 60, options, enclosed_volume);
   };
   const double kept = volume_ratio(true), free = volume_ratio(false);
   std::printf("volume of the 60-face level over the input's: kept %.4f, free %.4f\n", kept, free);
@@ -66,15 +72,9 @@ TEST(QuadricPlacement, ACoarseSphereKeepsItsVolume) {
 TEST(QuadricPlacement, ACoarseDiscKeepsItsArea) {
   const Mesh disc = testing::disc(10, 80);
   auto area_ratio = [&](bool keep_border) {
-    CollapseMesh mesh(disc);
-    const double before = covered_area(mesh);
     QuadricOptions options;
     options.keep_border = keep_border;
-    QuadricPriority priority({}, options);
-    Simplifier simplifier(mesh, priority, standard_constraints({}));
-    simplifier.run({12}, {}, nullptr);
-    EXPECT_EQ(mesh.live_faces(), 12u);
-    return covered_area(mesh) / before;
+    return after_over_before(disc, 12, options, covered_area);
   };
   const double kept = area_ratio(true), free = area_ratio(false);
   std::printf("area of the 12-face level over the input's: kept %.4f, free %.4f\n", kept, free);
