@@ -25,7 +25,7 @@ struct SimplifyArgs {
   double ratio = 0;
   std::string metric = "quadric";
   double samples_per_face = SimplifyOptions{}.samples_per_face;
-  double crease_angle = 60;
+  double crease_angle = 180;
   double attribute_weight = 0.01;
   EnergyTuning energy;
   uint64_t seed = 1;
@@ -238,9 +238,10 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--crease-angle", args->crease_angle,
                   "Energy metric: degrees between face normals above which an edge is a crease, "
-                  "kept as a curve like boundaries and attribute seams (180: none); a crease of "
-                  "fewer than --crease-min-edges edges and shorter than --crease-min-length is "
-                  "taken for a scan's noise and not kept")
+                  "kept as a curve like boundaries and attribute seams (180, the default: none; "
+                  "the star's planes keep creases without curves, which hold coarse levels "
+                  "back); a crease of fewer than --crease-min-edges edges and shorter than "
+                  "--crease-min-length is taken for a scan's noise and not kept")
       ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
   cmd->add_option("--crease-min-edges", args->energy.min_crease_edges,

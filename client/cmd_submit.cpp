@@ -168,11 +168,11 @@ void add_submit_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 40));
   cmd->add_option("--seed", args->seed, "seed of the randomised steps (default 1)");
   cmd->add_option("--samples-per-face", args->samples_per_face,
-                  "energy: extra sample points (default 0)")
+                  "energy: extra points per face, by area, beyond one per vertex (default 1)")
       ->check(CLI::Range(0.0, 64.0));
   cmd->add_option("--crease-angle", args->crease_angle,
-                  "energy: crease angle, degrees, in [0, 180] (default 60; creases of fewer than 8 "
-                  "edges and shorter than 5% of the diagonal are noise, not kept)")
+                  "energy: crease angle, degrees, in [0, 180] (default 180: no creases; creases of "
+                  "fewer than 8 edges and shorter than 5% of the diagonal are noise, not kept)")
       ->check(CLI::Range(0.0, 180.0));
   cmd->add_option("--attribute-weight", args->attribute_weight,
                   "energy: weight of attributes against geometry (default 0.01; 0: not optimised)")

@@ -34,7 +34,7 @@ namespace parapm {
 struct SubsetOptions {
   std::string metric = "quadric";  // "quadric" or "energy"
   double samples_per_face = 1;
-  double crease_angle_degrees = 60;
+  double crease_angle_degrees = 180;
   double attribute_weight = 0.01;
   EnergyTuning energy;
   uint64_t seed = 1;  // already mixed with the round and subset index by the extraction

@@ -20,9 +20,11 @@
 namespace parapm {
 
 struct SharpEdgeOptions {
-  double crease_angle_degrees = 60;  // sharp when the face normals differ by more
-  bool boundaries = true;            // open boundaries, and edges whose faces lie back to back
-  bool seams = true;                 // edges across which a corner's wedge changes
+  // Sharp when the face normals differ by more; 180: no creases (the default: the star's planes
+  // keep them, docs/DECISIONS.md, "No crease curves by default").
+  double crease_angle_degrees = 180;
+  bool boundaries = true;  // open boundaries, and edges whose faces lie back to back
+  bool seams = true;       // edges across which a corner's wedge changes
   // A crease of fewer edges than min_crease_edges and shorter than long_crease_diagonals of
   // the bounding-box diagonal is a scan's noise, not kept (1: every crease is); the length
   // clause keeps a coarse mesh's few but long creases (docs/DECISIONS.md, "Creases of fewer than 8

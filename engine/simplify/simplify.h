@@ -40,8 +40,10 @@ struct SimplifyOptions {
   // between the vertices, which the coarse collapses of a flat or sparsely sampled region cut
   // (docs/DECISIONS.md, "One extra point per face").
   double samples_per_face = 1;
-  // energy: an edge whose faces' normals differ by more is a crease, kept as a curve (E_disc)
-  double crease_angle_degrees = 60;
+  // energy: an edge whose faces' normals differ by more is a crease, kept as a curve (E_disc);
+  // 180: none, the default (the star's planes keep creases: docs/DECISIONS.md, "No crease
+  // curves by default")
+  double crease_angle_degrees = 180;
   // energy: E_scalar's weight of attributes (colours, normals, texture coordinates) against
   // geometry: an attribute difference of 1 costs as much as this fraction of the bounding-box
   // diagonal in distance. 0: attributes are not optimised (each wedge keeps its input value).

@@ -276,11 +276,18 @@ TEST(JobState, ImportedStateEqualsTheReplayedState) {
 
 // The energy's master on stratocaster-9k and the jobs of its two halves (by the sign of x),
 // each with the master's state and a target of half its faces.
+// The options with the stratocaster's creases kept as curves (off by default), so that the
+// states carry curve samples and sharp neighbours to check.
+SimplifyOptions creases_on(SimplifyOptions options) {
+  options.crease_angle_degrees = 60;
+  return options;
+}
+
 struct TwoHalves {
   TwoHalves()
       : repaired(testing::repaired_test_mesh("stratocaster-9k.ply")),
         locked(locked_vertices(repaired)),
-        options(options_of("energy")),
+        options(creases_on(options_of("energy"))),
         whole(repaired.mesh),
         master(make_priority_module(options, repaired.mesh, locked)),
         vertex_subset(whole.vertex_capacity(), 0) {

@@ -9,6 +9,7 @@
 
 #include "io/mesh_io.h"
 #include "mesh/repair.h"
+#include "parallel/subset_job.h"
 #include "pm/pm_file.h"
 #include "simplify/energy_priority.h"
 #include "simplify/simplify.h"
@@ -23,15 +24,16 @@ std::string pm_bytes(const ProgressiveMesh& pm) {
   return out.str();
 }
 
-// The textured bunny (a scan: short noise creases, which the crease knobs decide about) to
-// 10%, with one knob changed from its default: a different PM for every knob, and the same
-// bytes again with the defaults spelled out.
+// The textured bunny (a scan: short noise creases, which the crease knobs decide about once
+// creases are on) to 10%, with one knob changed from its default: a different PM for every
+// knob, and the same bytes again with the defaults spelled out.
 TEST(EnergyTuning, EveryKnobReachesTheMetric) {
   const RepairedMesh repaired =
       repair_mesh(read_mesh(testing::test_data("pymeshlab-bunny-textured-10k.obj")));
   SimplifyOptions options;
   options.metric = "energy";
   options.target_ratio = 0.1;
+  options.crease_angle_degrees = 60;  // creases on (off by default), for the crease knobs
   const std::string defaults = pm_bytes(build_progressive_mesh(repaired, options));
   SimplifyOptions spelled = options;
   spelled.energy = EnergyTuning{30, 4, 0.03, 8, 0.05};
@@ -59,6 +61,8 @@ TEST(EnergyTuning, DefaultsAreTheMetricsDefaults) {
   EXPECT_EQ(tuning.volume_weight, energy.volume_weight);
   EXPECT_EQ(tuning.spring_scale, energy.spring_scale);
   EXPECT_EQ(tuning.min_crease_edges, energy.sharp.min_crease_edges);
+  EXPECT_EQ(SimplifyOptions{}.crease_angle_degrees, energy.sharp.crease_angle_degrees);
+  EXPECT_EQ(SubsetOptions{}.crease_angle_degrees, energy.sharp.crease_angle_degrees);
   EXPECT_EQ(tuning.crease_min_length, energy.sharp.long_crease_diagonals);
 }
 
