@@ -189,7 +189,7 @@ void add_submit_command(CLI::App& app, int& exit_code) {
                   "energy: weight of the star's planes against the points (default 30; 0: off)")
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--volume-weight", args->volume_weight,
-                  "energy: weight of the enclosed volume's change (default 4; 0: off)")
+                  "energy: weight of the enclosed volume's change (default 64; 0: off)")
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--spring-scale", args->spring_scale,
                   "energy: E_spring's kappa times this (default 0.03; 0: no springs)")

@@ -123,9 +123,9 @@ struct EnergyOptions {
   // different subsets (and the weights derived from the diagonal) are comparable.
   double reference_diagonal = 0;
   // The star's planes and volume preservation (see the top; 0: off). The weights' choice:
-  // docs/DECISIONS.md, "The star's planes".
+  // docs/DECISIONS.md, "The star's planes" and "The volume term at 64".
   double star_planes_weight = 30;
-  double volume_weight = 4;
+  double volume_weight = 64;
 };
 
 // The input's wedge values, for E_scalar (CollapseMesh holds only the corners' wedge ids).

@@ -19,7 +19,7 @@ namespace parapm {
 struct EnergyTuning {
   // The star's planes and volume preservation (Lindstrom-Turk's terms), against E_dist.
   double star_planes_weight = 30;
-  double volume_weight = 4;
+  double volume_weight = 64;
   // E_spring's kappa: Hoppe's schedule times this.
   double spring_scale = 0.03;
   // A crease of fewer edges than this and shorter than crease_min_length x the bounding-box

@@ -36,7 +36,7 @@ TEST(EnergyTuning, EveryKnobReachesTheMetric) {
   options.crease_angle_degrees = 60;  // creases on (off by default), for the crease knobs
   const std::string defaults = pm_bytes(build_progressive_mesh(repaired, options));
   SimplifyOptions spelled = options;
-  spelled.energy = EnergyTuning{30, 4, 0.03, 8, 0.05};
+  spelled.energy = EnergyTuning{30, 64, 0.03, 8, 0.05};
   EXPECT_EQ(pm_bytes(build_progressive_mesh(repaired, spelled)), defaults);
 
   const std::vector<std::pair<const char*, std::function<void(EnergyTuning&)>>> knobs = {
