@@ -77,7 +77,7 @@ bool PlacementConstraints::minimize(const Quadric& q, Vec3& out) const {
 }
 
 void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& origin,
-                 StarTermsScratch& scratch, Vec3& g, double& h) {
+                 StarTermsScratch& scratch, Vec3& g, double& h, Quadric* planes) {
   // A face holding both ends is summed once, from the end whose position comes first.
   auto& terms = scratch.faces;
   terms.clear();
@@ -102,7 +102,14 @@ void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& o
   for (const auto& term : terms) {
     const Vec3 c = cross(sub(term.p1, origin), sub(term.p2, origin));
     h += dot(sub(term.end, origin), c);
-    if (!term.vanishes) g = add(g, c);
+    if (term.vanishes) continue;
+    g = add(g, c);
+    if (!planes) continue;
+    const Vec3 n = cross(sub(term.p1, term.end), sub(term.p2, term.end));
+    const double twice_area = length(n);
+    if (!(twice_area > 0)) continue;
+    const Vec3 unit = scale(n, 1 / twice_area);
+    *planes += Quadric::from_plane(unit, -dot(unit, term.end), 0.5 * twice_area);
   }
 }
 

@@ -53,9 +53,11 @@ struct StarTermsScratch {
 };
 
 // The volume equation of collapsing {a, b}: g.(v - origin) = h, six times the volume the star's
-// faces enclose with origin after and before (a face holding both ends vanishes).
+// faces enclose with origin after and before (a face holding both ends vanishes). With
+// `planes`: the planes of the star's faces that stay, before the collapse, each weighted by its
+// area, added to it.
 void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& origin,
-                 StarTermsScratch& scratch, Vec3& g, double& h);
+                 StarTermsScratch& scratch, Vec3& g, double& h, Quadric* planes = nullptr);
 
 // The border equations of collapsing {a, b}: (v - origin) x e1 = e2, e2 the sum of
 // (p - origin) x (q - origin) over the border edges (p, q) at a and b before, and the same sum

@@ -82,24 +82,31 @@ Vec3 QuadricPriority::place(const Quadric& q, const Vec3& pa, const Vec3& pb) co
 }
 
 bool QuadricPriority::place_on_constraints(const CollapseMesh& mesh, VertexId a, VertexId b,
-                                           const Quadric& q, Vec3& out) {
+                                           const Quadric& q, Quadric& total, Vec3& out) {
   const Vec3& pa = mesh.position(a);
   const Vec3& pb = mesh.position(b);
   const Vec3 o = scale(add(pa, pb), 0.5);  // (the origin of the sums, for precision)
   const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
   PlacementConstraints constraints(o);
-  if (options_.keep_volume) {
+  total = q;
+  const bool planes = options_.star_planes_weight > 0;
+  if (options_.keep_volume || planes) {
     Vec3 g;
     double h;
-    star_volume(mesh, a, b, o, star_scratch_, g, h);
-    if (dot(g, g) > 1e-12 * edge_sq * edge_sq) constraints.require(g, h);
+    Quadric star;
+    star_volume(mesh, a, b, o, star_scratch_, g, h, planes ? &star : nullptr);
+    if (options_.keep_volume && dot(g, g) > 1e-12 * edge_sq * edge_sq) constraints.require(g, h);
+    if (planes) {
+      star *= options_.star_planes_weight;
+      total += star;
+    }
   }
   Vec3 e1, e2;
   if (options_.keep_border && (mesh.is_boundary(a) || mesh.is_boundary(b)) &&
       star_border(mesh, a, b, o, star_scratch_, e1, e2) && dot(e1, e1) > 1e-12 * edge_sq) {
     constraints.require_cross(e1, e2);
   }
-  return constraints.minimize(q, out);
+  return constraints.minimize(total, out);
 }
 
 bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
@@ -121,17 +128,22 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     out.position = place(q, pa, pb);
   } else if (costing == Costing::kQueue && q.minimizer(kept)) {
     out.position = kept;  // no placement costs less: a lower bound of the constrained cost
-  } else if (place_on_constraints(mesh, a, b, q, kept) && near_edge(kept, pa, pb)) {
-    // An end that meets the constraints comes out of the solve up to rounding: a corner
-    // stays exactly where it was.
-    const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
-    for (const Vec3* end : {&pa, &pb})
-      if (dot(sub(kept, *end), sub(kept, *end)) <= 1e-18 * edge_sq) kept = *end;
-    out.position = kept;
-    if (options_.round_to_float)
-      for (double& c : out.position) c = round_to_float(c);
   } else {
-    out.position = place(q, pa, pb);
+    // Placed with the star's planes; costed by the accumulated quadric alone, whose free
+    // optimum's cost (the queue key) stays a lower bound.
+    Quadric total;
+    if (place_on_constraints(mesh, a, b, q, total, kept) && near_edge(kept, pa, pb)) {
+      // An end that meets the constraints comes out of the solve up to rounding: a corner
+      // stays exactly where it was.
+      const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
+      for (const Vec3* end : {&pa, &pb})
+        if (dot(sub(kept, *end), sub(kept, *end)) <= 1e-18 * edge_sq) kept = *end;
+      out.position = kept;
+      if (options_.round_to_float)
+        for (double& c : out.position) c = round_to_float(c);
+    } else {
+      out.position = place(total, pa, pb);
+    }
   }
   out.cost = std::max(0.0, q.evaluate(out.position));
   out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;

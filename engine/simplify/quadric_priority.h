@@ -27,6 +27,14 @@ struct QuadricOptions {
   // The optimum among the placements that keep the star's volume, and its border's area.
   bool keep_volume = true;
   bool keep_border = true;
+  // The planes of the star's faces before the collapse, weighted by area and by this, join the
+  // accumulated quadric in the performed collapse's placement, not in its cost (0: off). The
+  // accumulated quadrics remember the input's planes but not where the level stands now, and
+  // at a coarse level place a rim's merged vertex where it bevels the rim; the star's planes
+  // (Lindstrom-Turk's memoryless objective, in the quadric's units) hold it there. The cost
+  // stays the accumulated quadric's, so that a queue key, its free optimum's cost, stays a
+  // close lower bound (docs/DECISIONS.md, "The quadric places with its star's planes").
+  double star_planes_weight = 0.3;
 };
 
 class QuadricPriority : public PriorityModule {
@@ -62,10 +70,11 @@ class QuadricPriority : public PriorityModule {
  private:
   // Where the collapse of the edge (pa, pb) with quadric q puts its survivor.
   Vec3 place(const Quadric& q, const Vec3& pa, const Vec3& pb) const;
-  // The minimiser of q among the placements that meet the constraints the options ask for
-  // (placement_constraints.h); false where there is none.
+  // The minimiser of `total` among the placements that meet the constraints the options ask
+  // for (placement_constraints.h); false where there is none. `total` is q plus the star's
+  // planes (QuadricOptions::star_planes_weight).
   bool place_on_constraints(const CollapseMesh& mesh, VertexId a, VertexId b, const Quadric& q,
-                            Vec3& out);
+                            Quadric& total, Vec3& out);
 
   uint64_t costings_ = 0;
   std::vector<uint8_t> locked_;
