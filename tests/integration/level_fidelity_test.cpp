@@ -133,9 +133,8 @@ constexpr double kNegligible = 1e-4;
 // face lands there changes with the extra points' seed (DECISIONS.md, "rims of double-sided
 // sheets"); openfoam-motorbike-332k's 50% level is 3.5x the quadric's (2.0e-4 of the
 // diagonal; metro puts it at 0.10x CGAL Lindstrom-Turk's Hausdorff: bench/fidelity.sh).
-// lion-17k's 2% level, which once closed in over the input's open hole (3.5x the quadric's),
-// and cad-counter-84k's 10% level, which cut its round rim to a polygon while the energy kept
-// crease curves (3.1x), are held at kMetricGap (DECISIONS.md, "boundary planes" and "No
+// lion-17k's 2% level (an open hole the level must not close in over) and cad-counter-84k's
+// 10% level (a round rim) are held at kMetricGap (DECISIONS.md, "boundary planes" and "No
 // crease curves by default").
 double energy_gap(const std::string& mesh) {
   if (mesh == "openfoam-motorbike-332k.obj.gz") return 4;

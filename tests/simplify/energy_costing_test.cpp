@@ -190,7 +190,7 @@ Mesh live_mesh(const CollapseMesh& mesh) {
 // exercised), and the level stays near the build that re-projects every point: measured 1.28x
 // its RMS (0.0129 against 0.0101; a cap of 32 is far below the default 1024, to exercise the
 // path on a small mesh). The two builds' greedy paths part early and either may end the
-// closer: with the volume term at 4 the capped build's level was 0.75x the other's.
+// closer (DECISIONS.md, "The volume term at 64").
 TEST(EnergyCosting, PointsLeftOnTheirFacesKeepUpperBoundsOfTheirDistances) {
   struct Outcome {
     size_t points = 0, above = 0;

@@ -1,15 +1,21 @@
 // The quadric priority module's placement: the volume and the border area its collapses keep
-// (placement_constraints.h).
+// (placement_constraints.h), and the star's planes it weighs.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <vector>
 
 #include "drawn_meshes.h"
+#include "io/mesh_io.h"
+#include "measure/surface_distance.h"
+#include "mesh/repair.h"
 #include "simplify/quadric_priority.h"
 #include "simplify/simplifier.h"
+#include "simplify/simplify.h"
 #include "simplify/vec_math.h"
+#include "test_support.h"
 
 namespace parapm {
 namespace {
@@ -80,6 +86,37 @@ TEST(QuadricPlacement, ACoarseDiscKeepsItsArea) {
   std::printf("area of the 12-face level over the input's: kept %.4f, free %.4f\n", kept, free);
   EXPECT_NEAR(kept, 1.0, 0.002);
   EXPECT_LT(free, 0.99);
+}
+
+// The CAD bearing of ../shared/meshes taken to 2% of its faces: placed by the accumulated
+// quadrics alone, the level bevels its central boss's top rim (a quarter of its squared
+// distance to the input lies there); with the star's planes in the placement the rim holds.
+// Measured: RMS 0.91x the level without them (metro against CGAL Lindstrom-Turk: 1.37x
+// against 1.55x).
+TEST(QuadricPlacement, TheStarsPlanesKeepACoarseLevelsRims) {
+  const auto path = testing::shared_meshes_dir() / "occt-bearing-25k.stl";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  const RepairedMesh repaired = repair_mesh(read_mesh(path.string()));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const size_t faces = repaired.mesh.face_count() / 50;
+  auto rms = [&](double star_planes_weight) {
+    CollapseMesh working(repaired.mesh);
+    QuadricOptions options;
+    options.star_planes_weight = star_planes_weight;
+    QuadricPriority priority(locked, options);
+    Simplifier simplifier(working, priority, standard_constraints(locked));
+    simplifier.run({faces}, {}, nullptr);
+    Mesh level;
+    level.positions = working.positions();
+    for (FaceId f = 0; f < working.face_capacity(); ++f)
+      if (working.face_alive(f)) level.faces.push_back(working.face(f));
+    return surface_distance(repaired.mesh, level, 100000).rms;
+  };
+  const double with = rms(QuadricOptions{}.star_planes_weight), without = rms(0);
+  std::printf("occt-bearing-25k at %zu faces: RMS %.4g with the star's planes, %.4g without\n",
+              faces, with, without);
+  EXPECT_GT(QuadricOptions{}.star_planes_weight, 0);
+  EXPECT_LT(with, 0.95 * without);
 }
 
 }  // namespace
