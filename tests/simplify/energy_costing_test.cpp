@@ -173,15 +173,6 @@ TEST(EnergyCosting, ThinnedSamplesCostLikeAllOfThem) {
   EXPECT_GT(double(same_order), 0.95 * double(pairs));
 }
 
-// The live faces of a simplified mesh, as a Mesh (unused vertices stay: they do not count).
-Mesh live_mesh(const CollapseMesh& mesh) {
-  Mesh out;
-  out.positions = mesh.positions();
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
-    if (mesh.face_alive(f)) out.faces.push_back(mesh.face(f));
-  return out;
-}
-
 // A performed collapse whose star holds more than max_points_per_reprojection points leaves
 // its faces' points where they are (until a face's corners have moved by a quarter of its
 // size): their stored distances lag behind the moved corners, and each face's drift keeps them
@@ -215,7 +206,7 @@ TEST(EnergyCosting, PointsLeftOnTheirFacesKeepUpperBoundsOfTheirDistances) {
       out.true_sum += truth;
       if (p.distance_sq > truth * (1 + 1e-6) + 1e-30) ++out.above;
     }
-    out.rms = surface_distance(s.repaired.mesh, live_mesh(*s.mesh), 100000).rms;
+    out.rms = surface_distance(s.repaired.mesh, testing::live_mesh(*s.mesh), 100000).rms;
     return out;
   };
   const Outcome kept = run(32), moved = run(0);
@@ -242,8 +233,8 @@ TEST(EnergyCosting, ScaledSpringsKeepTheSurfaceCloserThanHoppesValues) {
     hoppe.spring_scale = 1;
     const Simplified scaled = simplified("gmsh-aneurysm-20k.stl.gz", EnergyOptions{}, ratio);
     const Simplified original = simplified("gmsh-aneurysm-20k.stl.gz", hoppe, ratio);
-    const SurfaceDistance a = surface_distance(input, live_mesh(*scaled.mesh), 100000);
-    const SurfaceDistance b = surface_distance(input, live_mesh(*original.mesh), 100000);
+    const SurfaceDistance a = surface_distance(input, testing::live_mesh(*scaled.mesh), 100000);
+    const SurfaceDistance b = surface_distance(input, testing::live_mesh(*original.mesh), 100000);
     std::printf(
         "gmsh-aneurysm-20k at %2.0f%%: RMS %.3g (scale %.2g) against %.3g (Hoppe's), ratio %.3f\n",
         ratio * 100, a.rms, EnergyOptions{}.spring_scale, b.rms, a.rms / b.rms);
@@ -265,8 +256,10 @@ TEST(EnergyCosting, StarPlanesAndVolumeKeepTheSurfaceCloser) {
       without.volume_weight = 0;
       const Simplified with_terms = simplified(name, EnergyOptions{}, ratio);
       const Simplified points_only = simplified(name, without, ratio);
-      const SurfaceDistance a = surface_distance(input, live_mesh(*with_terms.mesh), 100000);
-      const SurfaceDistance b = surface_distance(input, live_mesh(*points_only.mesh), 100000);
+      const SurfaceDistance a =
+          surface_distance(input, testing::live_mesh(*with_terms.mesh), 100000);
+      const SurfaceDistance b =
+          surface_distance(input, testing::live_mesh(*points_only.mesh), 100000);
       std::printf("%s at %2.0f%%: RMS %.3g with the star's terms, %.3g without, ratio %.3f\n", name,
                   ratio * 100, a.rms, b.rms, a.rms / b.rms);
       EXPECT_LT(a.rms, (ratio > 0.3 ? 0.7 : 1.0) * b.rms) << name << " at " << ratio;
@@ -296,8 +289,8 @@ TEST(EnergyCosting, NoiseCreasesDoNotHoldTheCoarseLevels) {
     every_crease.sharp.min_crease_edges = 1;
     const Simplified dropped = simplified_file(c.path, creases, c.ratio);
     const Simplified kept = simplified_file(c.path, every_crease, c.ratio);
-    const SurfaceDistance a = surface_distance(input, live_mesh(*dropped.mesh), 100000);
-    const SurfaceDistance b = surface_distance(input, live_mesh(*kept.mesh), 100000);
+    const SurfaceDistance a = surface_distance(input, testing::live_mesh(*dropped.mesh), 100000);
+    const SurfaceDistance b = surface_distance(input, testing::live_mesh(*kept.mesh), 100000);
     std::printf("%s at %.0f%%: RMS %.3g with short creases dropped, %.3g with every crease\n",
                 std::filesystem::path(c.path).filename().c_str(), c.ratio * 100, a.rms, b.rms);
     EXPECT_LT(a.rms, c.factor * b.rms) << c.path;

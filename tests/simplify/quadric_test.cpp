@@ -106,11 +106,7 @@ TEST(QuadricPlacement, TheStarsPlanesKeepACoarseLevelsRims) {
     QuadricPriority priority(locked, options);
     Simplifier simplifier(working, priority, standard_constraints(locked));
     simplifier.run({faces}, {}, nullptr);
-    Mesh level;
-    level.positions = working.positions();
-    for (FaceId f = 0; f < working.face_capacity(); ++f)
-      if (working.face_alive(f)) level.faces.push_back(working.face(f));
-    return surface_distance(repaired.mesh, level, 100000).rms;
+    return surface_distance(repaired.mesh, testing::live_mesh(working), 100000).rms;
   };
   const double with = rms(QuadricOptions{}.star_planes_weight), without = rms(0);
   std::printf("occt-bearing-25k at %zu faces: RMS %.4g with the star's planes, %.4g without\n",

@@ -1,5 +1,6 @@
 // Where the tests find their meshes: the small real meshes committed under tests/data, and
-// every mesh of ../shared/meshes when that folder is present (it is in CI).
+// every mesh of ../shared/meshes when that folder is present (it is in CI); and a simplified
+// mesh's live faces as a Mesh.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "simplify/collapse_mesh.h"
 #include "util/error.h"
 
 namespace parapm::testing {
@@ -58,6 +60,15 @@ std::string expect_error(F&& f, ErrorCode code, std::initializer_list<std::strin
   }
   ADD_FAILURE() << "did not throw";
   return "";
+}
+
+// The live faces of a simplified mesh, as a Mesh (unused vertices stay: they do not count).
+inline Mesh live_mesh(const CollapseMesh& mesh) {
+  Mesh out;
+  out.positions = mesh.positions();
+  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
+    if (mesh.face_alive(f)) out.faces.push_back(mesh.face(f));
+  return out;
 }
 
 }  // namespace parapm::testing
