@@ -10,7 +10,6 @@
 #include <spdlog/spdlog.h>
 
 #include "parallel/job_codec.h"
-#include "parallel/job_pool.h"
 #include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
 #include "parapm.grpc.pb.h"
@@ -18,6 +17,7 @@
 #include "rpc_status.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/job_pool.h"
 
 namespace parapm::service {
 

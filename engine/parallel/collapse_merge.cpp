@@ -7,9 +7,9 @@
 #include <string>
 #include <utility>
 
-#include "parallel/job_pool.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/job_pool.h"
 
 namespace parapm {
 

@@ -5,9 +5,9 @@
 #include <functional>
 #include <string>
 
-#include "parallel/job_pool.h"
 #include "parallel/simplify_subset.h"
 #include "util/clock.h"
+#include "util/job_pool.h"
 
 #include "simplify/energy_priority.h"
 #include "simplify/quadric_priority.h"

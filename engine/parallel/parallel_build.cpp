@@ -2,9 +2,9 @@
 
 #include <algorithm>
 
-#include "parallel/job_pool.h"
 #include "parallel/parallel_builder.h"
 #include "parallel/simplify_subset.h"
+#include "util/job_pool.h"
 
 namespace parapm {
 

@@ -13,7 +13,6 @@
 
 #include "parallel/collapse_merge.h"
 #include "parallel/edge_keys.h"
-#include "parallel/job_pool.h"
 #include "parallel/job_state.h"
 #include "parallel/round_shares.h"
 #include "parallel/simplify_subset.h"
@@ -27,6 +26,7 @@
 #include "simplify/surface_samples.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/job_pool.h"
 #include "util/memory.h"
 #include "util/number_text.h"
 
@@ -335,50 +335,47 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
 }
 
 void ParallelBuilder::set_up() {
-  const auto t = std::chrono::steady_clock::now();
-  whole_.emplace(mesh_);
+  // The passes over the whole mesh run in p chunks: with a core per subset (the critical
+  // path's assumption) each pass takes its slowest chunk.
+  ChunkedLoops loops(requested_.subsets, requested_.threads);
+  const LoopClock before_clock(loops);
+  whole_.emplace(mesh_, loops);
   CollapseMesh& whole = *whole_;
   master_ = make_priority_module(options_, mesh_, locked_);
   parallel_ = with_metric_floor(requested_, *master_);
   // The first round's partition needs the mesh only: it is drawn beside the master's
-  // initialisation, whose independent parts run side by side too (all read `whole`, none
-  // through its marks; each writes its own data).
+  // initialisation, which reads `whole` too (none through its marks).
   const uint32_t first_subsets = round_subsets(parallel_, whole.live_faces());
   first_round_ = first_subsets >= std::min(2u, parallel_.subsets) &&
                  whole.live_vertices() >= 4 * size_t(first_subsets) &&
                  whole.live_faces() > handover_;
   auto partition_first_round = [&] {
-    const auto tp = std::chrono::steady_clock::now();
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, 0);
     first_partition_ = partition_live(whole, copy_groups_, first_subsets, partition_options);
-    first_partition_seconds_ = seconds_since(tp);
   };
-  std::vector<std::function<void()>> setup_tasks;
-  if (first_round_) setup_tasks.push_back(partition_first_round);
-  const size_t first_part = setup_tasks.size();
-  for (std::function<void()>& part : master_->initialization_parts(whole))
-    setup_tasks.push_back(std::move(part));
-  std::vector<double> task_seconds(setup_tasks.size(), 0);
-  const auto section = std::chrono::steady_clock::now();
-  run_jobs(setup_tasks.size(), parallel_.threads, [&](size_t i) {
-    const auto ti = std::chrono::steady_clock::now();
-    setup_tasks[i]();
-    task_seconds[i] = seconds_since(ti);
-  });
-  // With a core per task, as the critical path assumes: the slowest part.
-  for (size_t i = first_part; i < task_seconds.size(); ++i)
-    initialize_seconds_ = std::max(initialize_seconds_, task_seconds[i]);
-  const double section_seconds = seconds_since(section);
+  const double before_seconds = before_clock.critical_seconds();
+  const Beside timed = run_beside(
+      parallel_.threads,
+      [&] {
+        const LoopClock clock(loops);
+        master_->initialize_in_chunks(whole, loops);
+        initialize_seconds_ = clock.critical_seconds();
+      },
+      first_round_ ? std::vector<std::function<void()>>{partition_first_round}
+                   : std::vector<std::function<void()>>{});
+  if (first_round_) first_partition_seconds_ = timed.side_seconds[0];
+  const LoopClock after_clock(loops);
   keys_.emplace(*master_, whole.vertex_capacity());
   carry_keys_ = parallel_.carry_keys && master_->costly();
   carry_deferred_ = carry_keys_ && parallel_.carry_deferred;
   master_queue_ = carry_keys_ ? static_cast<PriorityModule*>(&*keys_) : master_.get();
-  // The setup's own time: the first partition is round 0's (which the critical path counts
-  // only where it outlasts the initialisation: RoundStats::partition_overlap_seconds).
-  st_.setup_seconds = seconds_since(t) - section_seconds + initialize_seconds_;
   subset_options_ = subset_options_of(options_, mesh_);
   records_.reserve(whole.live_vertices());
+  // The set-up's own time, its loops at their critical path; the first partition is round 0's
+  // (which the critical path counts only where it outlasts the initialisation:
+  // RoundStats::partition_overlap_seconds).
+  st_.setup_seconds = before_seconds + initialize_seconds_ + after_clock.critical_seconds();
 }
 
 std::shared_ptr<const std::vector<uint32_t>> ParallelBuilder::whole_components() {

@@ -6,28 +6,42 @@
 
 namespace parapm {
 
-CollapseMesh::CollapseMesh(const Mesh& mesh)
-    : positions_(mesh.positions),
-      faces_(mesh.faces),
-      corner_wedges_(mesh.face_wedges),
-      face_alive_(mesh.faces.size(), 1),
-      vertex_alive_(mesh.positions.size(), 0),
-      faces_of_(mesh.positions.size()),
-      boundary_(mesh.positions.size(), 0),
-      live_faces_(mesh.faces.size()),
-      mark_(mesh.positions.size(), 0) {
+CollapseMesh::CollapseMesh(const Mesh& mesh) {
+  ChunkedLoops plain;
+  build(mesh, plain);
+}
+
+CollapseMesh::CollapseMesh(const Mesh& mesh, ChunkedLoops& loops) { build(mesh, loops); }
+
+void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
+  positions_ = mesh.positions;
+  faces_ = mesh.faces;
+  corner_wedges_ = mesh.face_wedges;
+  face_alive_.assign(mesh.faces.size(), 1);
+  vertex_alive_.assign(mesh.positions.size(), 0);
+  faces_of_.resize(mesh.positions.size());
+  boundary_.assign(mesh.positions.size(), 0);
+  live_faces_ = mesh.faces.size();
+  mark_.assign(mesh.positions.size(), 0);
+  // Each range of vertices reads every face for its own: a list holds its faces in face order,
+  // whatever the chunking.
   std::vector<uint32_t> valence(positions_.size(), 0);
-  for (const Triangle& t : faces_)
-    for (VertexId v : t) ++valence[v];
-  for (size_t v = 0; v < positions_.size(); ++v) faces_of_[v].reserve(valence[v]);
-  for (FaceId f = 0; f < faces_.size(); ++f)
-    for (VertexId v : faces_[f]) faces_of_[v].push_back(f);
-  for (VertexId v = 0; v < positions_.size(); ++v) {
-    if (faces_of_[v].empty()) continue;
-    vertex_alive_[v] = 1;
-    ++live_vertices_;
-    boundary_[v] = compute_boundary(v);
-  }
+  loops.run(positions_.size(), [&](size_t begin, size_t end) {
+    auto mine = [&](VertexId v) { return v - begin < end - begin; };
+    for (const Triangle& t : faces_)
+      for (VertexId v : t)
+        if (mine(v)) ++valence[v];
+    for (size_t v = begin; v < end; ++v) faces_of_[v].reserve(valence[v]);
+    for (FaceId f = 0; f < faces_.size(); ++f)
+      for (VertexId v : faces_[f])
+        if (mine(v)) faces_of_[v].push_back(f);
+    for (size_t v = begin; v < end; ++v) {
+      if (faces_of_[v].empty()) continue;
+      vertex_alive_[v] = 1;
+      boundary_[v] = compute_boundary(VertexId(v));
+    }
+  });
+  live_vertices_ = size_t(std::count(vertex_alive_.begin(), vertex_alive_.end(), 1));
 }
 
 EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
@@ -49,19 +63,28 @@ EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
 }
 
 std::vector<FaceId> CollapseMesh::twin_faces() const {
+  ChunkedLoops plain;
+  return twin_faces(plain);
+}
+
+std::vector<FaceId> CollapseMesh::twin_faces(ChunkedLoops& loops) const {
   std::vector<FaceId> twin(3 * faces_.size(), kNoId);
-  std::vector<std::pair<VertexId, FaceId>> fan;  // (the vertex before a, the face) around a
-  for (VertexId a = 0; a < vertex_capacity(); ++a) {
-    fan.clear();
-    for (FaceId f : faces_of_[a]) fan.emplace_back(faces_[f][(corner_of(faces_[f], a) + 2) % 3], f);
-    for (FaceId f : faces_of_[a]) {
-      const int i = corner_of(faces_[f], a);
-      const VertexId next = faces_[f][(i + 1) % 3];
-      // The face holding next -> a: next comes before a there (the last one, as edge_faces).
-      for (const auto& [before, g] : fan)
-        if (before == next) twin[3 * size_t(f) + size_t(i)] = g;
+  // A vertex a writes the slots of a's corners only: ranges of vertices write apart.
+  loops.run(vertex_capacity(), [&](size_t begin, size_t end) {
+    std::vector<std::pair<VertexId, FaceId>> fan;  // (the vertex before a, the face) around a
+    for (size_t a = begin; a < end; ++a) {
+      fan.clear();
+      for (FaceId f : faces_of_[a])
+        fan.emplace_back(faces_[f][(corner_of(faces_[f], VertexId(a)) + 2) % 3], f);
+      for (FaceId f : faces_of_[a]) {
+        const int i = corner_of(faces_[f], VertexId(a));
+        const VertexId next = faces_[f][(i + 1) % 3];
+        // The face holding next -> a: next comes before a there (the last one, as edge_faces).
+        for (const auto& [before, g] : fan)
+          if (before == next) twin[3 * size_t(f) + size_t(i)] = g;
+      }
     }
-  }
+  });
   return twin;
 }
 

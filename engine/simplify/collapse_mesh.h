@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -28,6 +29,8 @@ struct EdgeFaces {
 class CollapseMesh {
  public:
   explicit CollapseMesh(const Mesh& mesh);
+  // The same mesh, its adjacency built in `loops`' chunks side by side.
+  CollapseMesh(const Mesh& mesh, ChunkedLoops& loops);
 
   size_t vertex_capacity() const { return positions_.size(); }
   size_t face_capacity() const { return faces_.size(); }
@@ -51,6 +54,7 @@ class CollapseMesh {
   // face read three times, not six times per edge: passes over every edge, such as a first
   // queue or the sharp edges' search, used to spend most of their time in those lookups).
   std::vector<FaceId> twin_faces() const;
+  std::vector<FaceId> twin_faces(ChunkedLoops& loops) const;  // in loops' chunks, the same
   // The distinct vertices sharing a face with v, in no particular order.
   void neighbors(VertexId v, std::vector<VertexId>& out) const;
   // Calls visit(n) once for every vertex n adjacent to both a and b.
@@ -81,6 +85,7 @@ class CollapseMesh {
   void count_removed(const RemovedCounts& removed);
 
  private:
+  void build(const Mesh& mesh, ChunkedLoops& loops);
   void remove_face_from(VertexId v, FaceId f);
   uint32_t next_stamp() const;
   bool compute_boundary(VertexId v) const;

@@ -44,16 +44,18 @@ double spring_constant(double points_per_face) {
 }
 
 void EnergyPriority::initialize(const CollapseMesh& mesh) {
-  for (const std::function<void()>& part : initialization_parts(mesh)) part();
+  ChunkedLoops plain;
+  initialize_in_chunks(mesh, plain);
 }
 
-std::vector<std::function<void()>> EnergyPriority::initialization_parts(const CollapseMesh& mesh) {
-  return {[this, &mesh] { initialize_curves(mesh); }, [this, &mesh] { initialize_points(mesh); }};
+void EnergyPriority::initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) {
+  initialize_curves(mesh, loops);
+  initialize_points(mesh, loops);
 }
 
-void EnergyPriority::initialize_curves(const CollapseMesh& mesh) {
+void EnergyPriority::initialize_curves(const CollapseMesh& mesh, ChunkedLoops& loops) {
   if (options_.discontinuities) {
-    curves_.initialize(mesh, options_.sharp);
+    curves_.initialize(mesh, options_.sharp, loops);
   } else {
     curves_ = SharpCurves{};
     curves_.initialize_empty(mesh);
@@ -67,33 +69,39 @@ void EnergyPriority::reset_point_lists(const CollapseMesh& mesh) {
   parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
 }
 
-void EnergyPriority::initialize_points(const CollapseMesh& mesh) {
+void EnergyPriority::initialize_points(const CollapseMesh& mesh, ChunkedLoops& loops) {
   const std::vector<SurfaceSample> samples =
-      sample_surface(mesh, options_.samples_per_face, options_.seed);
+      sample_surface(mesh, options_.samples_per_face, options_.seed, loops);
   const double diagonal = diagonal_of(mesh);
   topology_price_ = topology_price(diagonal);
 
   const bool scalar = mesh.has_wedges() && attributes_.layout.any();
   scalar_.initialize(scalar ? attributes_.layout : AttributeLayout{}, attributes_.values,
                      options_.attribute_weight * diagonal);
+  if (scalar_.enabled()) scalar_.add_points(mesh, samples, loops);
 
   point_id_.clear();
-  positions_.clear();
-  positions_.reserve(samples.size());
+  positions_.resize(samples.size());
   reset_point_lists(mesh);
-  for (const SurfaceSample& s : samples) {
-    const auto id = uint32_t(positions_.size());
-    positions_.push_back(s.position);
-    if (scalar_.enabled()) scalar_.add_point(mesh, s.face, s.position);
-    if (s.vertex != kNoId) {
-      parked_point_[s.vertex] = id;
-    } else {
-      face_points_[s.face].push_back({s.position, 0.0, id});
+  // A point's id is its sample's index. The vertices' samples come first: each is parked at
+  // its vertex; the others are listed on their faces, newest first, as collapsed() leaves
+  // them (the order of the sums over a face's points is part of the build's arithmetic).
+  // Each range of faces reads every drawn sample for its own.
+  size_t parked = 0;
+  while (parked < samples.size() && samples[parked].vertex != kNoId) ++parked;
+  loops.run(samples.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      positions_[i] = samples[i].position;
+      if (i < parked) parked_point_[samples[i].vertex] = uint32_t(i);
     }
-  }
-  // A face lists its points newest first, as collapsed() leaves them: the order of the sums
-  // over a face's points is part of the build's arithmetic.
-  for (auto& list : face_points_) std::reverse(list.begin(), list.end());
+  });
+  loops.run(mesh.face_capacity(), [&](size_t begin, size_t end) {
+    for (size_t i = samples.size(); i-- > parked;) {
+      const SurfaceSample& s = samples[i];
+      if (s.face - begin < end - begin)
+        face_points_[s.face].push_back({s.position, 0.0, uint32_t(i)});
+    }
+  });
 }
 
 double EnergyPriority::diagonal_of(const CollapseMesh& mesh) const {

@@ -159,8 +159,9 @@ class EnergyPriority : public PriorityModule {
   std::string name() const override { return "energy"; }
   bool costly() const override { return true; }
   void initialize(const CollapseMesh& mesh) override;
-  // The sharp curves, and the rest (the sample points, the per-face lists, E_scalar).
-  std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) override;
+  // The sharp curves, then the sample points drawn, listed on their faces and given their
+  // attributes in `loops`' chunks.
+  void initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) override;
   // Costed by the module's evaluator (energy_evaluator.h). With Costing::kQueue each start's
   // solve is costed on the model it was solved on, not measured again.
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
@@ -259,8 +260,8 @@ class EnergyPriority : public PriorityModule {
   void unpark(VertexId v);
   FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
   double diagonal_of(const CollapseMesh& mesh) const;
-  void initialize_curves(const CollapseMesh& mesh);  // curves_ only
-  void initialize_points(const CollapseMesh& mesh);  // everything else
+  void initialize_curves(const CollapseMesh& mesh, ChunkedLoops& loops);  // curves_ only
+  void initialize_points(const CollapseMesh& mesh, ChunkedLoops& loops);  // everything else
   // Empty point lists, moments and drifts for every face, no parked sample: the start of
   // initialize_points and import_local.
   void reset_point_lists(const CollapseMesh& mesh);

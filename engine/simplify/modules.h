@@ -40,13 +40,12 @@ class PriorityModule {
   virtual ~PriorityModule() = default;
   virtual std::string name() const = 0;
   virtual void initialize(const CollapseMesh& mesh) = 0;
-  // initialize() cut into independent parts, which may run in any order or side by side (each
-  // writes its own part of the module; all only read `mesh`, which must outlive them): running
-  // them all is initialize(). The parallel build runs them on its pool, beside the first
-  // partition, so that the set-up is not one thread's work. A wrapper keeps this default: its
-  // parts are its own initialize(), whatever it does.
-  virtual std::vector<std::function<void()>> initialization_parts(const CollapseMesh& mesh) {
-    return {[this, &mesh] { initialize(mesh); }};
+  // initialize(), its passes over the mesh cut into `loops`' chunks, which may run side by side:
+  // the same state, whatever the chunking. The parallel build's set-up runs it on its pool,
+  // beside the first partition. Default: initialize(), one thread's work (so a wrapper
+  // initialises as its own initialize() does).
+  virtual void initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& /*loops*/) {
+    initialize(mesh);
   }
   // Costs the collapse of edge {a, b}, choosing which end survives and where. Returns false
   // when the collapse cannot be placed (the edge is then left alone). Not const: a costing may

@@ -27,8 +27,13 @@ bool near_edge(const Vec3& p, const Vec3& pa, const Vec3& pb) {
 }  // namespace
 
 void QuadricPriority::initialize(const CollapseMesh& mesh) {
+  ChunkedLoops plain;
+  initialize_in_chunks(mesh, plain);
+}
+
+void QuadricPriority::initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) {
   quadrics_.assign(mesh.vertex_capacity(), Quadric{});
-  const std::vector<FaceId> twin = mesh.twin_faces();
+  const std::vector<FaceId> twin = mesh.twin_faces(loops);
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     if (!mesh.face_alive(f)) continue;
     const Triangle& t = mesh.face(f);

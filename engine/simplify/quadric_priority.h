@@ -43,6 +43,8 @@ class QuadricPriority : public PriorityModule {
       : locked_(std::move(locked)), options_(options) {}
   std::string name() const override { return "quadric"; }
   void initialize(const CollapseMesh& mesh) override;
+  // The faces' twins found in `loops`' chunks; the quadrics summed on one thread.
+  void initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override;  // kQueue: the unconstrained optimum's cost
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,

@@ -38,15 +38,24 @@ void ScalarAttributes::initialize(const AttributeLayout& layout, std::vector<flo
   for (WedgeId w = 0; w < parent_.size(); ++w) parent_[w] = w;
 }
 
-void ScalarAttributes::add_point(const CollapseMesh& mesh, FaceId f, const Vec3& position) {
-  const Triangle& t = mesh.face(f);
-  const auto& w = mesh.corner_wedges(f);
-  const Projection p =
-      project_on_triangle(position, mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
-  for (int k = 0; k < floats_; ++k)
-    point_values_.push_back(float(p.bary[0] * value(w[0])[k] + p.bary[1] * value(w[1])[k] +
-                                  p.bary[2] * value(w[2])[k]));
-  residual_.push_back(0.0);
+void ScalarAttributes::add_points(const CollapseMesh& mesh,
+                                  const std::vector<SurfaceSample>& samples, ChunkedLoops& loops) {
+  const size_t first = residual_.size();
+  point_values_.resize((first + samples.size()) * size_t(floats_));
+  residual_.resize(first + samples.size(), 0.0);
+  loops.run(samples.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const FaceId f = samples[i].face;
+      const Triangle& t = mesh.face(f);
+      const auto& w = mesh.corner_wedges(f);
+      const Projection p = project_on_triangle(samples[i].position, mesh.position(t[0]),
+                                               mesh.position(t[1]), mesh.position(t[2]));
+      float* x = point_values_.data() + (first + i) * size_t(floats_);
+      for (int k = 0; k < floats_; ++k)
+        x[k] = float(p.bary[0] * value(w[0])[k] + p.bary[1] * value(w[1])[k] +
+                     p.bary[2] * value(w[2])[k]);
+    }
+  });
 }
 
 double ScalarAttributes::residual_against(uint32_t point, const std::array<WedgeId, 3>& w,

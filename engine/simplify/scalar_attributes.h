@@ -31,6 +31,7 @@
 
 #include "simplify/collapse_mesh.h"
 #include "simplify/module_state.h"
+#include "simplify/surface_samples.h"
 
 namespace parapm {
 
@@ -54,15 +55,17 @@ class ScalarAttributes {
   // `wedges` (the module's ids) through `to`, with their values and classes, to out.
   // import_local starts a job's attributes from a state whose wedges are 0..n-1 and whose
   // points are the job's (values and residuals in state order), instead of initialize() and
-  // add_point(). import_global gives the master the state's wedge values and classes.
+  // add_points(). import_global gives the master the state's wedge values and classes.
   void export_wedges(const std::vector<WedgeId>& wedges, const IdTranslation& to,
                      EnergyState& out) const;
   void import_local(const AttributeLayout& layout, double weight, const EnergyState& state);
   void import_global(const EnergyState& state);  // after check_global (kInvalidInput)
   void check_global(const EnergyState& state) const;
 
-  // The next point's attributes: those of the mesh where `position` projects on face f.
-  void add_point(const CollapseMesh& mesh, FaceId f, const Vec3& position);
+  // The next points' attributes, the samples' in order: those of the mesh where each projects
+  // on its face (residual 0), computed in `loops`' chunks.
+  void add_points(const CollapseMesh& mesh, const std::vector<SurfaceSample>& samples,
+                  ChunkedLoops& loops);
   // The point's weighted squared attribute error as of the last collapse that moved it.
   double residual(uint32_t point) const { return residual_[point]; }
   // The weighted squared error of the point against the mesh at corners w, barycentric b.

@@ -57,42 +57,59 @@ void keep_long_creases(const CollapseMesh& mesh, const SharpEdgeOptions& options
 
 std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& mesh,
                                                             const SharpEdgeOptions& options) {
-  std::vector<std::pair<VertexId, VertexId>> edges, creases;
+  ChunkedLoops plain;
+  return find_sharp_edges(mesh, options, plain);
+}
+
+std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& mesh,
+                                                            const SharpEdgeOptions& options,
+                                                            ChunkedLoops& loops) {
+  using Edges = std::vector<std::pair<VertexId, VertexId>>;
   const double crease_cos = std::cos(options.crease_angle_degrees * M_PI / 180.0);
-  const std::vector<FaceId> twin = mesh.twin_faces();
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-    if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    for (int k = 0; k < 3; ++k) {
-      const VertexId a = t[k], b = t[(k + 1) % 3];
-      const FaceId g = twin[3 * size_t(f) + size_t(k)];
-      if (g == kNoId) {
-        if (options.boundaries) edges.emplace_back(std::min(a, b), std::max(a, b));
-        continue;
-      }
-      if (a > b) continue;  // an interior edge is seen from both faces: take it once
-      bool sharp = false;
-      if (options.seams && mesh.has_wedges()) {
-        const Triangle& u = mesh.face(g);
-        sharp = mesh.corner_wedges(f)[k] != mesh.corner_wedges(g)[corner_of(u, a)] ||
-                mesh.corner_wedges(f)[(k + 1) % 3] != mesh.corner_wedges(g)[corner_of(u, b)];
-      }
-      if (sharp) {
-        edges.emplace_back(a, b);
-      } else {
-        const Triangle& u = mesh.face(g);
-        const Vec3 nf =
-            triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
-        const Vec3 ng =
-            triangle_normal(mesh.position(u[0]), mesh.position(u[1]), mesh.position(u[2]));
-        const double lengths = length(nf) * length(ng);
-        if (back_to_back(nf, ng)) {  // a double-sided sheet's rim: a border, kept as one
-          if (options.boundaries) edges.emplace_back(a, b);
-        } else if (lengths > 0 && dot(nf, ng) < crease_cos * lengths) {
-          creases.emplace_back(a, b);
+  const std::vector<FaceId> twin = mesh.twin_faces(loops);
+  // Each range of faces finds its own edges; joined in face order, as one pass finds them.
+  std::vector<std::pair<Edges, Edges>> found(loops.ranges(mesh.face_capacity()));
+  loops.run_indexed(mesh.face_capacity(), [&](size_t range, size_t begin, size_t end) {
+    auto& [edges, creases] = found[range];
+    for (FaceId f = FaceId(begin); f < end; ++f) {
+      if (!mesh.face_alive(f)) continue;
+      const Triangle& t = mesh.face(f);
+      for (int k = 0; k < 3; ++k) {
+        const VertexId a = t[k], b = t[(k + 1) % 3];
+        const FaceId g = twin[3 * size_t(f) + size_t(k)];
+        if (g == kNoId) {
+          if (options.boundaries) edges.emplace_back(std::min(a, b), std::max(a, b));
+          continue;
+        }
+        if (a > b) continue;  // an interior edge is seen from both faces: take it once
+        bool sharp = false;
+        if (options.seams && mesh.has_wedges()) {
+          const Triangle& u = mesh.face(g);
+          sharp = mesh.corner_wedges(f)[k] != mesh.corner_wedges(g)[corner_of(u, a)] ||
+                  mesh.corner_wedges(f)[(k + 1) % 3] != mesh.corner_wedges(g)[corner_of(u, b)];
+        }
+        if (sharp) {
+          edges.emplace_back(a, b);
+        } else {
+          const Triangle& u = mesh.face(g);
+          const Vec3 nf =
+              triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
+          const Vec3 ng =
+              triangle_normal(mesh.position(u[0]), mesh.position(u[1]), mesh.position(u[2]));
+          const double lengths = length(nf) * length(ng);
+          if (back_to_back(nf, ng)) {  // a double-sided sheet's rim: a border, kept as one
+            if (options.boundaries) edges.emplace_back(a, b);
+          } else if (lengths > 0 && dot(nf, ng) < crease_cos * lengths) {
+            creases.emplace_back(a, b);
+          }
         }
       }
     }
+  });
+  Edges edges, creases;
+  for (const auto& [found_edges, found_creases] : found) {
+    edges.insert(edges.end(), found_edges.begin(), found_edges.end());
+    creases.insert(creases.end(), found_creases.begin(), found_creases.end());
   }
   keep_long_creases(mesh, options, creases);
   edges.insert(edges.end(), creases.begin(), creases.end());
@@ -106,10 +123,16 @@ void SharpCurves::add_sharp(VertexId a, VertexId b) {
 }
 
 void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& options) {
+  ChunkedLoops plain;
+  initialize(mesh, options, plain);
+}
+
+void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& options,
+                             ChunkedLoops& loops) {
   samples_.clear();
   neighbors_.assign(mesh.vertex_capacity(), {});
   listed_at_.assign(mesh.vertex_capacity(), {});
-  const auto edges = find_sharp_edges(mesh, options);
+  const auto edges = find_sharp_edges(mesh, options, loops);
   edge_count_ = edges.size();
   for (const auto& [a, b] : edges) add_sharp(a, b);
   auto add_sample = [&](const Vec3& position, VertexId u, VertexId w) {

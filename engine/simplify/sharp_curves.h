@@ -36,11 +36,16 @@ struct SharpEdgeOptions {
 // Every sharp edge of the mesh once, as (a, b) with a < b (short creases dropped, see above).
 std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& mesh,
                                                             const SharpEdgeOptions& options);
+// The same edges, the faces' twins and the faces read in `loops`' chunks.
+std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& mesh,
+                                                            const SharpEdgeOptions& options,
+                                                            ChunkedLoops& loops);
 
 class SharpCurves {
  public:
   // One sample at each vertex on a curve and one at the midpoint of every sharp edge.
   void initialize(const CollapseMesh& mesh, const SharpEdgeOptions& options);
+  void initialize(const CollapseMesh& mesh, const SharpEdgeOptions& options, ChunkedLoops& loops);
   // No curves at all (E_disc off), sized for the mesh.
   void initialize_empty(const CollapseMesh& mesh);
 

@@ -9,45 +9,75 @@ namespace parapm {
 
 std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double samples_per_face,
                                           uint64_t seed) {
+  ChunkedLoops plain;
+  return sample_surface(mesh, samples_per_face, seed, plain);
+}
+
+std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double samples_per_face,
+                                          uint64_t seed, ChunkedLoops& loops) {
   std::vector<SurfaceSample> samples;
-  samples.reserve(mesh.live_vertices());
-  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
-    if (!mesh.faces_of(v).empty()) samples.push_back({mesh.position(v), mesh.faces_of(v)[0], v});
+  samples.reserve(mesh.live_vertices() + size_t(std::llround(std::max(0.0, samples_per_face) *
+                                                             double(mesh.live_faces()))));
+  // The vertices' samples: each range of vertices counts its own, then writes them after the
+  // ranges before it.
+  std::vector<size_t> first(loops.ranges(mesh.vertex_capacity()) + 1, 0);
+  auto has_faces = [&](size_t v) { return !mesh.faces_of(VertexId(v)).empty(); };
+  loops.run_indexed(mesh.vertex_capacity(), [&](size_t range, size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) first[range + 1] += has_faces(v) ? 1 : 0;
+  });
+  for (size_t r = 1; r < first.size(); ++r) first[r] += first[r - 1];
+  samples.resize(first.back());
+  loops.run_indexed(mesh.vertex_capacity(), [&](size_t range, size_t begin, size_t end) {
+    size_t out = first[range];
+    for (size_t v = begin; v < end; ++v)
+      if (has_faces(v))
+        samples[out++] = {mesh.position(VertexId(v)), mesh.faces_of(VertexId(v))[0], VertexId(v)};
+  });
   if (!(samples_per_face > 0)) return samples;
 
+  std::vector<double> area(mesh.face_capacity(), 0.0);
+  loops.run(mesh.face_capacity(), [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      if (!mesh.face_alive(FaceId(f))) continue;
+      const Triangle& t = mesh.face(FaceId(f));
+      area[f] = 0.5 * length(triangle_normal(mesh.position(t[0]), mesh.position(t[1]),
+                                             mesh.position(t[2])));
+    }
+  });
   std::vector<FaceId> faces;
   std::vector<double> cumulative_area;
   double total = 0;
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-    if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    const double area = 0.5 * length(triangle_normal(mesh.position(t[0]), mesh.position(t[1]),
-                                                     mesh.position(t[2])));
-    if (!(area > 0)) continue;
-    total += area;
+    if (!(area[f] > 0)) continue;
+    total += area[f];
     faces.push_back(f);
     cumulative_area.push_back(total);
   }
   if (faces.empty()) return samples;
   const auto count = static_cast<size_t>(std::llround(samples_per_face * double(faces.size())));
-  SplitMix64 random(seed);
-  samples.reserve(samples.size() + count);
-  for (size_t i = 0; i < count; ++i) {
-    const double target = random.uniform() * total;
-    const size_t k =
-        std::min<size_t>(std::upper_bound(cumulative_area.begin(), cumulative_area.end(), target) -
-                             cumulative_area.begin(),
-                         faces.size() - 1);
-    // Uniform on the triangle: the square-root warp of two uniforms (Turk 1990).
-    const double r1 = std::sqrt(random.uniform()), r2 = random.uniform();
-    const double u = 1 - r1, v = r1 * (1 - r2), w = r1 * r2;
-    const Triangle& t = mesh.face(faces[k]);
-    const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]), &c = mesh.position(t[2]);
-    samples.push_back({{u * a[0] + v * b[0] + w * c[0], u * a[1] + v * b[1] + w * c[1],
-                        u * a[2] + v * b[2] + w * c[2]},
-                       faces[k],
-                       kNoId});
-  }
+  const size_t drawn_from = samples.size();
+  samples.resize(drawn_from + count);
+  // Sample i takes the generator's outputs 3i + 1 ... 3i + 3: a range starts the generator
+  // where its first sample's draws begin.
+  loops.run(count, [&](size_t begin, size_t end) {
+    SplitMix64 random = SplitMix64::at(seed, 3 * uint64_t(begin));
+    for (size_t i = begin; i < end; ++i) {
+      const double target = random.uniform() * total;
+      const size_t k = std::min<size_t>(
+          std::upper_bound(cumulative_area.begin(), cumulative_area.end(), target) -
+              cumulative_area.begin(),
+          faces.size() - 1);
+      // Uniform on the triangle: the square-root warp of two uniforms (Turk 1990).
+      const double r1 = std::sqrt(random.uniform()), r2 = random.uniform();
+      const double u = 1 - r1, v = r1 * (1 - r2), w = r1 * r2;
+      const Triangle& t = mesh.face(faces[k]);
+      const Vec3 &a = mesh.position(t[0]), &b = mesh.position(t[1]), &c = mesh.position(t[2]);
+      samples[drawn_from + i] = {{u * a[0] + v * b[0] + w * c[0], u * a[1] + v * b[1] + w * c[1],
+                                  u * a[2] + v * b[2] + w * c[2]},
+                                 faces[k],
+                                 kNoId};
+    }
+  });
   return samples;
 }
 

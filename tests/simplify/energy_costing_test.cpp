@@ -410,8 +410,8 @@ TEST(EnergyCosting, ReleasedCachesChangeNoCosting) {
   EXPECT_GT(compared, 1000u);
 }
 
-TEST(EnergyPriority, InitializationPartsSideBySideEqualInitialize) {
-  // Keeps the state its parts made: the simplifier would initialise the module again.
+TEST(EnergyPriority, InitializationInChunksSideBySideEqualsInitialize) {
+  // Keeps the state the chunks made: the simplifier would initialise the module again.
   class Initialized : public PriorityWrapper {
    public:
     using PriorityWrapper::PriorityWrapper;
@@ -422,20 +422,16 @@ TEST(EnergyPriority, InitializationPartsSideBySideEqualInitialize) {
     SimplifyOptions options;
     options.metric = "energy";
     const std::vector<uint8_t> locked = locked_vertices(repaired);
-    auto run = [&](bool by_parts) {
-      CollapseMesh mesh(repaired.mesh);
+    auto run = [&](bool in_chunks) {
+      // Seven chunks of at least 64 items, on three threads.
+      ChunkedLoops loops(7, 3, 64);
+      CollapseMesh mesh =
+          in_chunks ? CollapseMesh(repaired.mesh, loops) : CollapseMesh(repaired.mesh);
       std::unique_ptr<PriorityModule> energy = make_priority_module(options, repaired.mesh, locked);
       std::unique_ptr<PriorityModule> priority;
-      if (by_parts) {
-        std::vector<std::function<void()>> parts = energy->initialization_parts(mesh);
-        EXPECT_EQ(parts.size(), 2u) << name;
-        std::vector<std::thread> threads;
-        for (auto part = parts.rbegin(); part != parts.rend(); ++part) threads.emplace_back(*part);
-        for (std::thread& t : threads) t.join();
-        // The curves' part has something to do: the CAD part's creases.
-        if (std::string(name) == "cad-featuretype-3k.stl") {
-          EXPECT_GT(dynamic_cast<const EnergyPriority&>(*energy).curves().sample_count(), 100u);
-        }
+      if (in_chunks) {
+        energy->initialize_in_chunks(mesh, loops);
+        EXPECT_LE(loops.critical_seconds(), loops.seconds()) << name;
         priority = std::make_unique<Initialized>(*energy);
       }
       Simplifier simplifier(mesh, priority ? *priority : *energy, standard_constraints(locked));

@@ -124,6 +124,23 @@ TEST(SurfaceSamples, OnePerVertexThenAreaWeightedOnTheirFaces) {
   EXPECT_NE(samples.back().position, other.back().position) << "the seed changes the draw";
 }
 
+TEST(SurfaceSamples, DrawnInChunksSideBySideTheSamePoints) {
+  const Mesh mesh = roof();
+  const CollapseMesh cm(mesh);
+  ChunkedLoops loops(5, 3, 2);
+  const auto whole = sample_surface(cm, 7.0, 42);
+  const auto chunked = sample_surface(cm, 7.0, 42, loops);
+  ASSERT_EQ(whole.size(), chunked.size());
+  for (size_t i = 0; i < whole.size(); ++i) {
+    EXPECT_EQ(whole[i].position, chunked[i].position) << i;
+    EXPECT_EQ(whole[i].face, chunked[i].face) << i;
+    EXPECT_EQ(whole[i].vertex, chunked[i].vertex) << i;
+  }
+  SplitMix64 stepped(9);
+  for (int i = 0; i < 5; ++i) stepped.next();
+  EXPECT_EQ(SplitMix64::at(9, 5).next(), stepped.next());
+}
+
 TEST(EnergyPriority, LeastSquaresPlacesTheVertexOnTheRidge) {
   const Mesh mesh = roof();
   CollapseMesh cm(mesh);

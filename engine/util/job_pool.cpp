@@ -1,4 +1,4 @@
-#include "parallel/job_pool.h"
+#include "util/job_pool.h"
 
 #include <algorithm>
 #include <atomic>

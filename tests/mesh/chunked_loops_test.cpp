@@ -1,0 +1,83 @@
+#include "util/chunked_loops.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace parapm {
+namespace {
+
+std::vector<std::pair<size_t, size_t>> ranges_of(ChunkedLoops& loops, size_t n) {
+  std::mutex m;
+  std::vector<std::pair<size_t, size_t>> ranges;
+  loops.run(n, [&](size_t begin, size_t end) {
+    std::lock_guard<std::mutex> lock(m);
+    ranges.emplace_back(begin, end);
+  });
+  std::sort(ranges.begin(), ranges.end());
+  return ranges;
+}
+
+TEST(ChunkedLoops, RangesCoverTheLoopInOrderAtMostChunksOfThemNoneBelowTheMinimum) {
+  ChunkedLoops loops(5, 3, 10);
+  for (size_t n : {0, 1, 19, 20, 49, 50, 1001}) {
+    const auto ranges = ranges_of(loops, n);
+    ASSERT_FALSE(ranges.empty()) << n;
+    EXPECT_LE(ranges.size(), 5u) << n;
+    EXPECT_EQ(ranges.front().first, 0u) << n;
+    EXPECT_EQ(ranges.back().second, n) << n;
+    for (size_t i = 1; i < ranges.size(); ++i) EXPECT_EQ(ranges[i].first, ranges[i - 1].second);
+    if (ranges.size() > 1) {
+      for (const auto& [begin, end] : ranges) EXPECT_GE(end - begin, 10u) << n;
+    }
+  }
+  EXPECT_EQ(ranges_of(loops, 1001).size(), 5u);
+  EXPECT_EQ(ranges_of(loops, 29).size(), 2u);
+  ChunkedLoops plain;
+  EXPECT_EQ(ranges_of(plain, 1000000).size(), 1u);
+}
+
+TEST(ChunkedLoops, ALoopCountsItsSlowestChunkOnTheCriticalPath) {
+  ChunkedLoops loops(4, 2, 1);
+  std::atomic<int> calls{0};
+  loops.run(4, [&](size_t begin, size_t) {
+    ++calls;
+    // Chunk 3 works longest: about 20 ms against 0 for the others.
+    if (begin == 3) {
+      const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
+      while (std::chrono::steady_clock::now() < until) {
+      }
+    }
+  });
+  EXPECT_EQ(calls, 4);
+  EXPECT_GE(loops.critical_seconds(), 0.02);
+  EXPECT_LT(loops.critical_seconds(), loops.seconds());
+  const LoopClock clock(loops);
+  loops.run(4, [](size_t, size_t) {});
+  EXPECT_LT(clock.critical_seconds(), 0.02) << "the loops before the clock are not its";
+}
+
+TEST(ChunkedLoops, TheLowestRangesExceptionIsRethrownAfterAllRan) {
+  ChunkedLoops loops(4, 4, 1);
+  std::atomic<int> calls{0};
+  try {
+    loops.run(4, [&](size_t begin, size_t) {
+      ++calls;
+      if (begin >= 1) throw std::runtime_error("range " + std::to_string(begin));
+    });
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "range 1");
+  }
+  EXPECT_EQ(calls, 4);
+}
+
+}  // namespace
+}  // namespace parapm
