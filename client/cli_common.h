@@ -36,6 +36,8 @@ struct LoadedMesh {
   uint64_t input_faces = 0;
   double read_seconds = 0;
   double repair_seconds = 0;
+  // The repair with a core per chunk of RepairOptions::loops (repair_seconds without them).
+  double repair_critical_seconds = 0;
   RepairedMesh repaired;
 };
 

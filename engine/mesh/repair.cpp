@@ -35,8 +35,10 @@
 // mesh_checks.h verifies the result independently; the tests run it on every mesh.
 //
 // Cost: counting sorts by vertex, then sorts inside each vertex's bucket (its few faces or
-// edges): O(F log(max valence)) time; about 60 bytes per face of scratch memory. No hashing
-// and no threads, ties broken by index: the output depends only on the input.
+// edges): O(F log(max valence)) time; about 60 bytes per face of scratch memory. No hashing,
+// ties broken by index: the output depends only on the input. The passes over faces and
+// vertices may run in chunks side by side (RepairOptions::loops), each over a range of faces
+// or of vertices, reading all and writing only its own: the same output.
 #include "mesh/repair.h"
 
 #include <algorithm>
@@ -183,10 +185,11 @@ void validate(const Mesh& mesh) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Counting sort by vertex, the building block of steps 2 and 4: for each item i whose
-// key_of(i) is not kNoId, value_of(i) is stored in bucket key_of(i), in increasing i inside a
-// bucket; bucket k is values[starts[k] .. starts[k + 1]). The values carry what the sort
-// inside a bucket compares, so that it does not go back to the faces.
+// Counting sort by vertex, the building block of steps 2 and 4 (run on each range of vertices
+// for the items of that range, items_of_ranges, keys counted from the range's first vertex):
+// for each item i whose key_of(i) is not kNoId, value_of(i) is stored in bucket key_of(i), in
+// increasing i inside a bucket; bucket k is values[starts[k] .. starts[k + 1]). The values
+// carry what the sort inside a bucket compares, so that it does not go back to the faces.
 
 template <class Value, class KeyOf, class ValueOf>
 void bucket_by_vertex(size_t items, size_t vertices, KeyOf key_of, ValueOf value_of,
@@ -214,44 +217,57 @@ struct FaceFilter {
   uint64_t duplicate = 0;
 };
 
-FaceFilter filter_faces(const std::vector<Triangle>& faces, size_t vertices) {
+FaceFilter filter_faces(const std::vector<Triangle>& faces, size_t vertices, ChunkedLoops& loops) {
   // Rotate each face so that its lowest vertex comes first: two faces are duplicates exactly
   // when their rotated triples are equal. Degenerate faces get kNoId, which keeps them out of
   // the buckets.
   std::vector<Triangle> rotated(faces.size());
-  FaceFilter filter;
-  for (size_t f = 0; f < faces.size(); ++f) {
-    const Triangle& t = faces[f];
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-      rotated[f] = {kNoId, kNoId, kNoId};
-      ++filter.degenerate;
-      continue;
+  loops.run(faces.size(), [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      const Triangle& t = faces[f];
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+        rotated[f] = {kNoId, kNoId, kNoId};
+        continue;
+      }
+      const int first = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
+      rotated[f] = {t[first], t[(first + 1) % 3], t[(first + 2) % 3]};
     }
-    const int first = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
-    rotated[f] = {t[first], t[(first + 1) % 3], t[(first + 2) % 3]};
-  }
-  // Bucket by the lowest vertex, holding (second vertex, third vertex, face). Inside a bucket
-  // equal triples become adjacent once sorted; the lowest face id of each run is kept.
-  std::vector<std::array<uint32_t, 3>> entries;
-  std::vector<uint32_t> starts;
-  bucket_by_vertex(
-      faces.size(), vertices, [&](size_t f) { return rotated[f][0]; },
-      [&](size_t f) {
-        return std::array<uint32_t, 3>{rotated[f][1], rotated[f][2], uint32_t(f)};
-      },
-      &entries, &starts);
-  std::vector<bool> removed(faces.size(), false);
-  for (size_t v = 0; v < vertices; ++v) {
-    const auto begin = entries.begin() + starts[v], end = entries.begin() + starts[v + 1];
-    if (end - begin < 2) continue;
-    std::sort(begin, end);
-    for (auto it = begin + 1; it != end; ++it) {
-      if ((*it)[0] == (*(it - 1))[0] && (*it)[1] == (*(it - 1))[1]) {
-        removed[(*it)[2]] = true;
-        ++filter.duplicate;
+  });
+  FaceFilter filter;
+  // Per range of vertices, its faces bucketed by their lowest vertex, holding (second vertex,
+  // third vertex, face). Inside a bucket equal triples become adjacent once sorted; the lowest
+  // face id of each run is kept.
+  std::vector<uint8_t> removed(faces.size(), 0);
+  std::vector<uint64_t> duplicates(loops.ranges(vertices), 0);
+  const auto faces_of_range =
+      items_of_ranges(loops, faces.size(), vertices, [&](size_t f) { return rotated[f][0]; });
+  loops.run_indexed(vertices, [&](size_t range, size_t first, size_t last) {
+    const RangeItems mine(faces_of_range, range, faces.size());
+    std::vector<std::array<uint32_t, 3>> entries;
+    std::vector<uint32_t> starts;
+    bucket_by_vertex(
+        mine.size(), last - first,
+        [&](size_t i) {  // kNoId stays kNoId: a degenerate face is in a one-range loop only
+          return rotated[mine[i]][0] == kNoId ? kNoId : VertexId(rotated[mine[i]][0] - first);
+        },
+        [&](size_t i) {
+          return std::array<uint32_t, 3>{rotated[mine[i]][1], rotated[mine[i]][2], mine[i]};
+        },
+        &entries, &starts);
+    for (size_t v = 0; v < last - first; ++v) {
+      const auto begin = entries.begin() + starts[v], end = entries.begin() + starts[v + 1];
+      if (end - begin < 2) continue;
+      std::sort(begin, end);
+      for (auto it = begin + 1; it != end; ++it) {
+        if ((*it)[0] == (*(it - 1))[0] && (*it)[1] == (*(it - 1))[1]) {
+          removed[(*it)[2]] = 1;
+          ++duplicates[range];
+        }
       }
     }
-  }
+  });
+  for (const Triangle& t : rotated) filter.degenerate += t[0] == kNoId ? 1 : 0;
+  for (uint64_t d : duplicates) filter.duplicate += d;
   filter.kept.reserve(faces.size() - filter.degenerate - filter.duplicate);
   for (size_t f = 0; f < faces.size(); ++f) {
     if (rotated[f][0] != kNoId && !removed[f]) filter.kept.push_back(FaceId(f));
@@ -441,40 +457,60 @@ bool pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
 // `sides_paired`: whether the sides of a double-sided surface were paired across an edge.
 std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vertices,
                                  const std::vector<uint8_t>& sides_apart,
-                                 uint64_t* nonmanifold_edges, bool* sides_paired) {
+                                 uint64_t* nonmanifold_edges, bool* sides_paired,
+                                 ChunkedLoops& loops) {
   const size_t halfedges = 3 * faces.size();
-  // Group the halfedges of each undirected edge: bucket by the lower end, holding
-  // (higher end << 32 | halfedge), and sort each bucket (ties by halfedge id).
-  std::vector<uint64_t> entries;
-  std::vector<uint32_t> starts;
-  bucket_by_vertex(
-      halfedges, vertices,
-      [&](size_t h) { return std::min(tail(faces, uint32_t(h)), head(faces, uint32_t(h))); },
-      [&](size_t h) {
-        return uint64_t(std::max(tail(faces, uint32_t(h)), head(faces, uint32_t(h)))) << 32 | h;
-      },
-      &entries, &starts);
-
   std::vector<uint32_t> twin(halfedges, kNoId);
-  std::vector<uint32_t> cut_halfedges, cut_offsets{0};  // the non-manifold edges' halfedges
-  for (size_t v = 0; v < vertices; ++v) {
-    const auto begin = entries.begin() + starts[v], end = entries.begin() + starts[v + 1];
-    std::sort(begin, end);
-    for (auto run = begin; run != end;) {
-      auto run_end = run + 1;
-      while (run_end != end && *run_end >> 32 == *run >> 32) ++run_end;
-      const uint32_t h0 = uint32_t(run[0]), h1 = uint32_t(run_end[-1]);
-      if (run_end - run == 2 && tail(faces, h0) == head(faces, h1)) {
-        twin[h0] = h1;
-        twin[h1] = h0;
-      } else if (run_end - run >= 2) {
-        ++*nonmanifold_edges;  // cut: its faces stay unpaired
-        for (auto h = run; h != run_end; ++h) cut_halfedges.push_back(uint32_t(*h));
-        cut_offsets.push_back(uint32_t(cut_halfedges.size()));
+  // Each range of vertices groups the halfedges of its undirected edges: bucketed by the lower
+  // end, holding (higher end << 32 | halfedge), each bucket sorted (ties by halfedge id). An
+  // edge is its lower end's range's alone, so the ranges pair apart; their cut edges are
+  // joined in vertex order.
+  struct Cuts {
+    std::vector<uint32_t> halfedges;
+    std::vector<uint32_t> ends;  // per cut edge, the end of its halfedges in `halfedges`
+  };
+  std::vector<Cuts> cuts(loops.ranges(vertices));
+  auto lower_end = [&](size_t h) {
+    return std::min(tail(faces, uint32_t(h)), head(faces, uint32_t(h)));
+  };
+  const auto halfedges_of_range = items_of_ranges(loops, halfedges, vertices, lower_end);
+  loops.run_indexed(vertices, [&](size_t range, size_t first, size_t last) {
+    const RangeItems mine(halfedges_of_range, range, halfedges);
+    std::vector<uint64_t> entries;
+    std::vector<uint32_t> starts;
+    bucket_by_vertex(
+        mine.size(), last - first, [&](size_t i) { return VertexId(lower_end(mine[i]) - first); },
+        [&](size_t i) {
+          const uint32_t h = mine[i];
+          return uint64_t(std::max(tail(faces, h), head(faces, h))) << 32 | h;
+        },
+        &entries, &starts);
+    Cuts& cut = cuts[range];
+    for (size_t v = 0; v < last - first; ++v) {
+      const auto begin = entries.begin() + starts[v], end = entries.begin() + starts[v + 1];
+      std::sort(begin, end);
+      for (auto run = begin; run != end;) {
+        auto run_end = run + 1;
+        while (run_end != end && *run_end >> 32 == *run >> 32) ++run_end;
+        const uint32_t h0 = uint32_t(run[0]), h1 = uint32_t(run_end[-1]);
+        if (run_end - run == 2 && tail(faces, h0) == head(faces, h1)) {
+          twin[h0] = h1;
+          twin[h1] = h0;
+        } else if (run_end - run >= 2) {  // cut: its faces stay unpaired
+          for (auto h = run; h != run_end; ++h) cut.halfedges.push_back(uint32_t(*h));
+          cut.ends.push_back(uint32_t(cut.halfedges.size()));
+        }
+        run = run_end;
       }
-      run = run_end;
     }
+  });
+  std::vector<uint32_t> cut_halfedges, cut_offsets{0};  // the non-manifold edges' halfedges
+  for (const Cuts& cut : cuts) {
+    const auto before = uint32_t(cut_halfedges.size());
+    cut_halfedges.insert(cut_halfedges.end(), cut.halfedges.begin(), cut.halfedges.end());
+    for (uint32_t end : cut.ends) cut_offsets.push_back(before + end);
   }
+  *nonmanifold_edges = cut_offsets.size() - 1;
   *sides_paired =
       pair_faces_beside_their_reverses(faces, cut_halfedges, cut_offsets, sides_apart, twin);
   return twin;
@@ -485,64 +521,75 @@ std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vert
 // the vertex. Corner c = 3 * face + i sits at faces[face][i]; its outgoing halfedge is c
 // itself and its incoming one is 3 * face + (i + 2) % 3.
 
-void split_fans(const std::vector<uint32_t>& twin, RepairedMesh* out) {
+void split_fans(const std::vector<uint32_t>& twin, RepairedMesh* out, ChunkedLoops& loops) {
   Mesh& mesh = out->mesh;
   std::vector<Triangle>& faces = mesh.faces;
   const size_t corners = 3 * faces.size();
   const size_t n = mesh.vertex_count();
 
-  // Label the fans in increasing order of their lowest corner, so that a vertex meets its fan
-  // with the lowest face first. Crossing a corner's outgoing halfedge leads to the next corner
-  // clockwise around the vertex; crossing its incoming halfedge, counter-clockwise.
+  // Each range of vertices labels its corners' fans, walking corners in increasing order: a fan
+  // is named by its lowest corner, where the walk meets it first, so that a vertex meets its
+  // fan with the lowest face first. Crossing a corner's outgoing halfedge leads to the next
+  // corner clockwise around the vertex; crossing its incoming halfedge, counter-clockwise. A
+  // fan's corners are its vertex's, so the ranges label apart.
   std::vector<uint32_t> fan_of(corners, kNoId);
-  std::vector<VertexId> fan_vertex;  // per fan: the vertex of the output it will use
-  std::vector<bool> vertex_has_fan(n, false);
-  std::vector<std::pair<VertexId, uint32_t>> extra_fans;  // (vertex, fan)
-  for (uint32_t c = 0; c < corners; ++c) {
-    if (fan_of[c] != kNoId) continue;
-    const uint32_t fan = uint32_t(fan_vertex.size());
-    auto label = [&](uint32_t corner) {
-      // Cannot happen with twins that pair opposite halfedges: the walk would loop.
-      if (fan_of[corner] != kNoId) throw_internal("repair: corner walked twice");
-      fan_of[corner] = fan;
-    };
-    label(c);
-    bool closed = false;
-    for (uint32_t x = c;;) {  // clockwise until the boundary or back to c
-      const uint32_t t = twin[x];
-      if (t == kNoId) break;
-      const uint32_t next = 3 * (t / 3) + (t % 3 + 1) % 3;
-      if (next == c) {
-        closed = true;
-        break;
+  std::vector<std::vector<std::pair<VertexId, uint32_t>>> extra_in(loops.ranges(n));
+  auto vertex_of = [&](size_t c) { return faces[c / 3][c % 3]; };
+  const auto corners_of_range = items_of_ranges(loops, corners, n, vertex_of);
+  loops.run_indexed(n, [&](size_t range, size_t first, size_t last) {
+    std::vector<uint8_t> vertex_has_fan(last - first, 0);
+    const RangeItems mine(corners_of_range, range, corners);
+    for (size_t j = 0; j < mine.size(); ++j) {
+      const uint32_t c = mine[j];
+      const VertexId v = vertex_of(c);
+      if (fan_of[c] != kNoId) continue;
+      auto label = [&](uint32_t corner) {
+        // Cannot happen with twins that pair opposite halfedges: the walk would loop, or
+        // leave the vertex.
+        if (fan_of[corner] != kNoId || vertex_of(corner) != v)
+          throw_internal("repair: corner walked twice");
+        fan_of[corner] = c;
+      };
+      label(c);
+      bool closed = false;
+      for (uint32_t x = c;;) {  // clockwise until the boundary or back to c
+        const uint32_t t = twin[x];
+        if (t == kNoId) break;
+        const uint32_t next = 3 * (t / 3) + (t % 3 + 1) % 3;
+        if (next == c) {
+          closed = true;
+          break;
+        }
+        label(next);
+        x = next;
       }
-      label(next);
-      x = next;
+      for (uint32_t x = c; !closed;) {  // then counter-clockwise until the boundary
+        const uint32_t t = twin[3 * (x / 3) + (x % 3 + 2) % 3];
+        if (t == kNoId) break;
+        label(t);
+        x = t;
+      }
+      if (!vertex_has_fan[v - first]) {
+        vertex_has_fan[v - first] = 1;
+      } else {
+        extra_in[range].emplace_back(v, c);
+      }
     }
-    for (uint32_t x = c; !closed;) {  // then counter-clockwise until the boundary
-      const uint32_t t = twin[3 * (x / 3) + (x % 3 + 2) % 3];
-      if (t == kNoId) break;
-      label(t);
-      x = t;
-    }
-    const VertexId v = faces[c / 3][c % 3];
-    if (!vertex_has_fan[v]) {
-      vertex_has_fan[v] = true;
-      fan_vertex.push_back(v);
-    } else {
-      fan_vertex.push_back(kNoId);
-      extra_fans.emplace_back(v, fan);
-    }
-  }
+  });
+  std::vector<std::pair<VertexId, uint32_t>> extra_fans;  // (vertex, fan)
+  for (const auto& extra : extra_in)
+    extra_fans.insert(extra_fans.end(), extra.begin(), extra.end());
 
   // Copies are numbered by original vertex, then by lowest face (the fan order above).
   std::sort(extra_fans.begin(), extra_fans.end());
   if (n + extra_fans.size() >= kNoId) {
     throw Error(ErrorCode::kResourceExhausted, "repair: too many vertex copies");
   }
+  std::vector<VertexId> copy_of;  // per fan (its lowest corner): its copy, or kNoId
+  if (!extra_fans.empty()) copy_of.assign(corners, kNoId);
   for (size_t k = 0; k < extra_fans.size(); ++k) {
     const auto [v, fan] = extra_fans[k];
-    fan_vertex[fan] = VertexId(n + k);
+    copy_of[fan] = VertexId(n + k);
     mesh.positions.push_back(mesh.positions[v]);
     out->input_vertex.push_back(out->input_vertex[v]);
     if (k == 0 || extra_fans[k - 1].first != v) ++out->report.nonmanifold_vertices;
@@ -550,7 +597,8 @@ void split_fans(const std::vector<uint32_t>& twin, RepairedMesh* out) {
   out->report.vertex_copies_added = extra_fans.size();
   if (extra_fans.empty()) return;
 
-  for (uint32_t c = 0; c < corners; ++c) faces[c / 3][c % 3] = fan_vertex[fan_of[c]];
+  for (uint32_t c = 0; c < corners; ++c)
+    if (copy_of[fan_of[c]] != kNoId) faces[c / 3][c % 3] = copy_of[fan_of[c]];
 
   // The corners now on a copy take copies of their wedges, one per (copy, wedge) pair.
   if (!mesh.layout.any()) return;
@@ -602,21 +650,22 @@ std::vector<FaceId> faces_sharing_a_halfedge(const std::vector<Triangle>& faces)
 // the split is made again, at most a few times before every side is kept apart. Without such
 // a pairing the split is a manifold by construction (this file's opening comment) and is made
 // once, unchecked.
-void split_keeping_sides_apart_where_needed(RepairedMesh* out) {
+void split_keeping_sides_apart_where_needed(RepairedMesh* out, ChunkedLoops& loops) {
   constexpr int kTries = 8;
   std::vector<uint8_t> sides_apart;  // per halfedge; empty: none kept apart
   for (int attempt = 1;; ++attempt) {
     uint64_t nonmanifold_edges = 0;
     bool sides_paired = false;
-    const std::vector<uint32_t> twin = pair_edges(out->mesh.faces, out->mesh.vertex_count(),
-                                                  sides_apart, &nonmanifold_edges, &sides_paired);
+    const std::vector<uint32_t> twin =
+        pair_edges(out->mesh.faces, out->mesh.vertex_count(), sides_apart, &nonmanifold_edges,
+                   &sides_paired, loops);
     out->report.nonmanifold_edges = nonmanifold_edges;
     if (!sides_paired) {
-      split_fans(twin, out);
+      split_fans(twin, out, loops);
       return;
     }
     RepairedMesh split = *out;
-    split_fans(twin, &split);
+    split_fans(twin, &split, loops);
     const std::vector<FaceId> shared = faces_sharing_a_halfedge(split.mesh.faces);
     if (shared.empty()) {
       *out = std::move(split);
@@ -637,7 +686,9 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
 
   // 2. Faces that are not triangles of a surface (degenerate) or that repeat an earlier
   // face go; zero-area faces stay (the simplifier removes them first) but are counted.
-  FaceFilter filter = filter_faces(input.faces, input.vertex_count());
+  ChunkedLoops one_thread;
+  ChunkedLoops& loops = options.loops ? *options.loops : one_thread;
+  FaceFilter filter = filter_faces(input.faces, input.vertex_count(), loops);
   RepairedMesh out;
   out.input_vertex_count = input.vertex_count();
   out.input_face_count = input.face_count();
@@ -656,7 +707,7 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   // 4. Cut along the non-manifold edges (faces laid back to back on a surface are cut off it,
   // the surface kept joined; the two sides of a double-sided surface each kept joined), then
   // copy each vertex once per extra fan.
-  split_keeping_sides_apart_where_needed(&out);
+  split_keeping_sides_apart_where_needed(&out, loops);
 
   // 5. Neighbours on the surface become neighbours in memory.
   if (options.spatial_order) order_spatially(out);

@@ -50,6 +50,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -57,6 +58,9 @@ struct RepairOptions {
   bool keep_unreferenced = false;
   // Rule 5. Off: the output keeps the input's order (rules 3 and 4).
   bool spatial_order = true;
+  // Where the passes over faces and edges run in chunks side by side (the same output); null:
+  // on the calling thread.
+  ChunkedLoops* loops = nullptr;
 };
 
 struct RepairReport {

@@ -6,7 +6,10 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
+#include <utility>
+#include <vector>
 
 namespace parapm {
 
@@ -39,6 +42,59 @@ class ChunkedLoops {
   double seconds_ = 0;
   double critical_seconds_ = 0;
 };
+
+// The items [0, n) of each range of a chunked loop over [0, keys): range r's are those whose
+// key_of(i) falls in it, in increasing order (a key of kNoKey: none). Counted and written in
+// chunks of items, so that each item's key is read twice in all, not once per range. A loop
+// of one range keeps no lists: its range's items are all of [0, n), kNoKey's included.
+constexpr uint32_t kNoKey = 0xffffffffu;
+class RangeItems {
+ public:
+  RangeItems(const std::vector<std::vector<uint32_t>>& lists, size_t range, size_t n)
+      : list_(lists.empty() ? nullptr : &lists[range]), n_(n) {}
+  size_t size() const { return list_ ? list_->size() : n_; }
+  uint32_t operator[](size_t j) const { return list_ ? (*list_)[j] : uint32_t(j); }
+
+ private:
+  const std::vector<uint32_t>* list_;
+  size_t n_;
+};
+template <class KeyOf>
+std::vector<std::vector<uint32_t>> items_of_ranges(ChunkedLoops& loops, size_t n, size_t keys,
+                                                   KeyOf key_of) {
+  const size_t ranges = loops.ranges(keys);
+  if (ranges == 1) return {};
+  auto range_of = [&](size_t key) {
+    // Range r begins at keys * r / ranges (ChunkedLoops::run_indexed).
+    size_t r = key * ranges / keys;
+    while (r > 0 && keys * r / ranges > key) --r;
+    while (r + 1 < ranges && keys * (r + 1) / ranges <= key) ++r;
+    return r;
+  };
+  std::vector<std::vector<uint32_t>> slots(loops.ranges(n), std::vector<uint32_t>(ranges, 0));
+  loops.run_indexed(n, [&](size_t chunk, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const uint32_t key = key_of(i);
+      if (key != kNoKey) ++slots[chunk][range_of(key)];
+    }
+  });
+  std::vector<std::vector<uint32_t>> items(ranges);
+  for (size_t r = 0; r < ranges; ++r) {
+    uint32_t at = 0;
+    for (std::vector<uint32_t>& chunk : slots) at += std::exchange(chunk[r], at);
+    items[r].resize(at);
+  }
+  loops.run_indexed(n, [&](size_t chunk, size_t begin, size_t end) {
+    std::vector<uint32_t>& next = slots[chunk];
+    for (size_t i = begin; i < end; ++i) {
+      const uint32_t key = key_of(i);
+      if (key == kNoKey) continue;
+      const size_t r = range_of(key);
+      items[r][next[r]++] = uint32_t(i);
+    }
+  });
+  return items;
+}
 
 // A section's time with a core per chunk: the wall seconds since it was made, with the loops
 // run meanwhile counted at their critical path.

@@ -100,6 +100,13 @@ inline void expect_same_repair(const RepairedMesh& a, const RepairedMesh& b) {
   EXPECT_EQ(a.input_vertex, b.input_vertex);
   EXPECT_EQ(a.input_face, b.input_face);
   EXPECT_EQ(a.input_wedge, b.input_wedge);
+  EXPECT_EQ(a.report.degenerate_faces_removed, b.report.degenerate_faces_removed);
+  EXPECT_EQ(a.report.duplicate_faces_removed, b.report.duplicate_faces_removed);
+  EXPECT_EQ(a.report.unreferenced_vertices_removed, b.report.unreferenced_vertices_removed);
+  EXPECT_EQ(a.report.nonmanifold_edges, b.report.nonmanifold_edges);
+  EXPECT_EQ(a.report.nonmanifold_vertices, b.report.nonmanifold_vertices);
+  EXPECT_EQ(a.report.vertex_copies_added, b.report.vertex_copies_added);
+  EXPECT_EQ(a.report.zero_area_faces, b.report.zero_area_faces);
 }
 
 }  // namespace parapm::testing

@@ -1,6 +1,7 @@
 // repair_mesh() on every mesh of ../shared/meshes (nothing runs when the folder is absent):
 // read, repair, check that the output is an oriented manifold that merges back into the input
-// minus exactly the removed faces, that a second repair changes nothing, and print one line
+// minus exactly the removed faces, that a repair in chunks side by side is the same, that a
+// second repair changes nothing, and print one line
 // per file with the report counts and the time.
 //
 // Comparison with INVENTORY.tsv, whose counts were made by another tool on the faces as read
@@ -161,6 +162,11 @@ TEST(RepairSharedMeshes, EveryMeshBecomesAManifoldThatMergesBack) {
       // fans (faces laid back to back stay joined across some non-manifold edges).
       EXPECT_LE(report.nonmanifold_vertices, before.nonmanifold_vertices);
     }
+
+    ChunkedLoops loops(16, 2);
+    RepairOptions chunked;
+    chunked.loops = &loops;
+    testing::expect_same_repair(repair_mesh(input, chunked), repaired);
 
     const RepairedMesh again = repair_mesh(repaired.mesh);
     EXPECT_FALSE(again.report.changed());

@@ -570,6 +570,10 @@ TEST(Repair, EveryRuleAtOnce) {
 
 TEST(Repair, Deterministic) {
   const Mesh mesh = everything_wrong();
+  ChunkedLoops loops(4, 2, 1);
+  RepairOptions chunked;
+  chunked.loops = &loops;
+  testing::expect_same_repair(repair_mesh(mesh, chunked), repair_mesh(mesh));
   testing::expect_same_repair(repair_in_input_order(mesh), repair_in_input_order(mesh));
   testing::expect_same_repair(repair_mesh(mesh), repair_mesh(mesh));  // rule 5 too
 }
@@ -607,6 +611,12 @@ TEST(Repair, RandomSoupsBecomeManifolds) {
     SCOPED_TRACE("round " + std::to_string(round));
     const RepairedMesh repaired = repair_in_input_order(mesh);
     expect_faithful_repair(mesh, repaired);
+    // In chunks side by side, ranges of a few vertices or faces: the same repair.
+    ChunkedLoops loops(5, 3, 2);
+    RepairOptions chunked;
+    chunked.loops = &loops;
+    chunked.spatial_order = false;
+    testing::expect_same_repair(repair_mesh(mesh, chunked), repaired);
     const RepairedMesh again = repair_in_input_order(repaired.mesh);
     EXPECT_FALSE(again.report.changed());
     EXPECT_EQ(again.report.nonmanifold_edges, 0u);
