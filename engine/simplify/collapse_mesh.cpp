@@ -23,18 +23,17 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
   boundary_.assign(mesh.positions.size(), 0);
   live_faces_ = mesh.faces.size();
   mark_.assign(mesh.positions.size(), 0);
-  // Each range of vertices reads every face for its own: a list holds its faces in face order,
-  // whatever the chunking.
-  std::vector<uint32_t> valence(positions_.size(), 0);
-  loops.run(positions_.size(), [&](size_t begin, size_t end) {
-    auto mine = [&](VertexId v) { return v - begin < end - begin; };
-    for (const Triangle& t : faces_)
-      for (VertexId v : t)
-        if (mine(v)) ++valence[v];
-    for (size_t v = begin; v < end; ++v) faces_of_[v].reserve(valence[v]);
-    for (FaceId f = 0; f < faces_.size(); ++f)
-      for (VertexId v : faces_[f])
-        if (mine(v)) faces_of_[v].push_back(f);
+  // Each range of vertices lists its own corners' faces, in face order whatever the chunking.
+  auto vertex_of = [&](size_t corner) { return faces_[corner / 3][corner % 3]; };
+  const auto corners_of_range =
+      items_of_ranges(loops, 3 * faces_.size(), positions_.size(), vertex_of);
+  loops.run_indexed(positions_.size(), [&](size_t range, size_t begin, size_t end) {
+    const RangeItems corners(corners_of_range, range, 3 * faces_.size());
+    std::vector<uint32_t> valence(end - begin, 0);
+    for (size_t j = 0; j < corners.size(); ++j) ++valence[vertex_of(corners[j]) - begin];
+    for (size_t v = begin; v < end; ++v) faces_of_[v].reserve(valence[v - begin]);
+    for (size_t j = 0; j < corners.size(); ++j)
+      faces_of_[vertex_of(corners[j])].push_back(FaceId(corners[j] / 3));
     for (size_t v = begin; v < end; ++v) {
       if (faces_of_[v].empty()) continue;
       vertex_alive_[v] = 1;

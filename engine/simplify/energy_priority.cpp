@@ -86,7 +86,7 @@ void EnergyPriority::initialize_points(const CollapseMesh& mesh, ChunkedLoops& l
   // A point's id is its sample's index. The vertices' samples come first: each is parked at
   // its vertex; the others are listed on their faces, newest first, as collapsed() leaves
   // them (the order of the sums over a face's points is part of the build's arithmetic).
-  // Each range of faces reads every drawn sample for its own.
+  // Each range of faces lists its own drawn samples.
   size_t parked = 0;
   while (parked < samples.size() && samples[parked].vertex != kNoId) ++parked;
   loops.run(samples.size(), [&](size_t begin, size_t end) {
@@ -95,11 +95,15 @@ void EnergyPriority::initialize_points(const CollapseMesh& mesh, ChunkedLoops& l
       if (i < parked) parked_point_[samples[i].vertex] = uint32_t(i);
     }
   });
-  loops.run(mesh.face_capacity(), [&](size_t begin, size_t end) {
-    for (size_t i = samples.size(); i-- > parked;) {
-      const SurfaceSample& s = samples[i];
-      if (s.face - begin < end - begin)
-        face_points_[s.face].push_back({s.position, 0.0, uint32_t(i)});
+  auto face_of = [&](size_t i) { return i < parked ? kNoKey : samples[i].face; };
+  const auto points_of_range =
+      items_of_ranges(loops, samples.size(), mesh.face_capacity(), face_of);
+  loops.run_indexed(mesh.face_capacity(), [&](size_t range, size_t, size_t) {
+    const RangeItems points(points_of_range, range, samples.size());
+    for (size_t j = points.size(); j-- > 0;) {
+      const uint32_t i = points[j];
+      if (i < parked) break;
+      face_points_[samples[i].face].push_back({samples[i].position, 0.0, i});
     }
   });
 }
