@@ -46,12 +46,15 @@ LoadedMesh load_and_repair(const std::string& path, const RepairOptions& options
   // .om: OpenMesh's own format, through its reader (ParaPM's readers do the others).
   const bool openmesh_file = path.size() > 3 && (path.compare(path.size() - 3, 3, ".om") == 0 ||
                                                  path.compare(path.size() - 3, 3, ".OM") == 0);
-  Mesh mesh = openmesh_file ? openmesh::read_openmesh(path) : read_mesh(path, &loaded.read);
+  ChunkedLoops one_thread;
+  const LoopClock read_clock(options.loops ? *options.loops : one_thread);
+  Mesh mesh = openmesh_file ? openmesh::read_openmesh(path)
+                            : read_mesh(path, &loaded.read, {}, options.loops);
   loaded.read_seconds = seconds_since(start);
+  loaded.read_critical_seconds = read_clock.critical_seconds();
   loaded.input_vertices = mesh.vertex_count();
   loaded.input_faces = mesh.face_count();
   start = std::chrono::steady_clock::now();
-  ChunkedLoops one_thread;
   const LoopClock repair_clock(options.loops ? *options.loops : one_thread);
   loaded.repaired = repair_mesh(mesh, options);
   loaded.repair_seconds = seconds_since(start);

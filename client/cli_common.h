@@ -36,12 +36,15 @@ struct LoadedMesh {
   uint64_t input_faces = 0;
   double read_seconds = 0;
   double repair_seconds = 0;
-  // The repair with a core per chunk of RepairOptions::loops (repair_seconds without them).
+  // Reading and repair with a core per chunk of RepairOptions::loops (the seconds above
+  // without them).
+  double read_critical_seconds = 0;
   double repair_critical_seconds = 0;
   RepairedMesh repaired;
 };
 
-// Reads and repairs; logs one info line with what was repaired.
+// Reads and repairs (both in RepairOptions::loops' chunks when given); logs one info line with
+// what was repaired.
 LoadedMesh load_and_repair(const std::string& path, const RepairOptions& options);
 
 nlohmann::json repair_report_json(const RepairReport& report);

@@ -105,7 +105,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
 int run_simplify(const SimplifyArgs& args) {
   RepairOptions repair_options;
   repair_options.keep_unreferenced = args.keep_order;  // the input's numbering needs them
-  // A parallel build repairs in p chunks on its threads too.
+  // A parallel build reads and repairs in p chunks on its threads too.
   ChunkedLoops loops(args.parallel, args.threads);
   if (args.parallel > 1) repair_options.loops = &loops;
   LoadedMesh loaded = load_and_repair(args.input, repair_options);
@@ -174,6 +174,7 @@ int run_simplify(const SimplifyArgs& args) {
                           {"seconds", stats.seconds},
                           {"read_seconds", loaded.read_seconds},
                           {"repair_seconds", loaded.repair_seconds},
+                          {"read_critical_seconds", loaded.read_critical_seconds},
                           {"repair_critical_seconds", loaded.repair_critical_seconds},
                           {"write_seconds", write_seconds},
                           {"metric", pm.info.metric},

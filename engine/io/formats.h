@@ -36,7 +36,8 @@ void check_mesh_start(const ReadContext& ctx, MeshFormat format, std::string_vie
 // soup, parts that meet at duplicated vertices) become one surface, as STL's reader makes its
 // corners. The merged vertices stay, unused; wedges keep their values, so attributes that
 // differed across a seam stay per corner. Returns the number of vertices merged (weld.cpp).
-uint64_t weld_coincident_vertices(Mesh& mesh);
+// In `loops`' chunks when given (the same result).
+uint64_t weld_coincident_vertices(Mesh& mesh, ChunkedLoops* loops = nullptr);
 
 // Throws kInvalidInput unless faces, wedges and attribute arrays are consistent (mesh_io.cpp).
 void check_writable(const Mesh& mesh);

@@ -12,13 +12,14 @@
 
 namespace parapm {
 
-Mesh read_mesh(const std::string& path, ReadReport* report, const ReadLimits& limits) {
+Mesh read_mesh(const std::string& path, ReadReport* report, const ReadLimits& limits,
+               ChunkedLoops* loops) {
   const std::string bytes = io::read_file_bytes(path, limits.max_bytes);
-  return read_mesh_from_memory(bytes, path, report, limits);
+  return read_mesh_from_memory(bytes, path, report, limits, loops);
 }
 
 Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name, ReadReport* report,
-                           const ReadLimits& limits) {
+                           const ReadLimits& limits, ChunkedLoops* loops) {
   ReadReport local;
   ReadReport& r = report ? *report : local;
   r = ReadReport{};
@@ -27,6 +28,7 @@ Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name, Re
   ctx.name = name;
   ctx.limits = limits;
   ctx.report = &r;
+  ctx.loops = loops;
   std::string inflated;
   MeshFormat format = format_from_name(name);
   if (io::is_gzip(bytes)) {
@@ -46,8 +48,8 @@ Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name, Re
 
   if (format == MeshFormat::kUnknown) format = io::detect_format(ctx.bytes);
   r.format = format;
-  auto welded = [&r](Mesh mesh) {
-    r.welded_vertices = io::weld_coincident_vertices(mesh);
+  auto welded = [&r, loops](Mesh mesh) {
+    r.welded_vertices = io::weld_coincident_vertices(mesh, loops);
     return mesh;
   };
   switch (format) {

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -68,13 +69,15 @@ const char* format_name(MeshFormat format);
 
 // Reads a whole file (gzip detected by its magic bytes, whatever the name). The format comes
 // from the extension (".gz" ignored) and, when the name has no known extension, from the
-// content. Messages name the file by `path` as given.
-Mesh read_mesh(const std::string& path, ReadReport* report = nullptr,
-               const ReadLimits& limits = {});
+// content. Messages name the file by `path` as given. `loops`: where an ascii PLY body of
+// one record per line is read in chunks side by side (the same mesh); null: on this thread.
+Mesh read_mesh(const std::string& path, ReadReport* report = nullptr, const ReadLimits& limits = {},
+               ChunkedLoops* loops = nullptr);
 // Reads from memory; `name` is used in messages and for the format when it has an extension,
 // otherwise the content decides.
 Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name,
-                           ReadReport* report = nullptr, const ReadLimits& limits = {});
+                           ReadReport* report = nullptr, const ReadLimits& limits = {},
+                           ChunkedLoops* loops = nullptr);
 
 struct WriteOptions {
   bool ascii = false;  // PLY: ascii instead of binary little endian

@@ -19,6 +19,7 @@
 // before anything is allocated; each list length is checked against the bytes left before it
 // is read; each index against the declared vertex count. Errors name the line (ascii) or the
 // byte offset (binary).
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstring>
@@ -28,6 +29,7 @@
 #include "io/formats.h"
 #include "io/ply_format.h"
 #include "io/text_scanner.h"
+#include "util/error.h"
 
 namespace parapm::io {
 namespace {
@@ -44,6 +46,9 @@ class AsciiSource {
       : ctx_(ctx),
         s_(ctx.bytes.data() + header.body_offset, ctx.bytes.data() + ctx.bytes.size(),
            header.body_line) {}
+  // The text [begin, end) of the body, starting on line `first_line`: a chunk of lines.
+  AsciiSource(const ReadContext& ctx, const char* begin, const char* end, uint64_t first_line)
+      : ctx_(ctx), s_(begin, end, first_line) {}
 
   void begin_record(const PlyElement& e, uint64_t index) {
     element_ = &e;
@@ -406,47 +411,50 @@ class PlyBody {
       }
     }
     src_.finish();
-    if (mesh_.layout.any()) {
-      mesh_.wedge_vertex.resize(mesh_.positions.size());
-      for (size_t v = 0; v < mesh_.wedge_vertex.size(); ++v) mesh_.wedge_vertex[v] = VertexId(v);
-      mesh_.face_wedges.assign(mesh_.faces.begin(), mesh_.faces.end());
-    }
-    finish_mesh(mesh_);
+    finish_per_vertex_attributes(mesh_);
     return std::move(mesh_);
   }
 
- private:
+  // The elements' readers, and their records' (read_ascii_in_chunks reads records).
   void read_vertices(const PlyElement& e) {
+    const VertexPlan plan = start_vertices(e);
+    for (uint64_t i = 0; i < e.count; ++i) read_vertex(e, plan, i);
+  }
+
+  // The element's layout, and room for `count` records.
+  VertexPlan start_vertices(const PlyElement& e, uint64_t count = kAll) {
     const VertexPlan plan = plan_vertices(ctx_, e);
     mesh_.layout = plan.layout;
+    if (count == kAll) count = e.count;
+    mesh_.positions.reserve(size_t(count));
+    mesh_.wedge_values.reserve(size_t(count) * size_t(plan.layout.floats_per_wedge()));
+    return plan;
+  }
+
+  void read_vertex(const PlyElement& e, const VertexPlan& plan, uint64_t i) {
     const AttributeLayout& layout = plan.layout;
-    const int stride = layout.floats_per_wedge();
-    mesh_.positions.reserve(size_t(e.count));
-    mesh_.wedge_values.reserve(size_t(e.count) * size_t(stride));
-    for (uint64_t i = 0; i < e.count; ++i) {
-      src_.begin_record(e, i);
-      double v[kSlots] = {};
-      v[kAlpha] = 1.0;
-      for (size_t k = 0; k < e.properties.size(); ++k) {
-        const PlyProperty& p = e.properties[k];
-        if (p.is_list) {
-          const uint64_t n = src_.list_count(p);
-          for (uint64_t j = 0; j < n; ++j) src_.skip(p.type);
-        } else if (plan.slot[k] == kSkip) {
-          src_.skip(p.type);
-        } else {
-          v[plan.slot[k]] = src_.scalar(p.type) / plan.divisor[k];
-        }
+    src_.begin_record(e, i);
+    double v[kSlots] = {};
+    v[kAlpha] = 1.0;
+    for (size_t k = 0; k < e.properties.size(); ++k) {
+      const PlyProperty& p = e.properties[k];
+      if (p.is_list) {
+        const uint64_t n = src_.list_count(p);
+        for (uint64_t j = 0; j < n; ++j) src_.skip(p.type);
+      } else if (plan.slot[k] == kSkip) {
+        src_.skip(p.type);
+      } else {
+        v[plan.slot[k]] = src_.scalar(p.type) / plan.divisor[k];
       }
-      mesh_.positions.push_back({v[kX], v[kY], v[kZ]});
-      check_finite_position(ctx_, mesh_.positions.back(), "vertex " + std::to_string(i), 0);
-      if (layout.normals)
-        for (int c : {kNx, kNy, kNz}) mesh_.wedge_values.push_back(float(v[c]));
-      if (layout.texcoords)
-        for (int c : {kS, kT}) mesh_.wedge_values.push_back(float(v[c]));
-      if (layout.colors)
-        for (int c : {kRed, kGreen, kBlue, kAlpha}) mesh_.wedge_values.push_back(float(v[c]));
     }
+    mesh_.positions.push_back({v[kX], v[kY], v[kZ]});
+    check_finite_position(ctx_, mesh_.positions.back(), "vertex " + std::to_string(i), 0);
+    if (layout.normals)
+      for (int c : {kNx, kNy, kNz}) mesh_.wedge_values.push_back(float(v[c]));
+    if (layout.texcoords)
+      for (int c : {kS, kT}) mesh_.wedge_values.push_back(float(v[c]));
+    if (layout.colors)
+      for (int c : {kRed, kGreen, kBlue, kAlpha}) mesh_.wedge_values.push_back(float(v[c]));
   }
 
   // Reads one index of `record` and checks it; -1 is allowed when `allow_restart`.
@@ -484,23 +492,26 @@ class PlyBody {
 
   void read_faces(const PlyElement& e) {
     mesh_.faces.reserve(mesh_.faces.size() + size_t(e.count));
+    for_each_index_list(e, [&](const PlyProperty& p, uint64_t i) { read_face(e, p, i); });
+  }
+
+  // Face record i's vertex index list (the source at its count), fan-split into triangles.
+  void read_face(const PlyElement& e, const PlyProperty& p, uint64_t i) {
     ReadReport& report = *ctx_.report;
-    for_each_index_list(e, [&](const PlyProperty& p, uint64_t i) {
-      const uint64_t at = src_.mark();
-      const uint64_t n = src_.list_count(p);
-      if (n < 3)
-        src_.fail_at(
-            at, record_name(e, i) + " has " + std::to_string(n) + " vertices, at least 3 needed");
-      const VertexId first = VertexId(read_index(p, e, i, false));
-      VertexId previous = VertexId(read_index(p, e, i, false));
-      for (uint64_t j = 2; j < n; ++j) {
-        const VertexId current = VertexId(read_index(p, e, i, false));
-        add_triangle(first, previous, current);
-        previous = current;
-      }
-      ++report.polygons;
-      if (n > 3) ++report.triangulated_polygons;
-    });
+    const uint64_t at = src_.mark();
+    const uint64_t n = src_.list_count(p);
+    if (n < 3)
+      src_.fail_at(
+          at, record_name(e, i) + " has " + std::to_string(n) + " vertices, at least 3 needed");
+    const VertexId first = VertexId(read_index(p, e, i, false));
+    VertexId previous = VertexId(read_index(p, e, i, false));
+    for (uint64_t j = 2; j < n; ++j) {
+      const VertexId current = VertexId(read_index(p, e, i, false));
+      add_triangle(first, previous, current);
+      previous = current;
+    }
+    ++report.polygons;
+    if (n > 3) ++report.triangulated_polygons;
   }
 
   void read_strips(const PlyElement& e) {
@@ -551,11 +562,25 @@ class PlyBody {
     }
   }
 
+ private:
   const ReadContext& ctx_;
   const PlyHeader& header_;
   Source& src_;
   const uint64_t vertex_count_;
   Mesh mesh_;
+
+ public:
+  static constexpr uint64_t kAll = ~uint64_t(0);
+  Mesh& mesh() { return mesh_; }
+  // The last steps of read() on a mesh joined from chunks (read_ascii_in_chunks).
+  static void finish_per_vertex_attributes(Mesh& mesh) {
+    if (mesh.layout.any()) {
+      mesh.wedge_vertex.resize(mesh.positions.size());
+      for (size_t v = 0; v < mesh.wedge_vertex.size(); ++v) mesh.wedge_vertex[v] = VertexId(v);
+      mesh.face_wedges.assign(mesh.faces.begin(), mesh.faces.end());
+    }
+    finish_mesh(mesh);
+  }
 };
 
 // Refuses, before anything is allocated, counts above the limits and then counts the bytes
@@ -594,6 +619,119 @@ Mesh read_body(const ReadContext& ctx, const PlyHeader& header) {
   return PlyBody<Source>(ctx, header, src, vertex_count).read();
 }
 
+// An ascii body of a vertex element then a face element of one index list, one record per line
+// (as writers put them), read in chunks of lines side by side (ReadContext::loops): the same
+// mesh as the one-pass reader. False, with nothing read, where the file is otherwise or a
+// chunk finds anything amiss (a record off its line, a bad value, a limit): the one-pass
+// reader then reads it and names the first problem.
+bool read_ascii_in_chunks(const ReadContext& ctx, const PlyHeader& header, Mesh& mesh) {
+  if (!ctx.loops || ctx.loops->chunks() < 2 || header.elements.size() != 2) return false;
+  const PlyElement& vertices = header.elements[0];
+  const PlyElement& faces = header.elements[1];
+  if (vertices.name != "vertex" || faces.name != "face" || faces.properties.size() != 1 ||
+      !faces.properties[0].is_list || index_list(ctx, faces) != 0)
+    return false;
+  for (const PlyProperty& p : vertices.properties)
+    if (p.is_list) return false;
+  const char* body = ctx.bytes.data() + header.body_offset;
+  const size_t size = ctx.bytes.size() - header.body_offset;
+  ChunkedLoops& loops = *ctx.loops;
+
+  // A line belongs to the chunk of bytes its first byte is in: each chunk counts the lines
+  // starting in it, then reads them (from its first line's start to the next chunk's).
+  const size_t chunks = loops.ranges(size);
+  std::vector<uint64_t> first_line(chunks + 1, 0);
+  std::vector<const char*> start(chunks + 1, body + size);
+  loops.run_indexed(size, [&](size_t chunk, size_t begin, size_t end) {
+    uint64_t lines = 0;
+    if (begin == 0) {
+      lines = 1;
+      start[chunk] = body;
+    }
+    // A newline at i starts a line at i + 1.
+    const char* p = body + (begin == 0 ? 0 : begin - 1);
+    const char* const last = body + std::min(end, size) - 1;
+    while (p < last) {
+      p = static_cast<const char*>(std::memchr(p, '\n', size_t(last - p)));
+      if (!p) break;
+      if (lines == 0) start[chunk] = p + 1;
+      ++lines;
+      ++p;
+    }
+    first_line[chunk + 1] = lines;
+  });
+  for (size_t c = chunks; c-- > 0;)
+    if (first_line[c + 1] == 0) start[c] = start[c + 1];  // no line starts in it: empty
+  for (size_t c = 0; c < chunks; ++c) first_line[c + 1] += first_line[c];
+  const uint64_t records = vertices.count + faces.count;
+  if (first_line[chunks] < records) return false;
+
+  struct Part {
+    Mesh mesh;
+    ReadReport report;
+  };
+  std::vector<Part> parts(chunks);
+  std::vector<uint8_t> ok(chunks, 0);
+  loops.run_indexed(size, [&](size_t chunk, size_t, size_t) {
+    Part& part = parts[chunk];
+    ReadContext local = ctx;
+    local.report = &part.report;
+    try {
+      AsciiSource src(local, start[chunk], start[chunk + 1], header.body_line + first_line[chunk]);
+      PlyBody<AsciiSource> reader(local, header, src, vertices.count);
+      const uint64_t line_begin = first_line[chunk], line_end = first_line[chunk + 1];
+      // Each record must start on its own line.
+      auto on_its_line = [&](uint64_t line) { return src.mark() == header.body_line + line; };
+      const uint64_t vertex_end = std::min(line_end, vertices.count);
+      if (line_begin < vertex_end) {
+        const VertexPlan plan = reader.start_vertices(vertices, vertex_end - line_begin);
+        for (uint64_t line = line_begin; line < vertex_end; ++line) {
+          if (!on_its_line(line)) return;
+          reader.read_vertex(vertices, plan, line);
+        }
+      } else {
+        reader.mesh().layout = plan_vertices(local, vertices).layout;
+      }
+      const uint64_t face_begin = std::max(line_begin, vertices.count);
+      const uint64_t face_end = std::min(line_end, records);
+      for (uint64_t line = face_begin; line < face_end; ++line) {
+        if (!on_its_line(line)) return;
+        reader.read_face(faces, faces.properties[0], line - vertices.count);
+      }
+      src.mark();
+      if (src.remaining() > 0) return;  // more than blank lines after the faces
+      part.mesh = std::move(reader.mesh());
+      ok[chunk] = 1;
+    } catch (const Error&) {
+      // The one-pass reader names it.
+    }
+  });
+  if (std::find(ok.begin(), ok.end(), 0) != ok.end()) return false;
+  size_t triangles = 0;
+  for (const Part& part : parts) triangles += part.mesh.faces.size();
+  if (triangles > ctx.max_faces()) return false;
+
+  mesh = Mesh{};
+  mesh.layout = parts[0].mesh.layout;
+  mesh.positions.reserve(size_t(vertices.count));
+  mesh.wedge_values.reserve(size_t(vertices.count) * size_t(mesh.layout.floats_per_wedge()));
+  mesh.faces.reserve(triangles);
+  ReadReport& report = *ctx.report;
+  for (Part& part : parts) {
+    mesh.positions.insert(mesh.positions.end(), part.mesh.positions.begin(),
+                          part.mesh.positions.end());
+    mesh.wedge_values.insert(mesh.wedge_values.end(), part.mesh.wedge_values.begin(),
+                             part.mesh.wedge_values.end());
+    mesh.faces.insert(mesh.faces.end(), part.mesh.faces.begin(), part.mesh.faces.end());
+    report.polygons += part.report.polygons;
+    report.triangulated_polygons += part.report.triangulated_polygons;
+    for (const std::string& what : part.report.ignored) note_ignored(ctx, what);
+    part.mesh = Mesh{};
+  }
+  PlyBody<AsciiSource>::finish_per_vertex_attributes(mesh);
+  return true;
+}
+
 }  // namespace
 
 Mesh read_ply(const ReadContext& ctx) {
@@ -603,9 +741,12 @@ Mesh read_ply(const ReadContext& ctx) {
   check_declared_counts(ctx, header);
   constexpr bool kLittleHost = std::endian::native == std::endian::little;
   switch (header.encoding) {
-    case PlyEncoding::kAscii:
+    case PlyEncoding::kAscii: {
       report.encoding = "ascii";
+      Mesh mesh;
+      if (read_ascii_in_chunks(ctx, header, mesh)) return mesh;
       return read_body<AsciiSource>(ctx, header);
+    }
     case PlyEncoding::kBinaryLittleEndian:
       report.encoding = "binary_little_endian";
       return read_body<BinarySource<!kLittleHost>>(ctx, header);

@@ -16,7 +16,8 @@ struct ReadContext {
   std::string name;        // for messages
   bool gzip = false;       // byte offsets are then offsets into the decompressed data
   ReadLimits limits;
-  ReadReport* report = nullptr;  // never null while reading
+  ReadReport* report = nullptr;   // never null while reading
+  ChunkedLoops* loops = nullptr;  // where a reader may read in chunks side by side; may be null
 
   // Limits clamped to what 32-bit ids can hold (kNoId is reserved).
   uint64_t max_vertices() const;

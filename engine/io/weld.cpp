@@ -66,18 +66,33 @@ void PlaceTable::grow() {
     if (v != kNoId) list(v);
 }
 
-uint64_t weld_coincident_vertices(Mesh& mesh) {
+uint64_t weld_coincident_vertices(Mesh& mesh, ChunkedLoops* loops) {
   const size_t n = mesh.positions.size();
-  PlaceTable places(mesh.positions, n);
+  ChunkedLoops one_thread;
+  ChunkedLoops& chunks = loops ? *loops : one_thread;
+  // Vertices at one place share their hash: each range of hashes (its top 16 bits) finds the
+  // first vertex at each of its places, taking its vertices in increasing order.
+  constexpr size_t kHashRanges = size_t(1) << 16;
+  auto hash_range = [&](size_t v) { return uint32_t(place_hash(mesh.positions[v]) >> 48); };
+  const auto vertices_of_range = items_of_ranges(chunks, n, kHashRanges, hash_range);
   std::vector<VertexId> first(n);
+  std::vector<uint64_t> welded_in(chunks.ranges(kHashRanges), 0);
+  chunks.run_indexed(kHashRanges, [&](size_t range, size_t, size_t) {
+    const RangeItems vertices(vertices_of_range, range, n);
+    PlaceTable places(mesh.positions, vertices.size());
+    for (size_t j = 0; j < vertices.size(); ++j) {
+      const VertexId v = vertices[j];
+      first[v] = places.first_at(v);
+      if (first[v] != v) ++welded_in[range];
+    }
+  });
   uint64_t welded = 0;
-  for (VertexId v = 0; v < n; ++v) {
-    first[v] = places.first_at(v);
-    if (first[v] != v) ++welded;
-  }
+  for (uint64_t w : welded_in) welded += w;
   if (welded == 0) return 0;
-  for (Triangle& t : mesh.faces)
-    for (VertexId& v : t) v = first[v];
+  chunks.run(mesh.faces.size(), [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f)
+      for (VertexId& v : mesh.faces[f]) v = first[v];
+  });
   for (VertexId& v : mesh.wedge_vertex) v = first[v];
   return welded;
 }

@@ -89,7 +89,8 @@ TEST(SharedMeshes, EveryFileLoadsWithTheInventoryCounts) {
   }
 }
 
-// Every shared mesh survives OBJ and binary PLY (in memory): same corners, bit for bit.
+// Every shared mesh reads the same in chunks, and survives OBJ and binary PLY (in memory): same
+// corners, bit for bit.
 TEST(SharedMeshes, EveryFileRoundTripsThroughObjAndPly) {
   const auto files = testing::shared_meshes();
   if (files.empty()) GTEST_SKIP() << "no shared meshes folder at " << testing::shared_meshes_dir();
@@ -98,6 +99,16 @@ TEST(SharedMeshes, EveryFileRoundTripsThroughObjAndPly) {
     SCOPED_TRACE(name);
     ReadReport report;
     const Mesh mesh = read_mesh(path.string(), &report);
+    // Read in chunks side by side (the welds, ascii PLY bodies): the same mesh.
+    ChunkedLoops loops(16, 2);
+    ReadReport chunked_report;
+    const Mesh chunked = read_mesh(path.string(), &chunked_report, {}, &loops);
+    EXPECT_EQ(chunked.positions, mesh.positions);
+    EXPECT_EQ(chunked.faces, mesh.faces);
+    EXPECT_EQ(chunked.face_wedges, mesh.face_wedges);
+    EXPECT_EQ(chunked.wedge_values, mesh.wedge_values);
+    EXPECT_EQ(chunked_report.welded_vertices, report.welded_vertices);
+    EXPECT_EQ(chunked_report.polygons, report.polygons);
     const Mesh obj = read_mesh_from_memory(io::write_obj(mesh), name + ".obj");
     testing::expect_same_corners(mesh, obj);
     const Mesh ply = read_mesh_from_memory(io::write_ply(mesh, false), name + ".ply");
