@@ -306,6 +306,7 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
       progress_(progress),
       cancel_(cancel),
       pool_(requested.threads),
+      partition_loops_(requested.subsets, requested.threads),
       runner_(runner ? runner : &pool_),
       events_(events),
       start_(std::chrono::steady_clock::now()),
@@ -350,12 +351,15 @@ void ParallelBuilder::set_up() {
                  whole.live_vertices() >= 4 * size_t(first_subsets) &&
                  whole.live_faces() > handover_;
   auto partition_first_round = [&] {
+    const LoopClock clock(partition_loops_);
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, 0);
+    partition_options.loops = &partition_loops_;
     first_partition_ = partition_live(whole, copy_groups_, first_subsets, partition_options);
+    first_partition_seconds_ = clock.critical_seconds();
   };
   const double before_seconds = before_clock.critical_seconds();
-  const Beside timed = run_beside(
+  run_beside(
       parallel_.threads,
       [&] {
         const LoopClock clock(loops);
@@ -364,7 +368,6 @@ void ParallelBuilder::set_up() {
       },
       first_round_ ? std::vector<std::function<void()>>{partition_first_round}
                    : std::vector<std::function<void()>>{});
-  if (first_round_) first_partition_seconds_ = timed.side_seconds[0];
   const LoopClock after_clock(loops);
   keys_.emplace(*master_, whole.vertex_capacity());
   carry_keys_ = parallel_.carry_keys && master_->costly();
@@ -534,15 +537,19 @@ void ParallelBuilder::partition(Round& r) {
     forgo_foreseen();
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, round);
+    partition_options.loops = &partition_loops_;
+    double partition_seconds = 0;
     const Beside timed = run_beside(parallel_.threads,
                                     [&] {
+                                      const LoopClock clock(partition_loops_);
                                       r.vertex_subset = partition_live(
                                           *whole_, copy_groups_, r.subsets, partition_options);
+                                      partition_seconds = clock.critical_seconds();
                                     },
                                     {[this] { append_pending(); }});
-    rs.partition_seconds = timed.work_seconds + early_check_seconds;
+    rs.partition_seconds = partition_seconds + early_check_seconds;
     rs.append_seconds = timed.side_seconds[0];
-    rs.partition_overlap_seconds = std::min(timed.work_seconds, timed.side_seconds[0]);
+    rs.partition_overlap_seconds = std::min(partition_seconds, timed.side_seconds[0]);
     subsets_cpu_ += timed.side_cpu_elsewhere;
   }
   foreseen_ = Foreseen{};
@@ -824,19 +831,23 @@ void ParallelBuilder::band_pass(Round& r) {
     std::vector<CollapseRecord> band_records;
     PartitionOptions next_options;
     next_options.seed = round_seed(options_.seed, rs.round + 1);
+    next_options.loops = &partition_loops_;
     const double prepared = seconds_since(t);
+    double partition_seconds = 0;
     const Beside timed =
         run_beside(parallel_.threads, [&] { band_records = pass.run(band_limits, {}, cancel_); },
                    {[this] { append_pending(); },
                     [&] {
+                      const LoopClock clock(partition_loops_);
                       if (next.go)
                         foreseen_.vertex_subset = partition_copy(copy, next.subsets, next_options);
+                      partition_seconds = clock.critical_seconds();
                     }});
     foreseen_.beside_band = true;
     foreseen_.drawn = next.go;
     foreseen_.band_seconds = prepared + timed.work_seconds - foreseen_.copy_seconds;
     foreseen_.append_seconds = timed.side_seconds[0];
-    foreseen_.partition_seconds = timed.side_seconds[1];
+    foreseen_.partition_seconds = partition_seconds;
     subsets_cpu_ += timed.side_cpu_elsewhere;
     rs.band_pass_collapses = band_records.size();
     if (carry_deferred_ && !band_records.empty())

@@ -98,6 +98,10 @@ class ParallelBuilder {
   const ProgressCallback& progress_;
   const CancelToken* cancel_;
   ThreadPoolRunner pool_;
+  // The partitions drawn while no job runs (round 0's beside the set-up, a round's beside the
+  // band pass before it, or alone) build their graph in p chunks on the pool's threads; the
+  // one drawn beside round 0's jobs runs on one thread, as the jobs hold the cores.
+  ChunkedLoops partition_loops_;
   SubsetRunner* runner_;
   const ParallelEvents& events_;
   const std::chrono::steady_clock::time_point start_;

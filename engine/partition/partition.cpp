@@ -19,45 +19,103 @@ uint32_t VertexGraph::max_degree() const {
 }
 
 VertexGraph build_vertex_graph(const Mesh& mesh) {
+  ChunkedLoops one_thread;
+  return build_vertex_graph(mesh, one_thread, false);
+}
+
+VertexGraph build_vertex_graph(const Mesh& mesh, ChunkedLoops& loops, bool with_faces) {
   const size_t n = mesh.vertex_count();
+  // The first face with a corner out of range, as one pass in face order finds it.
+  std::vector<std::pair<size_t, VertexId>> bad(loops.ranges(mesh.faces.size()), {SIZE_MAX, 0});
+  loops.run_indexed(mesh.faces.size(), [&](size_t range, size_t begin, size_t end) {
+    for (size_t f = begin; f < end && bad[range].first == SIZE_MAX; ++f)
+      for (VertexId v : mesh.faces[f])
+        if (v >= n) {
+          bad[range] = {f, v};
+          break;
+        }
+  });
+  for (const auto& [f, v] : bad)
+    if (f != SIZE_MAX)
+      throw_invalid("face " + std::to_string(f) + " has vertex " + std::to_string(v) +
+                    " but the mesh has " + std::to_string(n) + " vertices");
+
+  // Each range of vertices lists its vertices' neighbours from their corners, in face order:
+  // each corner gives its vertex two (possibly repeated) neighbours, kept at their first
+  // occurrence (no sorting or hashing); the ranges' lists are joined in vertex order. With
+  // `with_faces`, each vertex's faces too, in increasing order.
+  auto vertex_of = [&](size_t corner) { return mesh.faces[corner / 3][corner % 3]; };
+  const size_t corners = 3 * mesh.faces.size();
+  const auto corners_of_range = items_of_ranges(loops, corners, n, vertex_of);
+  struct Lists {
+    std::vector<size_t> offsets;  // per vertex of the range, then its end
+    std::vector<uint32_t> neighbours;
+    std::vector<size_t> face_offsets;
+    std::vector<uint32_t> face_ids;
+  };
+  std::vector<Lists> lists(loops.ranges(n));
+  loops.run_indexed(n, [&](size_t range, size_t first, size_t last) {
+    const RangeItems mine(corners_of_range, range, corners);
+    Lists& out = lists[range];
+    std::vector<size_t> start(last - first + 1, 0);
+    for (size_t j = 0; j < mine.size(); ++j) start[vertex_of(mine[j]) - first + 1] += 2;
+    for (size_t v = 0; v < last - first; ++v) start[v + 1] += start[v];
+    std::vector<uint32_t> around(start.back());
+    std::vector<size_t> fill(start.begin(), start.end() - 1);
+    for (size_t j = 0; j < mine.size(); ++j) {
+      const Triangle& face = mesh.faces[mine[j] / 3];
+      const size_t c = mine[j] % 3;
+      const size_t v = face[c] - first;
+      around[fill[v]++] = face[(c + 1) % 3];
+      around[fill[v]++] = face[(c + 2) % 3];
+    }
+    out.offsets.resize(last - first + 1);
+    out.neighbours.reserve(around.size() / 2 + 16);  // closed manifolds: each edge twice
+    for (size_t v = 0; v < last - first; ++v) {
+      out.offsets[v] = out.neighbours.size();
+      for (size_t i = start[v]; i < start[v + 1]; ++i) {
+        const uint32_t u = around[i];
+        if (u == first + v) continue;  // a repeated corner
+        if (std::find(out.neighbours.begin() + ptrdiff_t(out.offsets[v]), out.neighbours.end(),
+                      u) != out.neighbours.end())
+          continue;  // already listed
+        out.neighbours.push_back(u);
+      }
+    }
+    out.offsets[last - first] = out.neighbours.size();
+    if (!with_faces) return;
+    out.face_offsets.resize(last - first + 1);
+    for (size_t v = 0; v <= last - first; ++v) out.face_offsets[v] = start[v] / 2;
+    out.face_ids.resize(start.back() / 2);
+    for (size_t v = 0; v < last - first; ++v) fill[v] = start[v] / 2;
+    for (size_t j = 0; j < mine.size(); ++j)
+      out.face_ids[fill[vertex_of(mine[j]) - first]++] = mine[j] / 3;
+  });
   VertexGraph graph;
   graph.offsets.assign(n + 1, 0);
-  // Each corner gives its vertex two (possibly repeated) neighbours: count, fill, then drop
-  // repeats row by row with a per-vertex stamp. Linear, no sorting or hashing.
-  for (size_t f = 0; f < mesh.faces.size(); ++f) {
-    for (VertexId v : mesh.faces[f]) {
-      if (v >= n) {
-        throw_invalid("face " + std::to_string(f) + " has vertex " + std::to_string(v) +
-                      " but the mesh has " + std::to_string(n) + " vertices");
-      }
-      graph.offsets[v + 1] += 2;
-    }
+  if (with_faces) graph.face_offsets.assign(n + 1, 0);
+  size_t neighbours = 0, faces = 0;
+  for (const Lists& out : lists) {
+    neighbours += out.neighbours.size();
+    faces += out.face_ids.size();
   }
-  for (size_t v = 0; v < n; ++v) graph.offsets[v + 1] += graph.offsets[v];
-  std::vector<uint32_t> neighbours(graph.offsets[n]);
-  std::vector<size_t> fill(graph.offsets.begin(), graph.offsets.end() - 1);
-  for (const Triangle& face : mesh.faces) {
-    for (int c = 0; c < 3; ++c) {
-      const VertexId v = face[c];
-      neighbours[fill[v]++] = face[(c + 1) % 3];
-      neighbours[fill[v]++] = face[(c + 2) % 3];
+  graph.neighbours.reserve(neighbours);
+  graph.face_ids.reserve(faces);
+  for (size_t range = 0, v = 0; range < lists.size(); ++range) {
+    const Lists& out = lists[range];
+    const size_t before = graph.neighbours.size(), faces_before = graph.face_ids.size();
+    for (size_t i = 0; i + 1 < out.offsets.size(); ++i, ++v) {
+      graph.offsets[v] = before + out.offsets[i];
+      if (with_faces) graph.face_offsets[v] = faces_before + out.face_offsets[i];
     }
+    graph.neighbours.insert(graph.neighbours.end(), out.neighbours.begin(), out.neighbours.end());
+    graph.face_ids.insert(graph.face_ids.end(), out.face_ids.begin(), out.face_ids.end());
   }
-  std::vector<uint32_t> stamp(n, kNoId);
-  graph.neighbours.reserve(neighbours.size() / 2 + 16);  // closed manifolds: each edge twice
-  size_t out = 0;
-  for (size_t v = 0; v < n; ++v) {
-    const size_t begin = graph.offsets[v], end = graph.offsets[v + 1];
-    graph.offsets[v] = out;
-    for (size_t i = begin; i < end; ++i) {
-      const uint32_t u = neighbours[i];
-      if (u == v || stamp[u] == v) continue;  // a repeated corner, or already listed
-      stamp[u] = uint32_t(v);
-      graph.neighbours.push_back(u);
-      ++out;
-    }
+  graph.offsets[n] = graph.neighbours.size();
+  if (with_faces) {
+    graph.face_offsets[n] = graph.face_ids.size();
+    graph.face_count = uint32_t(mesh.face_count());
   }
-  graph.offsets[n] = out;
   return graph;
 }
 
@@ -141,7 +199,7 @@ uint32_t first_start_vertex(const VertexGraph& graph, const std::vector<uint32_t
   return by_degree[seed % count];
 }
 
-void assign_faces(const Mesh& mesh, Partition& partition) {
+void assign_faces(const Mesh& mesh, Partition& partition, ChunkedLoops& loops) {
   // Each face is simplified by exactly one worker. Giving it to the subset that owns the
   // majority of its vertices keeps it with the worker that holds most of its edges (two of
   // its three edges lie inside that subset), so fewer faces wait for the border pass. When
@@ -149,18 +207,20 @@ void assign_faces(const Mesh& mesh, Partition& partition) {
   // wins, which does not depend on which corner happens to be listed first.
   const auto& vs = partition.vertex_subset;
   partition.face_subset.resize(mesh.faces.size());
-  for (size_t f = 0; f < mesh.faces.size(); ++f) {
-    const uint32_t a = vs[mesh.faces[f][0]], b = vs[mesh.faces[f][1]], c = vs[mesh.faces[f][2]];
-    uint32_t owner;
-    if (a == b || a == c) {
-      owner = a;
-    } else if (b == c) {
-      owner = b;
-    } else {
-      owner = std::min({a, b, c});
+  loops.run(mesh.faces.size(), [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      const uint32_t a = vs[mesh.faces[f][0]], b = vs[mesh.faces[f][1]], c = vs[mesh.faces[f][2]];
+      uint32_t owner;
+      if (a == b || a == c) {
+        owner = a;
+      } else if (b == c) {
+        owner = b;
+      } else {
+        owner = std::min({a, b, c});
+      }
+      partition.face_subset[f] = owner;
     }
-    partition.face_subset[f] = owner;
-  }
+  });
 }
 
 }  // namespace partition_detail
@@ -236,20 +296,14 @@ Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& o
     throw_invalid("partition: unknown algorithm '" + options.algorithm +
                   "' (expected greedy or bfs)");
   }
-  VertexGraph graph = build_vertex_graph(mesh);
-  graph.weight.assign(n, options.balance == Balance::kVertices ? 1 : 0);
-  if (options.balance == Balance::kFaces) {
-    for (const Triangle& face : mesh.faces)
-      for (VertexId v : face) ++graph.weight[v];
-    graph.face_count = uint32_t(mesh.face_count());
-    graph.face_offsets.assign(n + 1, 0);
+  ChunkedLoops one_thread;
+  ChunkedLoops& loops = options.loops ? *options.loops : one_thread;
+  const bool by_faces = options.balance == Balance::kFaces;
+  VertexGraph graph = build_vertex_graph(mesh, loops, by_faces);
+  graph.weight.assign(n, by_faces ? 0 : 1);
+  if (by_faces)  // a vertex counts its faces
     for (VertexId v = 0; v < n; ++v)
-      graph.face_offsets[v + 1] = graph.face_offsets[v] + graph.weight[v];
-    graph.face_ids.resize(graph.face_offsets[n]);
-    std::vector<size_t> fill(graph.face_offsets.begin(), graph.face_offsets.end() - 1);
-    for (uint32_t f = 0; f < mesh.face_count(); ++f)
-      for (VertexId v : mesh.faces[f]) graph.face_ids[fill[v]++] = f;
-  }
+      graph.weight[v] = uint32_t(graph.face_offsets[v + 1] - graph.face_offsets[v]);
   uint64_t total = 0;
   for (uint32_t w : graph.weight) total += w;
   const std::vector<uint64_t> targets = share_targets(total, p, options.weights);
@@ -257,7 +311,7 @@ Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& o
                             ? greedy_partition(graph, targets, options.seed)
                             : bfs_partition(graph, targets, options.seed);
   if (options.refine) refine_partition(graph, targets, partition);
-  assign_faces(mesh, partition);
+  assign_faces(mesh, partition, loops);
   return partition;
 }
 

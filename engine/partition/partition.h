@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -44,6 +45,9 @@ struct PartitionOptions {
   // After the algorithm: move boundary vertices and stray components to cut fewer edges,
   // within the balance bound (refine_partition.cpp).
   bool refine = false;
+  // Where the graph's construction and the faces' assignment run in chunks side by side (the
+  // same partition); null: on the calling thread.
+  ChunkedLoops* loops = nullptr;
 };
 
 struct Partition {

@@ -44,6 +44,9 @@ struct VertexGraph {
 // O(F + V). Error(kInvalidInput) when a face corner is out of range; repeated corners are
 // ignored (no self loops).
 VertexGraph build_vertex_graph(const Mesh& mesh);
+// The same graph built in `loops`' chunks, with each vertex's faces (face_offsets, face_ids,
+// face_count) when `with_faces`.
+VertexGraph build_vertex_graph(const Mesh& mesh, ChunkedLoops& loops, bool with_faces);
 
 // The edges between subsets, and per subset its connected pieces (partition_metrics.cpp).
 struct CutShape {
@@ -91,7 +94,7 @@ uint32_t first_start_vertex(const VertexGraph& graph, const std::vector<uint32_t
                             uint64_t seed, size_t candidates);
 
 // Fills partition.face_subset from partition.vertex_subset (the rule in partition.h).
-void assign_faces(const Mesh& mesh, Partition& partition);
+void assign_faces(const Mesh& mesh, Partition& partition, ChunkedLoops& loops);
 
 // Shares of `total` proportional to the weights (equal when empty), by largest remainder.
 std::vector<uint64_t> share_targets(uint64_t total, uint32_t p, const std::vector<double>& weights);

@@ -77,6 +77,17 @@ TEST(PartitionRealMeshes, CompleteBalancedDeterministic) {
         const Partition again = partition_mesh(mesh, p, opts);
         EXPECT_EQ(run.partition.vertex_subset, again.vertex_subset);
         EXPECT_EQ(run.partition.face_subset, again.face_subset);
+        // Its graph built in chunks side by side, by faces and by vertices: the same.
+        ChunkedLoops loops(7, 3, 64);
+        for (Balance balance : {Balance::kFaces, Balance::kVertices}) {
+          PartitionOptions one_pass = opts, chunked = opts;
+          one_pass.balance = chunked.balance = balance;
+          chunked.loops = &loops;
+          const Partition a = partition_mesh(mesh, p, one_pass),
+                          b = partition_mesh(mesh, p, chunked);
+          EXPECT_EQ(a.vertex_subset, b.vertex_subset);
+          EXPECT_EQ(a.face_subset, b.face_subset);
+        }
       }
     }
   }

@@ -112,7 +112,19 @@ TEST(PartitionMesh, RejectsBadArguments) {
   EXPECT_THROW(partition_mesh(mesh, 2, options("greedy", 1, {1, 2, 3})), Error);
   Mesh broken = mesh;
   broken.faces[3][1] = 10;
+  broken.faces[5][0] = 12;
   EXPECT_THROW(partition_mesh(broken, 2, options("greedy")), Error);
+  // In chunks too, naming the first face, as one pass does.
+  ChunkedLoops loops(4, 2, 1);
+  PartitionOptions chunked = options("greedy");
+  chunked.loops = &loops;
+  try {
+    partition_mesh(broken, 2, chunked);
+    FAIL() << "a corner out of range was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
+    EXPECT_NE(std::string(e.what()).find("face 3 has vertex 10"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(partition_mesh(Mesh{}, 1, options("greedy")), Error);
 }
 
