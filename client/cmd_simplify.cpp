@@ -312,8 +312,8 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
   cmd->add_option("--threads", args->threads,
-                  "With --parallel: threads of the pool (0: min(P, hardware threads)); the .pm "
-                  "does not depend on it")
+                  "With --parallel: threads of the pool, which also read, repair and set up in "
+                  "P chunks (0: min(P, hardware threads)); the .pm does not depend on it")
       ->capture_default_str();
   cmd->add_option("--rounds", args->rounds,
                   "With --parallel: parallel rounds, each on a new partition (the borders "
@@ -364,12 +364,14 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                 "Energy: cost the edges around each collapse at once, not when they reach the "
                 "top of the queue (for measuring the costings deferral saves; the PM differs a "
                 "little, docs/decisions/notebook-2026-11.md)");
-  cmd->add_flag("--json", args->json,
-                "Print one JSON object on stdout: sizes, seconds, CPU seconds and costings (edges "
-                "the metric costed); with --parallel, under \"parallel\": p, rounds performed, "
-                "per round the partition, extraction, subset (per subset wall and CPU) and merge "
-                "seconds, the queue keys and deferred edges carried, the keys reused, the final "
-                "pass, the CPU and costings in all and the critical path");
+  cmd->add_flag(
+      "--json", args->json,
+      "Print one JSON object on stdout: sizes, seconds (reading and repair also with a "
+      "core per chunk: with --parallel P they run in P chunks), CPU seconds and costings "
+      "(edges the metric costed); with --parallel, under \"parallel\": p, rounds performed, "
+      "per round the partition, extraction, subset (per subset wall and CPU) and merge "
+      "seconds, the queue keys and deferred edges carried, the keys reused, the final "
+      "pass, the CPU and costings in all and the critical path");
   cmd->callback([args, &exit_code] { exit_code = run_simplify(*args); });
 }
 

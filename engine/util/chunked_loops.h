@@ -1,7 +1,8 @@
-// Loops over an index range cut into chunks that run side by side: the set-up passes over a
-// whole mesh, which the parallel build runs before its first round and which would otherwise
-// be one thread's work. Every chunk covers a contiguous range and writes only what belongs to
-// it, so a loop's result does not depend on the chunking: one chunk gives the same bytes.
+// Loops over an index range cut into chunks that run side by side: the passes over a whole
+// mesh that a parallel build's master makes (reading, repair, the set-up, the partitions'
+// graphs), which would otherwise be one thread's work. Every chunk covers a contiguous range and
+// writes only what belongs to it, so a loop's result does not depend on the chunking: one chunk
+// gives the same bytes.
 #pragma once
 
 #include <chrono>
