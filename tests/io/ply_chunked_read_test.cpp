@@ -80,7 +80,7 @@ TEST(PlyChunkedRead, FilesNotOneRecordPerLineReadAsTheOnePassReaderReadsThem) {
   two_per_line[two_per_line.find('\n', body + 60)] = ' ';  // two vertices on one line
   expect_same_read(two_per_line);
   std::string blank_inside = quad_strip(40);
-  blank_inside.insert(blank_inside.find('\n', body + 100) + 1, "\n");
+  blank_inside.insert(blank_inside.find('\n', body + 100) + 1, 1, '\n');
   expect_same_read(blank_inside);
   expect_same_read(quad_strip(40) + "junk after the faces\n");
 }
