@@ -495,7 +495,8 @@ class PlyBody {
     for_each_index_list(e, [&](const PlyProperty& p, uint64_t i) { read_face(e, p, i); });
   }
 
-  // Face record i's vertex index list (the source at its count), fan-split into triangles.
+  // Face record i's vertex index list (the source at its count, the record begun),
+  // fan-split into triangles.
   void read_face(const PlyElement& e, const PlyProperty& p, uint64_t i) {
     ReadReport& report = *ctx_.report;
     const uint64_t at = src_.mark();
@@ -628,8 +629,12 @@ bool read_ascii_in_chunks(const ReadContext& ctx, const PlyHeader& header, Mesh&
   if (!ctx.loops || ctx.loops->chunks() < 2 || header.elements.size() != 2) return false;
   const PlyElement& vertices = header.elements[0];
   const PlyElement& faces = header.elements[1];
-  if (vertices.name != "vertex" || faces.name != "face" || faces.properties.size() != 1 ||
-      !faces.properties[0].is_list || index_list(ctx, faces) != 0)
+  // Checked without failing: what the one-pass reader refuses, it refuses with its message.
+  if (vertices.name != "vertex" || faces.name != "face" || faces.properties.size() != 1)
+    return false;
+  const PlyProperty& indices = faces.properties[0];
+  if (!indices.is_list || (indices.name != "vertex_indices" && indices.name != "vertex_index") ||
+      !ply_type_is_integer(indices.type))
     return false;
   for (const PlyProperty& p : vertices.properties)
     if (p.is_list) return false;
@@ -696,7 +701,8 @@ bool read_ascii_in_chunks(const ReadContext& ctx, const PlyHeader& header, Mesh&
       const uint64_t face_end = std::min(line_end, records);
       for (uint64_t line = face_begin; line < face_end; ++line) {
         if (!on_its_line(line)) return;
-        reader.read_face(faces, faces.properties[0], line - vertices.count);
+        src.begin_record(faces, line - vertices.count);
+        reader.read_face(faces, indices, line - vertices.count);
       }
       src.mark();
       if (src.remaining() > 0) return;  // more than blank lines after the faces

@@ -32,11 +32,16 @@ void ChunkedLoops::run_indexed(size_t n, const std::function<void(size_t, size_t
     return;
   }
   std::vector<double> range_seconds(count, 0);
-  run_jobs(count, threads_, [&](size_t i) {
+  auto range = [&](size_t i) {
     const auto t = std::chrono::steady_clock::now();
     body(i, n * i / count, n * (i + 1) / count);
     range_seconds[i] = seconds_since(t);
-  });
+  };
+  if (pool_threads(threads_, count) == 1) {
+    for (size_t i = 0; i < count; ++i) range(i);  // one thread: this one
+  } else {
+    run_jobs(count, threads_, range);
+  }
   seconds_ += seconds_since(start);
   critical_seconds_ += *std::max_element(range_seconds.begin(), range_seconds.end());
 }

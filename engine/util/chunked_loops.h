@@ -23,7 +23,8 @@ class ChunkedLoops {
 
   unsigned chunks() const { return chunks_; }
   // Calls body(begin, end) on consecutive ranges covering [0, n) and returns when all are
-  // done; the exception of the lowest range is rethrown. One loop at a time.
+  // done; the exception of the lowest range is rethrown (with one thread, the ranges run on
+  // the calling thread, in order, and the first exception ends the loop). One loop at a time.
   void run(size_t n, const std::function<void(size_t begin, size_t end)>& body);
   // The same with each range's index (0 ... ranges(n) - 1, in order along [0, n)), for loops
   // whose ranges each fill an output of their own, joined in order afterwards.

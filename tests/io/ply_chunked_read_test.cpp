@@ -102,6 +102,16 @@ TEST(PlyChunkedRead, ErrorsAreTheOnePassReadersOwn) {
   }
   EXPECT_NE(message_one_pass.find("vertex index 999"), std::string::npos) << message_one_pass;
   EXPECT_EQ(message_one_pass, message_chunked);
+  // A header with two problems: the one-pass reader names the vertex element's first.
+  std::string two_problems = quad_strip(40);
+  two_problems.replace(two_problems.find("property float x"), 16, "property float w");
+  two_problems.replace(two_problems.find("vertex_indices"), 14, "vertex_nidices");
+  try {
+    read_mesh_from_memory(two_problems, "m.ply", nullptr, {}, &c.loops);
+    FAIL() << "read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no scalar 'x' property"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
