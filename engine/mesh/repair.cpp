@@ -38,7 +38,8 @@
 // edges): O(F log(max valence)) time; about 60 bytes per face of scratch memory. No hashing,
 // ties broken by index: the output depends only on the input. The passes over faces and
 // vertices may run in chunks side by side (RepairOptions::loops), each over a range of faces
-// or of vertices, reading all and writing only its own: the same output.
+// or of vertices, its items sent to it once (items_of_ranges), writing only its own: the same
+// output.
 #include "mesh/repair.h"
 
 #include <algorithm>
