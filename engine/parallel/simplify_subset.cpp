@@ -98,28 +98,35 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
       make_subset_priority(memo ? *memo : module, std::move(free_vertex));
   auto constraints = standard_constraints(job.locked);
   constraints.push_back(make_subset_constraint(job.owned));
-  Simplifier simplifier(working, *priority, std::move(constraints));
   const CopyGroups groups = copy_groups_of(job.copy_group);
-  if (!groups.empty()) simplifier.join_copies(&groups);
+  std::optional<Simplifier> simplifier;
+  simplifier.emplace(working, *priority, std::move(constraints));
+  if (!groups.empty()) simplifier->join_copies(&groups);
   SimplifierLimits limits;
   limits.target_faces = job.options.target_faces;
   if (job.options.max_cost > 0) limits.max_cost = job.options.max_cost;
   if (job.options.defer_recosting) limits.defer_above_faces = 0;
   limits.first_deferred = &job.deferred;
-  result.records = simplifier.run(limits, progress, cancel);
-  if (had_state) result.state = export_result_state(*metric, working, job, result.records);
-  for (CollapseRecord& r : result.records) globalise(r, job);
+  result.records = simplifier->run(limits, progress, cancel);
   // Keys mean something to the master only when the job's state is the master's.
   if (memo && had_state) {
     result.keys = current_keys_in_global_ids(*memo, working, job);
     // But those the module refused last (infinite key): the next round's jobs cost them at
     // once, as before, rather than wait for their queues to empty.
-    for (const DeferredEdge& d : simplifier.deferred_edges())
+    for (const DeferredEdge& d : simplifier->deferred_edges())
       if (!std::isinf(d.key))  // still sorted: local ids follow the global order
         result.deferred.push_back({job.global_vertex[d.a], job.global_vertex[d.b], d.key});
   }
   result.keys_reused = memo ? memo->reused() : 0;
-  result.stats = simplifier.stats();
+  result.stats = simplifier->stats();
+  // The queue, the keys and the metric's caches go before the state is exported: the job's
+  // exported state takes their place at its peak, not a place beside them.
+  simplifier.reset();
+  priority.reset();
+  memo.reset();
+  metric->release_caches();
+  if (had_state) result.state = export_result_state(*metric, working, job, result.records);
+  for (CollapseRecord& r : result.records) globalise(r, job);
   result.costings = metric->costings();
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;

@@ -10,6 +10,23 @@
 
 namespace parapm {
 
+namespace {
+
+// Reserves each face's list for the run of `points` naming it (a state lists its points
+// grouped by face): a list grown point by point would leave the blocks it outgrew behind.
+// Faces out of range are left to the caller's checks.
+void reserve_face_lists(const std::vector<EnergyState::Point>& points,
+                        std::vector<std::vector<EnergyFacePoint>>& lists) {
+  for (size_t i = 0, run = 0; i < points.size(); i += run) {
+    const FaceId f = points[i].face;
+    run = 1;
+    while (i + run < points.size() && points[i + run].face == f) ++run;
+    if (f < lists.size()) lists[f].reserve(lists[f].size() + run);
+  }
+}
+
+}  // namespace
+
 void EnergyPriority::export_state(const std::vector<FaceId>& faces,
                                   const std::vector<VertexId>& vertices,
                                   const std::vector<WedgeId>& wedges, const IdMaps& maps,
@@ -28,6 +45,15 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
       out.point_values.insert(out.point_values.end(), scalar_.point_values(id),
                               scalar_.point_values(id) + floats);
   };
+  // Sized once: grown by doubling, a state of a million points left twice its size behind in
+  // freed blocks.
+  size_t points = 0;
+  for (const FaceId f : faces) points += face_points_[f].size();
+  for (const VertexId v : vertices) points += parked_point_[v] != kNoPoint ? 1 : 0;
+  out.points.reserve(points);
+  if (floats && to_local) out.point_values.reserve(points * size_t(floats));
+  out.faces.reserve(faces.size());
+  out.vertices.reserve(vertices.size());
   // (Each id translated near its own position in the list: exact when the list is the map
   // itself, a job's export_local.)
   for (size_t i = 0; i < faces.size(); ++i) {
@@ -98,6 +124,7 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   positions_.resize(n);
   point_id_.resize(n);
   reset_point_lists(mesh);
+  reserve_face_lists(state.points, face_points_);
   // The faces keep the written order.
   for (size_t i = 0; i < n; ++i) {
     const EnergyState::Point& p = state.points[i];
@@ -205,6 +232,7 @@ void EnergyPriority::apply_global(const EnergyState& state, const GlobalImport& 
     drift_[f] = 0;
   }
   for (VertexId v : state.vertices) parked_point_[v] = kNoPoint;
+  reserve_face_lists(state.points, face_points_);
   // The faces keep the written order.
   for (const EnergyState::Point& p : state.points) {
     if (p.face != kNoId) {
@@ -214,6 +242,9 @@ void EnergyPriority::apply_global(const EnergyState& state, const GlobalImport& 
     }
     if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
   }
+  // A face left without points (most were removed by the job) gives its list's memory back.
+  for (FaceId f : state.faces)
+    if (face_points_[f].empty()) face_points_[f].shrink_to_fit();
   if (options_.discontinuities) curves_.import_global(state, &import.samples);
 }
 
