@@ -117,6 +117,11 @@ std::vector<std::pair<VertexId, VertexId>> find_sharp_edges(const CollapseMesh& 
   return edges;
 }
 
+void SharpCurves::make_lists() {
+  neighbors_.assign(vertex_capacity_, {});
+  listed_at_.assign(vertex_capacity_, {});
+}
+
 void SharpCurves::add_sharp(VertexId a, VertexId b) {
   neighbors_[a].push_back(b);
   neighbors_[b].push_back(a);
@@ -130,10 +135,12 @@ void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& o
 void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& options,
                              ChunkedLoops& loops) {
   samples_.clear();
-  neighbors_.assign(mesh.vertex_capacity(), {});
-  listed_at_.assign(mesh.vertex_capacity(), {});
+  vertex_capacity_ = mesh.vertex_capacity();
+  neighbors_.clear();
+  listed_at_.clear();
   const auto edges = find_sharp_edges(mesh, options, loops);
   edge_count_ = edges.size();
+  if (!edges.empty()) make_lists();
   for (const auto& [a, b] : edges) add_sharp(a, b);
   auto add_sample = [&](const Vec3& position, VertexId u, VertexId w) {
     const auto id = uint32_t(samples_.size());
@@ -141,7 +148,7 @@ void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& o
     listed_at_[u].push_back(id);
     listed_at_[w].push_back(id);
   };
-  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v)
+  for (VertexId v = 0; v < neighbors_.size(); ++v)
     if (!neighbors_[v].empty()) add_sample(mesh.position(v), v, neighbors_[v][0]);
   for (const auto& [a, b] : edges)
     add_sample(scale(add(mesh.position(a), mesh.position(b)), 0.5), a, b);
@@ -151,18 +158,19 @@ void SharpCurves::initialize(const CollapseMesh& mesh, const SharpEdgeOptions& o
 
 void SharpCurves::initialize_empty(const CollapseMesh& mesh) {
   samples_.clear();
-  neighbors_.assign(mesh.vertex_capacity(), {});
-  listed_at_.assign(mesh.vertex_capacity(), {});
+  vertex_capacity_ = mesh.vertex_capacity();
+  neighbors_.clear();
+  listed_at_.clear();
   edge_count_ = 0;
   total_samples_ = 0;
   sample_id_.clear();
 }
 
-bool SharpCurves::is_sharp(VertexId a, VertexId b) const { return contains(neighbors_[a], b); }
+bool SharpCurves::is_sharp(VertexId a, VertexId b) const { return contains(sharp_neighbors(a), b); }
 
 bool SharpCurves::changes_topology(VertexId a, VertexId b) const {
-  const auto& na = neighbors_[a];
-  const auto& nb = neighbors_[b];
+  const auto& na = sharp_neighbors(a);
+  const auto& nb = sharp_neighbors(b);
   if (na.empty() || nb.empty()) return false;
   if (!contains(na, b)) return true;
   for (VertexId x : na)
@@ -177,8 +185,8 @@ void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh,
   ends_.clear();
   end_positions_.clear();
   if (samples_.empty()) return;
-  gathered_.insert(gathered_.end(), listed_at_[a].begin(), listed_at_[a].end());
-  for (uint32_t id : listed_at_[b]) {
+  gathered_.insert(gathered_.end(), listed_at(a).begin(), listed_at(a).end());
+  for (uint32_t id : listed_at(b)) {
     const Sample& s = samples_[id];
     if (s.u != a && s.w != a) gathered_.push_back(id);  // else listed at a too
   }
@@ -196,7 +204,7 @@ void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh,
     }
   }
   for (VertexId end : {a, b})
-    for (VertexId x : neighbors_[end])
+    for (VertexId x : sharp_neighbors(end))
       if (x != a && x != b && !contains(ends_, x)) {
         ends_.push_back(x);
         end_positions_.push_back(mesh.position(x));
@@ -250,6 +258,7 @@ void SharpCurves::unlist(VertexId v, uint32_t id) {
 
 double SharpCurves::collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh) {
   // A job may hold sharp edges but none of their samples: the curves are updated anyway.
+  if (neighbors_.empty()) return 0;  // no curves (and so no samples)
   if (samples_.empty() && neighbors_[vs].empty() && neighbors_[vt].empty()) return 0;
   std::vector<uint32_t>& moved = gathered_;  // (every sample: no weights here)
   gathered_weight_ = 1;
@@ -310,11 +319,11 @@ void SharpCurves::export_state(const std::vector<VertexId>& vertices, const IdTr
   for (size_t i = 0; i < vertices.size(); ++i) {
     const VertexId v = vertices[i];
     // (Translated near v's own position: exact when `vertices` is the map itself, a job's.)
-    for (VertexId x : neighbors_[v])
+    for (VertexId x : sharp_neighbors(v))
       if (const VertexId written = to.near(x, i); written != kNoId)
         out.sharp_neighbors.push_back(written);
     out.sharp_begin.push_back(uint32_t(out.sharp_neighbors.size()));
-    for (uint32_t id : listed_at_[v]) {
+    for (uint32_t id : listed_at(v)) {
       const Sample& s = samples_[id];
       const VertexId u = to.near(s.u, i), w = to.near(s.w, i);
       if (u == kNoId || (s.w != kNoId && w == kNoId)) continue;
@@ -333,8 +342,11 @@ void SharpCurves::import_local(const CollapseMesh& mesh, const EnergyState& stat
   const size_t n = state.vertices.size();
   if (state.sharp_begin.size() != n + 1 || state.listed_begin.size() != n + 1)
     throw_invalid("energy state: curve lists disagree with the vertices");
-  neighbors_.assign(mesh.vertex_capacity(), {});
-  listed_at_.assign(mesh.vertex_capacity(), {});
+  vertex_capacity_ = mesh.vertex_capacity();
+  neighbors_.clear();
+  listed_at_.clear();
+  if (!state.sharp_neighbors.empty() || !state.listed.empty() || !state.samples.empty())
+    make_lists();
   samples_.clear();
   sample_id_.clear();
   for (const EnergyState::CurveSample& s : state.samples) {
@@ -349,7 +361,7 @@ void SharpCurves::import_local(const CollapseMesh& mesh, const EnergyState& stat
     return begin[k + 1] > begin[k] ? std::min<size_t>(begin[k + 1] - begin[k], total) : 0;
   };
   size_t ends = 0;
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < n && !neighbors_.empty(); ++i) {
     const VertexId v = state.vertices[i];
     neighbors_[v].reserve(neighbors_[v].size() +
                           count(state.sharp_begin, i, state.sharp_neighbors.size()));
@@ -376,18 +388,21 @@ void SharpCurves::check_global(const EnergyState& state) const {
     throw_invalid("energy state: curve lists disagree with the vertices");
   for (const EnergyState::CurveSample& s : state.samples) {
     if (s.id >= samples_.size()) throw_invalid("energy state: curve sample id out of range");
-    if (s.u >= neighbors_.size() || (s.w != kNoId && s.w >= neighbors_.size()))
+    if (s.u >= vertex_capacity_ || (s.w != kNoId && s.w >= vertex_capacity_))
       throw_invalid("energy state: curve sample on a vertex out of range");
   }
+  // A module without curves has no sample, and a collapse never makes a sharp edge.
+  if (neighbors_.empty() && (!state.sharp_neighbors.empty() || !state.listed.empty()))
+    throw_invalid("energy state: sharp curves for a mesh without any");
   for (size_t i = 0; i < n; ++i) {
-    if (state.vertices[i] >= neighbors_.size()) throw_invalid("energy state: vertex out of range");
+    if (state.vertices[i] >= vertex_capacity_) throw_invalid("energy state: vertex out of range");
     if (state.sharp_begin[i] > state.sharp_begin[i + 1] ||
         state.sharp_begin[i + 1] > state.sharp_neighbors.size() ||
         state.listed_begin[i] > state.listed_begin[i + 1] ||
         state.listed_begin[i + 1] > state.listed.size())
       throw_invalid("energy state: curve lists out of range");
     for (uint32_t k = state.sharp_begin[i]; k < state.sharp_begin[i + 1]; ++k)
-      if (state.sharp_neighbors[k] >= neighbors_.size())
+      if (state.sharp_neighbors[k] >= vertex_capacity_)
         throw_invalid("energy state: sharp neighbour out of range");
     for (uint32_t k = state.listed_begin[i]; k < state.listed_begin[i + 1]; ++k)
       if (state.listed[k] >= state.samples.size())
@@ -405,6 +420,7 @@ void SharpCurves::import_global(const EnergyState& state, const std::vector<uint
   } else {
     for (const EnergyState::CurveSample& s : state.samples) write(s);
   }
+  if (neighbors_.empty()) return;  // (check_global: the state has no curves either)
   for (size_t i = 0; i < state.vertices.size(); ++i) {
     const VertexId v = state.vertices[i];
     neighbors_[v].assign(state.sharp_neighbors.begin() + state.sharp_begin[i],

@@ -53,8 +53,10 @@ class SharpCurves {
   // Whether the whole mesh has curve samples (a job may hold none of them).
   bool has_samples() const { return total_samples_ > 0; }
   size_t sharp_edge_count() const { return edge_count_; }
-  const std::vector<VertexId>& sharp_neighbors(VertexId v) const { return neighbors_[v]; }
-  bool on_curve(VertexId v) const { return !neighbors_[v].empty(); }
+  const std::vector<VertexId>& sharp_neighbors(VertexId v) const {
+    return neighbors_.empty() ? no_neighbors_ : neighbors_[v];
+  }
+  bool on_curve(VertexId v) const { return !sharp_neighbors(v).empty(); }
   bool is_sharp(VertexId a, VertexId b) const;
   // Hoppe 96's test: collapsing {a, b} changes the curves' topology when both ends are on
   // curves but the edge is not sharp (two curves would touch), when both ends are curve
@@ -113,10 +115,20 @@ class SharpCurves {
   };
   void add_sharp(VertexId a, VertexId b);
   void unlist(VertexId v, uint32_t id);
+  const std::vector<uint32_t>& listed_at(VertexId v) const {
+    return listed_at_.empty() ? no_samples_ : listed_at_[v];
+  }
+  // Sizes the per-vertex lists for the mesh (before any is written).
+  void make_lists();
 
   std::vector<Sample> samples_;
+  size_t vertex_capacity_ = 0;
+  // Per vertex, or empty where the module has no sharp edge and no sample (most scans: 48 B per
+  // vertex saved); a collapse never makes the first one.
   std::vector<std::vector<VertexId>> neighbors_;
   std::vector<std::vector<uint32_t>> listed_at_;  // per vertex: samples on its sharp edges
+  static inline const std::vector<VertexId> no_neighbors_{};
+  static inline const std::vector<uint32_t> no_samples_{};
   size_t edge_count_ = 0;
   size_t total_samples_ = 0;
   std::vector<uint32_t> sample_id_;  // a job's: per sample, the master's id (empty: identity)

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <functional>
 
+#include "drawn_meshes.h"
 #include "parallel/collapse_merge.h"
 #include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
@@ -393,6 +394,46 @@ TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
     expect_refused_and_unchanged([&] { import_result_state(*master, state, result.records); },
                                  tamper.what, *energy, before);
   }
+  EXPECT_NO_THROW(import_result_state(*master, result.state, result.records));
+}
+
+// A mesh without sharp edges (a closed sphere, no attributes, no crease curves) keeps no
+// per-vertex curve lists: its jobs' states carry no curves and go back as usual, and a state
+// that brings curves to such a master (from a worker: a collapse never makes a sharp edge) is
+// refused before the master changes.
+TEST(JobState, AMasterWithoutCurvesRefusesAStateWithCurves) {
+  const RepairedMesh repaired = repair_mesh(testing::uv_sphere(24, 48, 0.1));
+  const Mesh& mesh = repaired.mesh;
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const SimplifyOptions options = options_of("energy");
+  const CollapseMesh whole(mesh);
+  const std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
+  master->initialize(whole);
+  std::vector<uint32_t> vertex_subset(whole.vertex_capacity());
+  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+    vertex_subset[v] = whole.position(v)[0] < 0 ? 0 : 1;
+  std::vector<SubsetJob> jobs =
+      extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                      vertex_subset, 2, 0, subset_options_of(options, mesh));
+  SubsetJob& job = jobs.at(0);
+  job.options.target_faces = job.mesh.face_count() / 2;
+  job.state = export_job_state(*master, job);
+  ASSERT_TRUE(job.state.energy.sharp_neighbors.empty());
+  ASSERT_TRUE(job.state.energy.samples.empty());
+  const SubsetResult result = simplify_subset(job);
+  ASSERT_FALSE(result.records.empty());
+  ASSERT_TRUE(result.state.energy.sharp_neighbors.empty());
+  const auto* energy = dynamic_cast<EnergyPriority*>(master.get());
+  ASSERT_NE(energy, nullptr);
+  const auto before = energy->point_states();
+
+  MetricState curved = result.state;
+  EnergyState& state = curved.energy;
+  ASSERT_GE(state.vertices.size(), 2u);
+  state.sharp_neighbors = {state.vertices[1]};
+  for (size_t i = 1; i < state.sharp_begin.size(); ++i) state.sharp_begin[i] = 1;
+  expect_refused_and_unchanged([&] { import_result_state(*master, curved, result.records); },
+                               "sharp curves for a mesh without any", *energy, before);
   EXPECT_NO_THROW(import_result_state(*master, result.state, result.records));
 }
 
