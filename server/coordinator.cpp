@@ -495,9 +495,10 @@ void Coordinator::run_job(const std::string& job_id) {
     done->set_seconds(record.seconds);
     done->set_pm_sha256(record.pm_sha256);
     *done->mutable_transport() = transport;
-    end_job(record, event);
+    // Counted before the end is published: whoever sees the job ended scrapes it counted.
     metrics_.jobs_ended.Add({{"state", "done"}}).Increment();
     metrics_.job_build_seconds.Observe(record.seconds);
+    end_job(record, event);
     spdlog::info("job {} done: {} -> {} faces, {} vsplits in {:.3f} s", job_id, record.input_faces,
                  record.base_faces, record.vsplits, record.seconds);
   } catch (const Error& e) {
@@ -523,8 +524,8 @@ void Coordinator::run_job(const std::string& job_id) {
       }
       record.seconds = seconds_since(start);
       record.updated_unix_ms = unix_ms_now();
-      end_job(record, event);
       metrics_.jobs_ended.Add({{"state", to_string(record.status)}}).Increment();
+      end_job(record, event);
     }
   } catch (const std::exception& e) {
     record.status = JobStatus::kFailed;
@@ -532,8 +533,8 @@ void Coordinator::run_job(const std::string& job_id) {
     record.updated_unix_ms = unix_ms_now();
     parapm::v1::JobEvent event;
     event.mutable_failed()->set_reason(record.failure_reason);
-    end_job(record, event);
     metrics_.jobs_ended.Add({{"state", "failed"}}).Increment();
+    end_job(record, event);
     spdlog::error("job {} failed: {}", job_id, record.failure_reason);
   }
   {
