@@ -45,8 +45,8 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
       out.point_values.insert(out.point_values.end(), scalar_.point_values(id),
                               scalar_.point_values(id) + floats);
   };
-  // Sized once: grown by doubling, a state of a million points left twice its size behind in
-  // freed blocks.
+  // Sized once: grown by doubling, a state of a million points would leave up to twice its
+  // size behind in freed blocks.
   size_t points = 0;
   for (const FaceId f : faces) points += face_points_[f].size();
   for (const VertexId v : vertices) points += parked_point_[v] != kNoPoint ? 1 : 0;

@@ -123,8 +123,8 @@ class SharpCurves {
 
   std::vector<Sample> samples_;
   size_t vertex_capacity_ = 0;
-  // Per vertex, or empty where the module has no sharp edge and no sample (most scans: 48 B per
-  // vertex saved); a collapse never makes the first one.
+  // Per vertex, or empty where the module has no sharp edge and no sample (a closed mesh
+  // without seams: 48 B per vertex saved); a collapse never makes the first one.
   std::vector<std::vector<VertexId>> neighbors_;
   std::vector<std::vector<uint32_t>> listed_at_;  // per vertex: samples on its sharp edges
   static inline const std::vector<VertexId> no_neighbors_{};
