@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "util/error.h"
+#include "util/zeroed_array.h"
 
 namespace parapm {
 namespace {
@@ -15,13 +16,17 @@ uint32_t local_of(const std::vector<uint32_t>& ids, uint32_t global) {
 // Per thread (jobs are built concurrently, one per pool task), a stamp and a slot per element
 // of the whole mesh: the extraction collects each face and vertex once, and finds a corner's
 // local id, without sorting every corner or searching for it (either would be a large part of
-// the quadric's parallel build).
+// the quadric's parallel build). Zeroed pages: a thread holds memory for the ids of the
+// regions it extracted, not for the whole mesh (16 threads held 167 MB on the 871k dragon).
 class Marks {
  public:
   void begin(size_t size) {
-    if (stamp_.size() < size) stamp_.resize(size, 0), slot_.resize(size, 0);
+    if (stamp_.size() < size) {  // (fresh stamps: all below the generation)
+      stamp_.assign_zeroed(size);
+      slot_.assign_zeroed(size);
+    }
     if (++generation_ == 0) {  // wrapped: forget every stamp
-      std::fill(stamp_.begin(), stamp_.end(), 0);
+      stamp_.assign_zeroed(stamp_.size());
       generation_ = 1;
     }
   }
@@ -34,7 +39,7 @@ class Marks {
   uint32_t& slot(uint32_t id) { return slot_[id]; }
 
  private:
-  std::vector<uint32_t> stamp_, slot_;
+  ZeroedArray<uint32_t> stamp_, slot_;
   uint32_t generation_ = 0;
 };
 

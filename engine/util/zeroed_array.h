@@ -1,10 +1,16 @@
-// A fixed-size array whose elements start as all-zero bytes, taken from calloc: for a large
-// array the system maps zero pages and gives memory only to the pages first written, so a
-// per-face cache of which a run touches a part (a parallel build's master, costing only along
-// the cuts and in the final pass) holds only that part.
+// A fixed-size array whose elements start as all-zero bytes, in pages the system gives memory
+// to only when first written: a per-face cache of which a run touches a part (a parallel
+// build's master, costing only along the cuts and in the final pass), or a per-thread table
+// indexed by the whole mesh's ids of which a subset job's extraction writes its region's,
+// holds only that part. A large array is mapped on its own (calloc would take it from the
+// allocator's free memory, which it must clear, page by page, whenever a block of that size
+// was freed before); a small one comes from calloc.
 #pragma once
 
+#include <sys/mman.h>
+
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <type_traits>
@@ -13,7 +19,7 @@
 namespace parapm {
 
 // T: trivially copyable, its all-zero bytes its empty value (an implicit-lifetime type, which
-// calloc's storage holds without construction).
+// zeroed storage holds without construction).
 template <typename T>
 class ZeroedArray {
   static_assert(std::is_trivially_copyable_v<T>);
@@ -32,18 +38,30 @@ class ZeroedArray {
     }
     return *this;
   }
-  ~ZeroedArray() { std::free(data_); }
+  ~ZeroedArray() { clear(); }
 
   // n zeroed elements in place of the old ones; throws std::bad_alloc.
   void assign_zeroed(size_t n) {
     clear();
     if (n == 0) return;
-    data_ = static_cast<T*>(std::calloc(n, sizeof(T)));
-    if (!data_) throw std::bad_alloc();
+    if (n > SIZE_MAX / sizeof(T)) throw std::bad_alloc();
+    if (n * sizeof(T) >= kMappedBytes) {
+      void* mapped =
+          mmap(nullptr, n * sizeof(T), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (mapped == MAP_FAILED) throw std::bad_alloc();
+      data_ = static_cast<T*>(mapped);
+    } else {
+      data_ = static_cast<T*>(std::calloc(n, sizeof(T)));
+      if (!data_) throw std::bad_alloc();
+    }
     size_ = n;
   }
   void clear() {
-    std::free(data_);
+    if (data_ && size_ * sizeof(T) >= kMappedBytes) {
+      munmap(data_, size_ * sizeof(T));
+    } else {
+      std::free(data_);
+    }
     data_ = nullptr;
     size_ = 0;
   }
@@ -53,6 +71,8 @@ class ZeroedArray {
   const T& operator[](size_t i) const { return data_[i]; }
 
  private:
+  static constexpr size_t kMappedBytes = size_t(1) << 20;  // from 1 MiB, mapped
+
   T* data_ = nullptr;
   size_t size_ = 0;
 };
