@@ -42,8 +42,12 @@ TEST(ZeroedArray, SmallAndLargeStartZeroedKeepWhatIsWrittenAndStartAgainZeroed) 
     EXPECT_EQ(b[n - 1], 0u);
     a = std::move(b);
     EXPECT_EQ(a.size(), n);
-    a.clear();
-    EXPECT_TRUE(a.empty());
+    ZeroedArray<uint64_t> c;
+    c.assign_zeroed(n);
+    c = std::move(a);  // c's own storage released as it takes a's
+    EXPECT_EQ(c.size(), n);
+    c.clear();
+    EXPECT_TRUE(c.empty());
   }
 }
 
