@@ -8,6 +8,7 @@
 
 #include "partition/partition_internal.h"
 #include "util/error.h"
+#include "util/zeroed_array.h"
 
 namespace parapm {
 namespace partition_detail {
@@ -57,6 +58,11 @@ VertexGraph build_vertex_graph(const Mesh& mesh, ChunkedLoops& loops, bool with_
   loops.run_indexed(n, [&](size_t range, size_t first, size_t last) {
     const RangeItems mine(corners_of_range, range, corners);
     Lists& out = lists[range];
+    // listed[u] == v + 1: u is already among v's neighbours (a stamp per vertex of the mesh,
+    // zeroed pages: a range touches its neighbours' only). A hub of a million faces costs its
+    // corners, not their square.
+    ZeroedArray<uint32_t> listed;
+    listed.assign_zeroed(n);
     std::vector<size_t> start(last - first + 1, 0);
     for (size_t j = 0; j < mine.size(); ++j) start[vertex_of(mine[j]) - first + 1] += 2;
     for (size_t v = 0; v < last - first; ++v) start[v + 1] += start[v];
@@ -75,10 +81,9 @@ VertexGraph build_vertex_graph(const Mesh& mesh, ChunkedLoops& loops, bool with_
       out.offsets[v] = out.neighbours.size();
       for (size_t i = start[v]; i < start[v + 1]; ++i) {
         const uint32_t u = around[i];
-        if (u == first + v) continue;  // a repeated corner
-        if (std::find(out.neighbours.begin() + ptrdiff_t(out.offsets[v]), out.neighbours.end(),
-                      u) != out.neighbours.end())
-          continue;  // already listed
+        const uint32_t stamp = uint32_t(first + v + 1);
+        if (u == first + v || listed[u] == stamp) continue;  // a repeated corner, or listed
+        listed[u] = stamp;
         out.neighbours.push_back(u);
       }
     }

@@ -5,21 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <fstream>
-#include <string>
 #include <utility>
+
+#include "util/memory.h"
 
 namespace parapm {
 namespace {
-
-// The process's resident set in KiB (Linux).
-long resident_kib() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  return -1;
-}
 
 TEST(ZeroedArray, SmallAndLargeStartZeroedKeepWhatIsWrittenAndStartAgainZeroed) {
   for (const size_t n : {size_t(2), size_t(1000), size_t(3) << 20}) {
@@ -55,13 +46,13 @@ TEST(ZeroedArray, SmallAndLargeStartZeroedKeepWhatIsWrittenAndStartAgainZeroed) 
 // one element in every 16 MiB is written holds far less than 256 MiB.
 TEST(ZeroedArray, ALargeArrayTakesMemoryOnlyForThePagesWritten) {
   constexpr size_t kElements = size_t(32) << 20;  // 256 MiB of uint64_t
-  const long start = resident_kib();
-  ASSERT_GT(start, 0);
+  const uint64_t start = current_memory_bytes();
+  ASSERT_GT(start, 0u);
   ZeroedArray<uint64_t> table;
   table.assign_zeroed(kElements);
   for (size_t i = 0; i < kElements; i += size_t(2) << 20) table[i] = 1;
-  const long grown = resident_kib() - start;
-  EXPECT_LT(grown, 16 * 1024) << "KiB resident for 16 elements written";
+  const uint64_t now = current_memory_bytes();
+  EXPECT_LT(now, start + (uint64_t(16) << 20)) << "bytes resident for 16 elements written";
   EXPECT_EQ(table[kElements - 1], 0u);
 }
 

@@ -10,6 +10,7 @@
 #include "drawn_meshes.h"
 #include "mesh/mesh.h"
 #include "partition/partition.h"
+#include "partition/partition_internal.h"
 #include "partition/partition_metrics.h"
 #include "partition_expectations.h"
 #include "util/error.h"
@@ -282,6 +283,26 @@ TEST(PartitionMesh, WeightedGrid) {
     const PartitionOptions opts = options(algorithm, 1, {1, 2, 3, 4});
     const Partition partition = partition_mesh(mesh, 4, opts);
     expect_valid(mesh, partition, 4, opts.weights);  // 10, 20, 30, 40 vertices
+  }
+}
+
+// A hub of thousands of faces (a disk's centre) lists each rim vertex once, in the order of
+// their first corners, in one pass and in chunks alike; each rim vertex has the hub and its
+// two rim neighbours.
+TEST(VertexGraph, AHubListsEachNeighbourOnceInTheOrderOfTheirFirstCorners) {
+  constexpr uint32_t kRim = 5000;
+  Mesh disk;
+  disk.positions.resize(kRim + 1);
+  for (uint32_t i = 0; i < kRim; ++i) disk.faces.push_back({0, 1 + i, 1 + (i + 1) % kRim});
+  ChunkedLoops one_pass;
+  ChunkedLoops chunked(4, 2, 16);
+  for (ChunkedLoops* loops : {&one_pass, &chunked}) {
+    const partition_detail::VertexGraph graph =
+        partition_detail::build_vertex_graph(disk, *loops, true);
+    ASSERT_EQ(graph.degree(0), kRim);
+    for (uint32_t i = 0; i < kRim; ++i) EXPECT_EQ(graph.neighbours_of(0)[i], 1 + i);
+    for (uint32_t v = 1; v <= kRim; ++v) EXPECT_EQ(graph.degree(v), 3u) << v;
+    EXPECT_EQ(graph.faces_of(0).size(), size_t(kRim));
   }
 }
 
