@@ -66,8 +66,9 @@ struct ParallelOptions {
   // their fraction of cheap edges in the same sample (parallel_build.cpp, set_targets); off:
   // in proportion to their removable faces only.
   bool cost_shares = true;
-  // Round 1's partition drawn beside round 0's jobs, on the mesh as round 0 found it
-  // (RoundStats::partition_foreseen); off: after round 0's merge, on the mesh it left.
+  // Round 1's partition drawn beside round 0 (from the set-up on, on round 0's partition
+  // graph: the mesh as round 0 found it; RoundStats::partition_foreseen); off: after round 0's
+  // merge, on the mesh it left.
   bool early_partition = true;
   // After each round but the first, a sequential pass over the edges with a lagging end,
   // up to the 95th percentile of the round's costs (parallel_build.cpp).
@@ -109,12 +110,12 @@ struct RoundStats {
   double append_seconds = 0;
   // Drawn ahead, when the round has as many subsets as foreseen: beside the previous round's
   // band pass, on a copy of the mesh before it (partition_seconds then counts the copy), or,
-  // for round 1 (round 0 has no band pass), beside round 0's jobs, on the mesh as round 0
-  // found it.
+  // for round 1 (round 0 has no band pass), beside round 0 from the set-up on, on round 0's
+  // partition graph (the mesh as round 0 found it).
   bool partition_foreseen = false;
-  // Round 0's partition is drawn beside the master's initialisation, round 1's beside round 0's
-  // jobs, a later round's beside the append or beside the last band pass: what of it the
-  // critical path leaves out.
+  // Round 0's partition is drawn beside the master's initialisation, round 1's beside the rest
+  // of the set-up and round 0, a later round's beside the append or beside the last band pass:
+  // what of it the critical path leaves out.
   double partition_overlap_seconds = 0;
   double extract_seconds = 0;  // jobs and their state, shares included (wall)
   // The edge sample (water level, shares), costed in the extraction's tasks: their CPU summed.

@@ -67,15 +67,19 @@ LiveCopy live_copy(const CollapseMesh& mesh, const CopyGroups& groups) {
   return out;
 }
 
-// Partitions a live copy into p subsets; returns, per vertex of the mesh it was copied from,
-// its subset (0 for vertices dead at the copy).
-std::vector<uint32_t> partition_copy(const LiveCopy& live, uint32_t p,
-                                     const PartitionOptions& options) {
-  const Partition partition = partition_mesh(live.mesh, p, options);
+// Per vertex of the mesh a live copy was made from, its subset in a partition of the copy (0
+// for vertices dead at the copy).
+std::vector<uint32_t> subsets_of_copied(const LiveCopy& live, const Partition& partition) {
   std::vector<uint32_t> vertex_subset(live.compact.size(), 0);
   for (VertexId v = 0; v < live.compact.size(); ++v)
     if (live.compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[live.compact[v]];
   return vertex_subset;
+}
+
+// Partitions a live copy into p subsets (subsets_of_copied).
+std::vector<uint32_t> partition_copy(const LiveCopy& live, uint32_t p,
+                                     const PartitionOptions& options) {
+  return subsets_of_copied(live, partition_mesh(live.mesh, p, options));
 }
 
 std::vector<uint32_t> partition_live(const CollapseMesh& mesh, const CopyGroups& groups, uint32_t p,
@@ -294,6 +298,18 @@ uint64_t border_bounded_goal(uint64_t faces, uint64_t border, double excess) {
 
 }  // namespace
 
+// A live copy of the mesh and its partition graph, for several partitions of the same mesh.
+struct ParallelBuilder::LiveGraph {
+  LiveGraph(const CollapseMesh& mesh, const CopyGroups& groups, ChunkedLoops* loops)
+      : live(live_copy(mesh, groups)), graph(live.mesh, Balance::kFaces, loops) {}
+  // Per vertex of the mesh, its subset (subsets_of_copied).
+  std::vector<uint32_t> draw(uint32_t p, const PartitionOptions& options) const {
+    return subsets_of_copied(live, graph.draw(p, options));
+  }
+  LiveCopy live;
+  PartitionGraph graph;
+};
+
 ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOptions& options,
                                  const ParallelOptions& requested, ParallelStats* stats,
                                  const ProgressCallback& progress, const CancelToken* cancel,
@@ -350,15 +366,17 @@ void ParallelBuilder::set_up() {
   first_round_ = first_subsets >= std::min(2u, parallel_.subsets) &&
                  whole.live_vertices() >= 4 * size_t(first_subsets) &&
                  whole.live_faces() > handover_;
+  const double before_seconds = before_clock.critical_seconds();
   auto partition_first_round = [&] {
     const LoopClock clock(partition_loops_);
+    auto source = std::make_shared<const LiveGraph>(whole, copy_groups_, &partition_loops_);
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, 0);
     partition_options.loops = &partition_loops_;
-    first_partition_ = partition_live(whole, copy_groups_, first_subsets, partition_options);
+    first_partition_ = source->draw(first_subsets, partition_options);
     first_partition_seconds_ = clock.critical_seconds();
+    if (parallel_.early_partition) draw_round_one(std::move(source), first_subsets, before_seconds);
   };
-  const double before_seconds = before_clock.critical_seconds();
   run_beside(
       parallel_.threads,
       [&] {
@@ -494,8 +512,9 @@ bool ParallelBuilder::round() {
 void ParallelBuilder::partition(Round& r) {
   RoundStats& rs = r.rs;
   const uint32_t round = rs.round;
+  if (round == 1 && round_one_.valid()) take_round_one();
   auto t = std::chrono::steady_clock::now();
-  // Round 1's partition drawn beside round 0's jobs, unless it keeps round 0's borders.
+  // Round 1's partition drawn beside round 0, unless it keeps round 0's borders.
   const bool early_drawn =
       foreseen_.drawn && !foreseen_.beside_band && foreseen_.subsets == r.subsets;
   const bool early_taken = early_drawn && !repeats_borders(*whole_, foreseen_.vertex_subset,
@@ -507,13 +526,12 @@ void ParallelBuilder::partition(Round& r) {
     rs.partition_seconds = first_partition_seconds_;
     rs.partition_overlap_seconds = std::min(first_partition_seconds_, initialize_seconds_);
   } else if (early_taken) {
-    // Drawn beside round 0's jobs: the critical path counts what of it outlasted the slowest
-    // of them, its check, and the previous round's records, appended now.
+    // Drawn beside round 0: the critical path counts what of it outlasted round 0, its check,
+    // and the previous round's records, appended now.
     r.vertex_subset = std::move(foreseen_.vertex_subset);
     rs.partition_foreseen = true;
     rs.partition_seconds = foreseen_.partition_seconds + early_check_seconds;
-    rs.partition_overlap_seconds =
-        std::min(foreseen_.partition_seconds, st_.round_stats.back().slowest_subset_cpu_seconds);
+    rs.partition_overlap_seconds = std::min(foreseen_.partition_seconds, foreseen_.beside_seconds);
     const auto ta = std::chrono::steady_clock::now();
     append_pending();
     rs.append_seconds = seconds_since(ta);
@@ -670,33 +688,64 @@ void ParallelBuilder::extract_jobs(Round& r) {
   rs.extract_critical_seconds = sequential_extract + rs.slowest_extract_cpu_seconds;
 }
 
-// The jobs, on the runner. Round 1's partition is drawn beside round 0's jobs on the mesh as
-// round 0 found it (the master only waits for them, and the whole mesh changes only at their
-// merge): round 0 has no band pass to draw it beside, and drawn after the merge it would be
-// all on the critical path. The price: its subsets, balanced for round 0's faces, hold round
-// 1's a little unevenly (round 0's jobs stop at its water level).
+// Round 1's partition, on round 0's graph (the mesh as round 0 finds it: the whole mesh changes
+// only at round 0's merge): on a thread of its own, beside round 0's extraction, jobs and
+// merge, as drawn after the merge it would be all on the critical path. The price: its
+// subsets, balanced for round 0's faces, hold round 1's a little unevenly (round 0's jobs stop
+// at its water level). `start`: the critical path's seconds before round 0's partition.
+void ParallelBuilder::draw_round_one(std::shared_ptr<const LiveGraph> source, uint32_t subsets,
+                                     double start) {
+  round_one_subsets_ = subsets;
+  round_one_start_ = start + first_partition_seconds_;
+  auto draw = [source = std::move(source), subsets, seed = round_seed(options_.seed, 1)]() mutable {
+    const auto t = std::chrono::steady_clock::now();
+    const double cpu = thread_cpu_seconds();
+    PartitionOptions options;
+    options.seed = seed;
+    DrawnAhead drawn;
+    drawn.vertex_subset = source->draw(subsets, options);
+    source.reset();  // the graph's memory, back before round 0's jobs end
+    drawn.seconds = seconds_since(t);
+    drawn.cpu_seconds = thread_cpu_seconds() - cpu;
+    return drawn;
+  };
+  round_one_elsewhere_ = pool_threads(parallel_.threads, 2) >= 2;
+  if (round_one_elsewhere_) {
+    round_one_ = std::async(std::launch::async, std::move(draw));
+  } else {
+    std::promise<DrawnAhead> now;
+    round_one_ = now.get_future();
+    try {
+      now.set_value(draw());
+    } catch (...) {
+      now.set_exception(std::current_exception());
+    }
+  }
+}
+
+// Round 1's partition as foreseen_, beside what of the critical path ran from its start to
+// round 1: the rest of the set-up and round 0.
+void ParallelBuilder::take_round_one() {
+  DrawnAhead drawn = round_one_.get();
+  if (round_one_elsewhere_) subsets_cpu_ += drawn.cpu_seconds;
+  foreseen_ = Foreseen{};
+  foreseen_.drawn = true;
+  foreseen_.subsets = round_one_subsets_;
+  foreseen_.vertex_subset = std::move(drawn.vertex_subset);
+  foreseen_.partition_seconds = drawn.seconds;
+  const double round_one = st_.setup_seconds + round_critical_seconds(st_.round_stats.front());
+  foreseen_.beside_seconds = std::max(0.0, round_one - round_one_start_);
+}
+
+// The jobs, on the runner.
 void ParallelBuilder::run_subsets(Round& r) {
   RoundStats& rs = r.rs;
-  auto draw_round_one = [&] {
-    PartitionOptions next_options;
-    next_options.seed = round_seed(options_.seed, 1);
-    foreseen_.vertex_subset = partition_live(*whole_, copy_groups_, r.subsets, next_options);
-  };
-  const bool draw_early = rs.round == 0 && parallel_.early_partition;
-  std::vector<std::function<void()>> beside_jobs;
-  if (draw_early) beside_jobs.push_back(draw_round_one);
   // The master costs nothing while the jobs run: its caches make way for theirs.
   master_->release_caches();
-  const Beside timed_jobs = run_beside(
-      parallel_.threads, [&] { r.results = runner_->run(r.jobs, cancel_); }, beside_jobs);
+  const auto t = std::chrono::steady_clock::now();
+  r.results = runner_->run(r.jobs, cancel_);
   r.jobs.clear();
-  rs.subsets_seconds = timed_jobs.work_seconds;
-  if (draw_early) {
-    foreseen_.drawn = true;
-    foreseen_.subsets = r.subsets;
-    foreseen_.partition_seconds = timed_jobs.side_seconds[0];
-    subsets_cpu_ += timed_jobs.side_cpu_elsewhere;
-  }
+  rs.subsets_seconds = seconds_since(t);
   if (cancel_) cancel_->check();
   if (r.results.size() != r.subsets)
     throw Error(ErrorCode::kInternal, "the subset runner returned " +

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <chrono>
+#include <future>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -72,6 +73,9 @@ class ParallelBuilder {
     double ceiling = 0;  // its water level: 95% of its collapses cost less
     ReplayReport replay;
   };
+  struct LiveGraph;
+  void draw_round_one(std::shared_ptr<const LiveGraph> source, uint32_t subsets, double start);
+  void take_round_one();
   void partition(Round& r);
   void bound_goal_by_border(Round& r);
   void extract_jobs(Round& r);
@@ -99,8 +103,8 @@ class ParallelBuilder {
   const CancelToken* cancel_;
   ThreadPoolRunner pool_;
   // The partitions drawn while no job runs (round 0's beside the set-up, a round's beside the
-  // band pass before it, or alone) build their graph in p chunks on the pool's threads; the
-  // one drawn beside round 0's jobs runs on one thread, as the jobs hold the cores.
+  // band pass before it, or alone) build their graph in p chunks on the pool's threads; round
+  // 1's, drawn on round 0's graph beside round 0, runs on one thread of its own.
   ChunkedLoops partition_loops_;
   SubsetRunner* runner_;
   const ParallelEvents& events_;
@@ -165,7 +169,7 @@ class ParallelBuilder {
   // Scheduled rounds still to come: geometric steps to the handover; a round shortened by its
   // border band does not count, unless its jobs did not do half of it.
   uint32_t scheduled_left_ = 0;
-  // The next round's partition, drawn ahead: beside round 0's jobs (round 1's), or beside the
+  // The next round's partition, drawn ahead: beside round 0 (round 1's), or beside the
   // band pass on a copy of the mesh before it (the band pass moves a few hundred vertices
   // along old borders). Used if the round has as many subsets as foreseen.
   struct Foreseen {
@@ -174,7 +178,19 @@ class ParallelBuilder {
     uint32_t subsets = 0;
     std::vector<uint32_t> vertex_subset;
     double copy_seconds = 0, partition_seconds = 0, append_seconds = 0, band_seconds = 0;
+    double beside_seconds = 0;  // round 1's: the critical path's seconds it ran beside
   } foreseen_;
+  // Round 1's partition, drawn from the set-up on (draw_round_one), and where it started on the
+  // critical path's clock: after the set-up's loops before round 0's partition and that
+  // partition.
+  struct DrawnAhead {
+    std::vector<uint32_t> vertex_subset;
+    double seconds = 0, cpu_seconds = 0;
+  };
+  std::future<DrawnAhead> round_one_;
+  bool round_one_elsewhere_ = false;  // on a thread of its own
+  uint32_t round_one_subsets_ = 0;
+  double round_one_start_ = 0;
 };
 
 }  // namespace parapm

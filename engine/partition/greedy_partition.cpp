@@ -30,63 +30,98 @@ namespace {
 // counts it; the next subsets make up for it.)
 class SettledFaces {
  public:
-  explicit SettledFaces(const VertexGraph& graph)
-      : graph_(graph),
-        corners_(graph.face_count, 0),
-        first_(graph.face_count, kNoId),
-        pending_(graph.face_count, 0) {}
+  explicit SettledFaces(const VertexGraph& graph) : graph_(graph), faces_(graph.face_count) {}
 
   // Corner units settled when v joins subset k.
   uint64_t join(uint32_t v, uint32_t k) {
     uint64_t settled = 0;
-    for (uint32_t f : graph_.faces_of(v)) settled += step(corners_[f], first_[f], k) ? 3 : 0;
+    for (uint32_t f : graph_.faces_of(v)) settled += step(faces_[f], k) ? 3 : 0;
     return settled;
   }
 
   // What join() of every vertex of `front` would return in total, without joining them.
   uint64_t gain(const std::vector<uint32_t>& front, uint32_t k) {
     for (uint32_t v : front)
-      for (uint32_t f : graph_.faces_of(v)) ++pending_[f];
+      for (uint32_t f : graph_.faces_of(v)) ++faces_[f].pending;
     uint64_t settled = 0;
     for (uint32_t v : front)
       for (uint32_t f : graph_.faces_of(v)) {
-        if (pending_[f] == 0) continue;  // done from another of its corners
-        uint8_t corners = corners_[f];
-        uint32_t first = first_[f];
+        Face& face = faces_[f];
+        if (face.pending == 0) continue;  // done from another of its corners
+        Face trial = face;
         bool any = false;
-        for (uint32_t i = 0; i < pending_[f]; ++i) any = step(corners, first, k) || any;
+        for (uint32_t i = 0; i < face.pending; ++i) any = step(trial, k) || any;
         settled += any ? 3 : 0;
-        pending_[f] = 0;
+        face.pending = 0;
       }
     return settled;
   }
 
  private:
-  // One more corner of a face in k; true when that settles its owner. corners counts the
-  // corners in subsets so far, 4 once settled.
-  static bool step(uint8_t& corners, uint32_t& first, uint32_t k) {
-    switch (corners) {
+  // Per face, together: one cache line for all three.
+  struct Face {
+    uint32_t first = kNoId;  // the subset of its first corner in a subset
+    uint8_t corners = 0;     // its corners in subsets so far, 4 once settled
+    uint8_t pending = 0;     // its corners in the front gain() looks at
+  };
+
+  // One more corner of a face in k; true when that settles its owner.
+  static bool step(Face& face, uint32_t k) {
+    switch (face.corners) {
       case 0:
-        first = k;
-        corners = 1;
+        face.first = k;
+        face.corners = 1;
         return false;
       case 1:
-        if (first == k) break;  // a pair in k
-        corners = 2;            // two subsets: the third corner decides
+        if (face.first == k) break;  // a pair in k
+        face.corners = 2;            // two subsets: the third corner decides
         return false;
       case 2:
         break;
       default:
         return false;  // settled already
     }
-    corners = 4;
+    face.corners = 4;
     return true;
   }
 
   const VertexGraph& graph_;
-  std::vector<uint8_t> corners_;
-  std::vector<uint32_t> first_;
-  std::vector<uint8_t> pending_;  // per face, its corners in the front gain() looks at
+  std::vector<Face> faces_;
+};
+
+// Unmarked vertices next to the marked region, by updated degree, for continuation seeds: a
+// list per degree, in the order the vertices reached it. A vertex's updated degree only falls,
+// so it enters each list at most once, and an entry is current while its vertex is unmarked and
+// still of that degree; min() skips the others, for good. The order of a BucketQueue whose key
+// is changed at every fall, without unlinking anything at each one.
+class FallingDegrees {
+ public:
+  explicit FallingDegrees(uint32_t max_degree)
+      : lists_(size_t(max_degree) + 1),
+        heads_(size_t(max_degree) + 1, 0),
+        min_key_(max_degree + 1) {}
+
+  void push(uint32_t v, uint32_t degree) {
+    lists_[degree].push_back(v);
+    min_key_ = std::min(min_key_, degree);
+  }
+
+  // The first current entry of the least degree; kNoId when none is current.
+  // current(v, degree): whether v is unmarked and of that updated degree.
+  template <class Current>
+  uint32_t min(const Current& current) {
+    for (; min_key_ < lists_.size(); ++min_key_) {
+      const std::vector<uint32_t>& list = lists_[min_key_];
+      for (size_t& head = heads_[min_key_]; head < list.size(); ++head)
+        if (current(list[head], min_key_)) return list[head];
+    }
+    return kNoId;
+  }
+
+ private:
+  std::vector<std::vector<uint32_t>> lists_;  // per degree
+  std::vector<size_t> heads_;                 // per degree: the entries before it are stale
+  uint32_t min_key_;                          // no current entry has a lesser degree
 };
 
 }  // namespace
@@ -104,7 +139,10 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
   for (uint32_t v = 0; v < n; ++v) updated_degree[v] = graph.degree(v);
   // Unmarked vertices with a marked neighbour, by updated degree: where a locked-in subset
   // continues. Kept up to date by mark(), so that finding a seed is O(1) amortised.
-  BucketQueue touched(n, max_degree);
+  FallingDegrees touched(max_degree);
+  auto current = [&](uint32_t v, uint32_t degree) {
+    return subset[v] == kNoId && updated_degree[v] == degree;
+  };
   // The front being taken in part when the last front overshoots the target.
   BucketQueue partial_front(n, max_degree);
   const std::vector<uint32_t> by_degree = vertices_by_degree(graph);
@@ -116,16 +154,11 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
   // faces it settles.
   auto mark = [&](uint32_t v, uint32_t k) -> uint64_t {
     subset[v] = k;
-    if (touched.contains(v)) touched.remove(v);
     for (uint32_t u : graph.neighbours_of(v)) {
       if (subset[u] != kNoId) continue;
       const uint32_t d = --updated_degree[u];
-      if (touched.contains(u)) {
-        touched.set_key(u, d);
-      } else {
-        touched.insert(u, d);
-      }
-      if (partial_front.contains(u)) partial_front.set_key(u, d);
+      touched.push(u, d);
+      if (!partial_front.empty() && partial_front.contains(u)) partial_front.set_key(u, d);
     }
     return faces ? faces->join(v, k) : graph.weight[v];
   };
@@ -133,7 +166,7 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
   // to the marked region, or when there is none (the region covers whole components), the
   // unmarked vertex of minimal degree (isolated vertices last). kNoId when all are marked.
   auto continuation_seed = [&]() -> uint32_t {
-    if (!touched.empty()) return touched.min();
+    if (const uint32_t v = touched.min(current); v != kNoId) return v;
     while (by_degree_next < n && subset[by_degree[by_degree_next]] != kNoId) ++by_degree_next;
     return by_degree_next < n ? by_degree[by_degree_next] : kNoId;
   };
@@ -188,12 +221,14 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
         if (s == kNoId) break;  // cannot happen: the targets sum to n; kept for safety
         front.assign(1, s);
       }
+      // By faces, the front settles at most 3 per face of its vertices (its weight times 3):
+      // counted exactly only where that bound would overshoot.
       uint64_t front_weight = 0;
-      if (faces) {
+      for (uint32_t v : front) front_weight += graph.weight[v];
+      if (faces && counted + 3 * front_weight > cumulative_target)
         front_weight = faces->gain(front, k);
-      } else {
-        for (uint32_t v : front) front_weight += graph.weight[v];
-      }
+      else if (faces)
+        front_weight *= 3;
       if (counted + front_weight <= cumulative_target) {
         for (uint32_t v : front) {
           counted += mark(v, k);

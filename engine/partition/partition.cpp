@@ -288,8 +288,10 @@ std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
   return std::vector<uint32_t>(shares.begin(), shares.end());
 }
 
-Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& options) {
-  using namespace partition_detail;
+namespace {
+
+// partition_mesh's checks of its arguments, before any work.
+void check_partition_arguments(const Mesh& mesh, uint32_t p, const PartitionOptions& options) {
   if (mesh.vertex_count() >= kNoId) throw_invalid("partition: too many vertices");
   const uint32_t n = uint32_t(mesh.vertex_count());
   partition_targets(n, p, options.weights);  // validates p and the weights
@@ -301,23 +303,48 @@ Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& o
     throw_invalid("partition: unknown algorithm '" + options.algorithm +
                   "' (expected greedy or bfs)");
   }
+}
+
+}  // namespace
+
+PartitionGraph::PartitionGraph(const Mesh& mesh, Balance balance, ChunkedLoops* loops)
+    : mesh_(mesh), balance_(balance) {
+  using namespace partition_detail;
+  if (mesh.vertex_count() >= kNoId) throw_invalid("partition: too many vertices");
+  const uint32_t n = uint32_t(mesh.vertex_count());
   ChunkedLoops one_thread;
-  ChunkedLoops& loops = options.loops ? *options.loops : one_thread;
-  const bool by_faces = options.balance == Balance::kFaces;
-  VertexGraph graph = build_vertex_graph(mesh, loops, by_faces);
-  graph.weight.assign(n, by_faces ? 0 : 1);
+  const bool by_faces = balance == Balance::kFaces;
+  auto graph = std::make_unique<VertexGraph>(
+      build_vertex_graph(mesh, loops ? *loops : one_thread, by_faces));
+  graph->weight.assign(n, by_faces ? 0 : 1);
   if (by_faces)  // a vertex counts its faces
     for (VertexId v = 0; v < n; ++v)
-      graph.weight[v] = uint32_t(graph.face_offsets[v + 1] - graph.face_offsets[v]);
+      graph->weight[v] = uint32_t(graph->face_offsets[v + 1] - graph->face_offsets[v]);
+  graph_ = std::move(graph);
+}
+
+PartitionGraph::~PartitionGraph() = default;
+
+Partition PartitionGraph::draw(uint32_t p, const PartitionOptions& options) const {
+  using namespace partition_detail;
+  check_partition_arguments(mesh_, p, options);
+  if (options.balance != balance_)
+    throw_invalid("partition: the graph was built for the other balance");
   uint64_t total = 0;
-  for (uint32_t w : graph.weight) total += w;
+  for (uint32_t w : graph_->weight) total += w;
   const std::vector<uint64_t> targets = share_targets(total, p, options.weights);
   Partition partition = options.algorithm == "greedy"
-                            ? greedy_partition(graph, targets, options.seed)
-                            : bfs_partition(graph, targets, options.seed);
-  if (options.refine) refine_partition(graph, targets, partition);
-  assign_faces(mesh, partition, loops);
+                            ? greedy_partition(*graph_, targets, options.seed)
+                            : bfs_partition(*graph_, targets, options.seed);
+  if (options.refine) refine_partition(*graph_, targets, partition);
+  ChunkedLoops one_thread;
+  assign_faces(mesh_, partition, options.loops ? *options.loops : one_thread);
   return partition;
+}
+
+Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& options) {
+  check_partition_arguments(mesh, p, options);
+  return PartitionGraph(mesh, options.balance, options.loops).draw(p, options);
 }
 
 }  // namespace parapm

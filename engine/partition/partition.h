@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -71,5 +72,31 @@ std::vector<uint32_t> partition_targets(uint32_t vertices, uint32_t p,
 // 0 vertices is allowed and stays empty); weights neither empty nor p positive finite
 // values; an unknown algorithm; a face corner out of range.
 Partition partition_mesh(const Mesh& mesh, uint32_t p, const PartitionOptions& options = {});
+
+namespace partition_detail {
+struct VertexGraph;
+}
+
+// A mesh's partition graph, built once for several partitions of the same mesh (other seeds
+// or p): draw(p, options) gives what partition_mesh(mesh, p, options) gives, the balance being
+// the one built for. Holds a reference to `mesh`, which must outlive it; draw() may run on
+// several threads at once (each with loops of its own, or none).
+class PartitionGraph {
+ public:
+  // Builds the graph in `loops`' chunks (null: on the calling thread). Error(kInvalidInput)
+  // as partition_mesh: too many vertices, a face corner out of range.
+  PartitionGraph(const Mesh& mesh, Balance balance, ChunkedLoops* loops = nullptr);
+  ~PartitionGraph();
+  PartitionGraph(const PartitionGraph&) = delete;
+  PartitionGraph& operator=(const PartitionGraph&) = delete;
+
+  // Error(kInvalidInput) as partition_mesh, and for options.balance other than the graph's.
+  Partition draw(uint32_t p, const PartitionOptions& options) const;
+
+ private:
+  const Mesh& mesh_;
+  Balance balance_;
+  std::unique_ptr<const partition_detail::VertexGraph> graph_;
+};
 
 }  // namespace parapm

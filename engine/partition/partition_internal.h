@@ -15,7 +15,7 @@ namespace parapm::partition_detail {
 // The mesh's edge graph in compressed rows: the neighbours of v are
 // neighbours[offsets[v] .. offsets[v + 1]), each once, in order of first appearance in the
 // faces. Isolated vertices have none. 8 bytes per vertex + 4 bytes per directed edge; by faces,
-// 8 more per vertex and 12 per face for the face lists, and the greedy's 6 per face.
+// 8 more per vertex and 12 per face for the face lists, and the greedy's 8 per face.
 struct VertexGraph {
   std::vector<size_t> offsets;  // vertex_count + 1
   std::vector<uint32_t> neighbours;

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <numeric>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "io/mesh_io.h"
@@ -19,6 +20,7 @@
 #include "partition/partition_metrics.h"
 #include "partition_expectations.h"
 #include "test_support.h"
+#include "util/error.h"
 
 namespace parapm {
 namespace {
@@ -123,6 +125,39 @@ TEST(PartitionRealMeshes, OtherSeedsAreValidToo) {
       const Partition partition = partition_mesh(mesh, 16, options(algorithm, {}, seed));
       expect_valid(mesh, partition, 16, {}, Balance::kFaces, std::string(algorithm) == "bfs");
     }
+  }
+}
+
+// One graph, several partitions (other seeds, p, algorithms, refined), two of them drawn on two
+// threads at once: each what partition_mesh draws from scratch. A graph built for one balance
+// refuses to draw by the other.
+TEST(PartitionGraph, DrawsWhatPartitionMeshDraws) {
+  const Mesh mesh = read_repaired(testing::test_data("stratocaster-9k.ply"));  // 94 components
+  for (Balance balance : {Balance::kFaces, Balance::kVertices}) {
+    const PartitionGraph graph(mesh, balance);
+    for (const char* algorithm : {"greedy", "bfs"})
+      for (uint32_t p : {2u, 16u})
+        for (uint64_t seed : {1u, 7u})
+          for (bool refine : {false, true}) {
+            PartitionOptions opts = options(algorithm, {}, seed);
+            opts.balance = balance;
+            opts.refine = refine;
+            const Partition drawn = graph.draw(p, opts), fresh = partition_mesh(mesh, p, opts);
+            EXPECT_EQ(drawn.vertex_subset, fresh.vertex_subset)
+                << algorithm << " p=" << p << " seed " << seed << " refine " << refine;
+            EXPECT_EQ(drawn.face_subset, fresh.face_subset);
+          }
+    PartitionOptions a = options("greedy", {}, 3), b = options("greedy", {}, 4);
+    a.balance = b.balance = balance;
+    Partition beside;
+    std::thread other([&] { beside = graph.draw(8, b); });
+    const Partition here = graph.draw(8, a);
+    other.join();
+    EXPECT_EQ(here.vertex_subset, partition_mesh(mesh, 8, a).vertex_subset);
+    EXPECT_EQ(beside.vertex_subset, partition_mesh(mesh, 8, b).vertex_subset);
+    PartitionOptions other_balance = a;
+    other_balance.balance = balance == Balance::kFaces ? Balance::kVertices : Balance::kFaces;
+    EXPECT_THROW(graph.draw(8, other_balance), Error);
   }
 }
 
