@@ -43,6 +43,7 @@
 #include "mesh/repair.h"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -287,50 +288,93 @@ bool has_zero_area(const Vec3& a, const Vec3& b, const Vec3& c) {
 // Step 3: keep the kept faces' vertices (or all of them), renumbered in order, with their
 // wedges. Fills everything of `out` but the manifold split.
 
-void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOptions& options,
-             RepairedMesh* out) {
-  const size_t n = input.vertex_count();
-  std::vector<VertexId> new_vertex(n, kNoId);
-  for (FaceId f : kept) {
-    for (VertexId v : input.faces[f]) new_vertex[v] = 0;  // referenced
-  }
-  Mesh& mesh = out->mesh;
-  for (size_t v = 0; v < n; ++v) {
-    if (new_vertex[v] == kNoId && !options.keep_unreferenced) {
-      ++out->report.unreferenced_vertices_removed;
-      continue;
-    }
-    new_vertex[v] = VertexId(mesh.positions.size());
-    mesh.positions.push_back(input.positions[v]);
-    out->input_vertex.push_back(VertexId(v));
-  }
+// The elements of [0, n) that keep(i) keeps, numbered in order, in `loops`' chunks: per
+// element its new id (kNoId if dropped), and per new id, its element.
+struct Kept {
+  std::vector<uint32_t> new_id;
+  std::vector<uint32_t> old_id;
+};
+template <class Keep>
+Kept number_kept(size_t n, Keep keep, ChunkedLoops& loops) {
+  Kept out;
+  out.new_id.assign(n, kNoId);
+  std::vector<size_t> first(loops.ranges(n) + 1, 0);  // per range, its first new id
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    size_t count = 0;
+    for (size_t i = begin; i < end; ++i) count += keep(i) ? 1 : 0;
+    first[range + 1] = count;
+  });
+  for (size_t r = 0; r + 1 < first.size(); ++r) first[r + 1] += first[r];
+  out.old_id.resize(first.back());
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    uint32_t next = uint32_t(first[range]);
+    for (size_t i = begin; i < end; ++i)
+      if (keep(i)) {
+        out.new_id[i] = next;
+        out.old_id[next++] = uint32_t(i);
+      }
+  });
+  return out;
+}
 
-  mesh.faces.reserve(kept.size());
-  for (FaceId f : kept) {
-    const Triangle& t = input.faces[f];
-    mesh.faces.push_back({new_vertex[t[0]], new_vertex[t[1]], new_vertex[t[2]]});
-  }
+void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOptions& options,
+             RepairedMesh* out, ChunkedLoops& loops) {
+  const size_t n = input.vertex_count();
+  // Marked from the kept faces' corners, chunks side by side (relaxed stores of the same 1).
+  std::vector<uint8_t> referenced(n, options.keep_unreferenced ? 1 : 0);
+  if (!options.keep_unreferenced)
+    loops.run(kept.size(), [&](size_t begin, size_t end) {
+      for (size_t j = begin; j < end; ++j)
+        for (VertexId v : input.faces[kept[j]])
+          std::atomic_ref<uint8_t>(referenced[v]).store(1, std::memory_order_relaxed);
+    });
+  Kept vertices = number_kept(n, [&](size_t v) { return referenced[v] != 0; }, loops);
+  out->report.unreferenced_vertices_removed = n - vertices.old_id.size();
+  Mesh& mesh = out->mesh;
+  mesh.positions.resize(vertices.old_id.size());
+  loops.run(vertices.old_id.size(), [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) mesh.positions[v] = input.positions[vertices.old_id[v]];
+  });
+  const std::vector<VertexId>& new_vertex = vertices.new_id;
+  mesh.faces.resize(kept.size());
+  loops.run(kept.size(), [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      const Triangle& t = input.faces[kept[j]];
+      mesh.faces[j] = {new_vertex[t[0]], new_vertex[t[1]], new_vertex[t[2]]};
+    }
+  });
   out->input_face = kept;
 
   mesh.layout = input.layout;
   mesh.positions_are_float = input.positions_are_float;
-  if (!input.layout.any()) return;
+  if (!input.layout.any()) {
+    out->input_vertex = std::move(vertices.old_id);
+    return;
+  }
+  Kept wedges = number_kept(
+      input.wedge_count(), [&](size_t w) { return new_vertex[input.wedge_vertex[w]] != kNoId; },
+      loops);
   const size_t floats = size_t(input.layout.floats_per_wedge());
-  std::vector<WedgeId> new_wedge(input.wedge_count(), kNoId);
-  for (size_t w = 0; w < input.wedge_count(); ++w) {
-    const VertexId v = new_vertex[input.wedge_vertex[w]];
-    if (v == kNoId) continue;  // its vertex was removed
-    new_wedge[w] = WedgeId(mesh.wedge_vertex.size());
-    mesh.wedge_vertex.push_back(v);
-    const float* values = input.wedge(WedgeId(w));
-    mesh.wedge_values.insert(mesh.wedge_values.end(), values, values + floats);
-    out->input_wedge.push_back(WedgeId(w));
-  }
-  mesh.face_wedges.reserve(kept.size());
-  for (FaceId f : kept) {
-    const auto& fw = input.face_wedges[f];
-    mesh.face_wedges.push_back({new_wedge[fw[0]], new_wedge[fw[1]], new_wedge[fw[2]]});
-  }
+  mesh.wedge_vertex.resize(wedges.old_id.size());
+  mesh.wedge_values.resize(wedges.old_id.size() * floats);
+  loops.run(wedges.old_id.size(), [&](size_t begin, size_t end) {
+    for (size_t w = begin; w < end; ++w) {
+      const WedgeId old = wedges.old_id[w];
+      mesh.wedge_vertex[w] = new_vertex[input.wedge_vertex[old]];
+      const float* values = input.wedge(old);
+      std::copy_n(values, floats, mesh.wedge_values.begin() + ptrdiff_t(w * floats));
+    }
+  });
+  const std::vector<WedgeId>& new_wedge = wedges.new_id;
+  mesh.face_wedges.resize(kept.size());
+  loops.run(kept.size(), [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      const auto& fw = input.face_wedges[kept[j]];
+      mesh.face_wedges[j] = {new_wedge[fw[0]], new_wedge[fw[1]], new_wedge[fw[2]]};
+    }
+  });
+  out->input_vertex = std::move(vertices.old_id);
+  out->input_wedge = std::move(wedges.old_id);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -695,15 +739,18 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   out.input_face_count = input.face_count();
   out.report.degenerate_faces_removed = filter.degenerate;
   out.report.duplicate_faces_removed = filter.duplicate;
-  for (FaceId f : filter.kept) {
-    const Triangle& t = input.faces[f];
-    if (has_zero_area(input.positions[t[0]], input.positions[t[1]], input.positions[t[2]])) {
-      ++out.report.zero_area_faces;
+  std::vector<uint64_t> zero_area(loops.ranges(filter.kept.size()), 0);
+  loops.run_indexed(filter.kept.size(), [&](size_t range, size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      const Triangle& t = input.faces[filter.kept[j]];
+      if (has_zero_area(input.positions[t[0]], input.positions[t[1]], input.positions[t[2]]))
+        ++zero_area[range];
     }
-  }
+  });
+  for (uint64_t count : zero_area) out.report.zero_area_faces += count;
 
   // 3. Vertices no face uses go (unless asked to keep them), with their wedges.
-  compact(input, filter.kept, options, &out);
+  compact(input, filter.kept, options, &out, loops);
 
   // 4. Cut along the non-manifold edges (faces laid back to back on a surface are cut off it,
   // the surface kept joined; the two sides of a double-sided surface each kept joined), then
@@ -711,7 +758,7 @@ RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   split_keeping_sides_apart_where_needed(&out, loops);
 
   // 5. Neighbours on the surface become neighbours in memory.
-  if (options.spatial_order) order_spatially(out);
+  if (options.spatial_order) order_spatially(out, loops);
   return out;
 }
 

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -33,12 +34,16 @@ struct RepairedMesh;
 // outside the box, clamps.
 uint64_t morton_code(const Vec3& p, const Box& box);
 
-// new_id[old] for every vertex of `mesh`: ranked by Morton code, ties by id.
+// new_id[old] for every vertex of `mesh`: ranked by Morton code, ties by id. In `loops`'
+// chunks, the same order.
 std::vector<VertexId> spatial_vertex_order(const Mesh& mesh);
+std::vector<VertexId> spatial_vertex_order(const Mesh& mesh, ChunkedLoops& loops);
 
 // Renumbers repaired.mesh's vertices, faces and wedges as above and composes the maps back to
 // the input (input_vertex, input_face, input_wedge), so that the repaired mesh means what it
-// meant. A mesh with one wedge per vertex (wedge i of vertex i) keeps that property.
+// meant. A mesh with one wedge per vertex (wedge i of vertex i) keeps that property. In `loops`'
+// chunks, the same mesh and maps.
 void order_spatially(RepairedMesh& repaired);
+void order_spatially(RepairedMesh& repaired, ChunkedLoops& loops);
 
 }  // namespace parapm

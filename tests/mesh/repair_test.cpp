@@ -617,6 +617,9 @@ TEST(Repair, RandomSoupsBecomeManifolds) {
     chunked.loops = &loops;
     chunked.spatial_order = false;
     testing::expect_same_repair(repair_mesh(mesh, chunked), repaired);
+    RepairOptions ordered_in_chunks;  // the spatial order in chunks too
+    ordered_in_chunks.loops = &loops;
+    testing::expect_same_repair(repair_mesh(mesh, ordered_in_chunks), repair_mesh(mesh));
     const RepairedMesh again = repair_in_input_order(repaired.mesh);
     EXPECT_FALSE(again.report.changed());
     EXPECT_EQ(again.report.nonmanifold_edges, 0u);

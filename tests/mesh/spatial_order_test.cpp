@@ -127,6 +127,14 @@ TEST(SpatialOrder, ShuffledRealMeshComesOutInOrderAndFaithful) {
   RepairedMesh again = ordered;
   order_spatially(again);
   testing::expect_same_repair(again, ordered);
+
+  // In chunks side by side (a sample sort of the codes, counting sorts per range): the same.
+  for (unsigned chunks : {2u, 7u}) {
+    ChunkedLoops loops(chunks, 2, 64);
+    RepairOptions in_chunks;
+    in_chunks.loops = &loops;
+    testing::expect_same_repair(repair_mesh(input, in_chunks), ordered);
+  }
 }
 
 // Per-vertex attributes (a PLY's colours: wedge i of vertex i) stay per vertex.
