@@ -43,8 +43,8 @@
 #include "mesh/repair.h"
 
 #include <algorithm>
-#include <atomic>
 #include <array>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -288,35 +288,6 @@ bool has_zero_area(const Vec3& a, const Vec3& b, const Vec3& c) {
 // Step 3: keep the kept faces' vertices (or all of them), renumbered in order, with their
 // wedges. Fills everything of `out` but the manifold split.
 
-// The elements of [0, n) that keep(i) keeps, numbered in order, in `loops`' chunks: per
-// element its new id (kNoId if dropped), and per new id, its element.
-struct Kept {
-  std::vector<uint32_t> new_id;
-  std::vector<uint32_t> old_id;
-};
-template <class Keep>
-Kept number_kept(size_t n, Keep keep, ChunkedLoops& loops) {
-  Kept out;
-  out.new_id.assign(n, kNoId);
-  std::vector<size_t> first(loops.ranges(n) + 1, 0);  // per range, its first new id
-  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
-    size_t count = 0;
-    for (size_t i = begin; i < end; ++i) count += keep(i) ? 1 : 0;
-    first[range + 1] = count;
-  });
-  for (size_t r = 0; r + 1 < first.size(); ++r) first[r + 1] += first[r];
-  out.old_id.resize(first.back());
-  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
-    uint32_t next = uint32_t(first[range]);
-    for (size_t i = begin; i < end; ++i)
-      if (keep(i)) {
-        out.new_id[i] = next;
-        out.old_id[next++] = uint32_t(i);
-      }
-  });
-  return out;
-}
-
 void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOptions& options,
              RepairedMesh* out, ChunkedLoops& loops) {
   const size_t n = input.vertex_count();
@@ -328,7 +299,7 @@ void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOpt
         for (VertexId v : input.faces[kept[j]])
           std::atomic_ref<uint8_t>(referenced[v]).store(1, std::memory_order_relaxed);
     });
-  Kept vertices = number_kept(n, [&](size_t v) { return referenced[v] != 0; }, loops);
+  KeptItems vertices = number_kept(loops, n, [&](size_t v) { return referenced[v] != 0; });
   out->report.unreferenced_vertices_removed = n - vertices.old_id.size();
   Mesh& mesh = out->mesh;
   mesh.positions.resize(vertices.old_id.size());
@@ -351,9 +322,9 @@ void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOpt
     out->input_vertex = std::move(vertices.old_id);
     return;
   }
-  Kept wedges = number_kept(
-      input.wedge_count(), [&](size_t w) { return new_vertex[input.wedge_vertex[w]] != kNoId; },
-      loops);
+  KeptItems wedges = number_kept(loops, input.wedge_count(), [&](size_t w) {
+    return new_vertex[input.wedge_vertex[w]] != kNoId;
+  });
   const size_t floats = size_t(input.layout.floats_per_wedge());
   mesh.wedge_vertex.resize(wedges.old_id.size());
   mesh.wedge_values.resize(wedges.old_id.size() * floats);

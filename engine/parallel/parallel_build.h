@@ -161,7 +161,7 @@ struct ParallelStats {
   double final_pass_seconds = 0;    // its set-up and its collapses
   double final_work_seconds = 0;    // its collapses
   double final_append_seconds = 0;  // the last round's records appended, beside the final pass
-  double pm_build_seconds = 0;
+  double pm_build_seconds = 0;      // the PM's assembly, its loops at their critical path
   uint64_t collapses = 0;
   std::string stop_reason;  // of the final pass
   double seconds = 0;       // the whole construction, wall

@@ -322,7 +322,7 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
       progress_(progress),
       cancel_(cancel),
       pool_(requested.threads),
-      partition_loops_(requested.subsets, requested.threads),
+      master_loops_(requested.subsets, requested.threads),
       runner_(runner ? runner : &pool_),
       events_(events),
       start_(std::chrono::steady_clock::now()),
@@ -368,11 +368,11 @@ void ParallelBuilder::set_up() {
                  whole.live_faces() > handover_;
   const double before_seconds = before_clock.critical_seconds();
   auto partition_first_round = [&] {
-    const LoopClock clock(partition_loops_);
-    auto source = std::make_shared<const LiveGraph>(whole, copy_groups_, &partition_loops_);
+    const LoopClock clock(master_loops_);
+    auto source = std::make_shared<const LiveGraph>(whole, copy_groups_, &master_loops_);
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, 0);
-    partition_options.loops = &partition_loops_;
+    partition_options.loops = &master_loops_;
     first_partition_ = source->draw(first_subsets, partition_options);
     first_partition_seconds_ = clock.critical_seconds();
     if (parallel_.early_partition) draw_round_one(std::move(source), first_subsets, before_seconds);
@@ -555,11 +555,11 @@ void ParallelBuilder::partition(Round& r) {
     forgo_foreseen();
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, round);
-    partition_options.loops = &partition_loops_;
+    partition_options.loops = &master_loops_;
     double partition_seconds = 0;
     const Beside timed = run_beside(parallel_.threads,
                                     [&] {
-                                      const LoopClock clock(partition_loops_);
+                                      const LoopClock clock(master_loops_);
                                       r.vertex_subset = partition_live(
                                           *whole_, copy_groups_, r.subsets, partition_options);
                                       partition_seconds = clock.critical_seconds();
@@ -880,14 +880,14 @@ void ParallelBuilder::band_pass(Round& r) {
     std::vector<CollapseRecord> band_records;
     PartitionOptions next_options;
     next_options.seed = round_seed(options_.seed, rs.round + 1);
-    next_options.loops = &partition_loops_;
+    next_options.loops = &master_loops_;
     const double prepared = seconds_since(t);
     double partition_seconds = 0;
     const Beside timed =
         run_beside(parallel_.threads, [&] { band_records = pass.run(band_limits, {}, cancel_); },
                    {[this] { append_pending(); },
                     [&] {
-                      const LoopClock clock(partition_loops_);
+                      const LoopClock clock(master_loops_);
                       if (next.go)
                         foreseen_.vertex_subset = partition_copy(copy, next.subsets, next_options);
                       partition_seconds = clock.critical_seconds();
@@ -985,12 +985,13 @@ void ParallelBuilder::final_pass() {
 
 ProgressiveMesh ParallelBuilder::progressive_mesh() {
   release_free_memory();  // before the PM's arrays, the build's largest
-  const auto t = std::chrono::steady_clock::now();
+  const LoopClock clock(master_loops_);
   PmBuildOptions build_options;
   build_options.keep_order = options_.keep_order;
+  build_options.loops = &master_loops_;
   ProgressiveMesh pm = build_pm_from_collapses(repaired_, *whole_, records_, build_options);
   pm.info.metric = master_->name();
-  st_.pm_build_seconds = seconds_since(t);
+  st_.pm_build_seconds = clock.critical_seconds();
   st_.collapses = records_.size();
   st_.critical_path_seconds = critical_path_seconds(st_);
   st_.seconds = seconds_since(start_);

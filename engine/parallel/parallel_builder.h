@@ -102,10 +102,11 @@ class ParallelBuilder {
   const ProgressCallback& progress_;
   const CancelToken* cancel_;
   ThreadPoolRunner pool_;
-  // The partitions drawn while no job runs (round 0's beside the set-up, a round's beside the
-  // band pass before it, or alone) build their graph in p chunks on the pool's threads; round
-  // 1's, drawn on round 0's graph beside round 0, runs on one thread of its own.
-  ChunkedLoops partition_loops_;
+  // The master's passes over the whole mesh while no job runs, in p chunks on the pool's
+  // threads: the graphs of the partitions (round 0's beside the set-up, a round's beside the
+  // band pass before it, or alone; round 1's, drawn on round 0's graph beside round 0, runs on
+  // one thread of its own) and the PM's assembly.
+  ChunkedLoops master_loops_;
   SubsetRunner* runner_;
   const ParallelEvents& events_;
   const std::chrono::steady_clock::time_point start_;

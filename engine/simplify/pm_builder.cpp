@@ -1,6 +1,8 @@
 #include "simplify/pm_builder.h"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 
 #include "util/error.h"
 
@@ -74,7 +76,10 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
                                         const CollapseMesh& final_mesh,
                                         const std::vector<CollapseRecord>& records,
                                         const PmBuildOptions& options) {
+  ChunkedLoops one_thread;
+  ChunkedLoops& loops = options.loops ? *options.loops : one_thread;
   const Mesh& mesh = repaired.mesh;
+  const size_t splits = records.size();
   ProgressiveMesh pm;
   pm.info.input_vertices = repaired.input_vertex_count;
   pm.info.input_faces = repaired.input_face_count;
@@ -82,36 +87,52 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
   pm.base.positions_are_float = mesh.positions_are_float;
 
   // Vertices: the survivors (and isolated vertices) in their original order, then one per
-  // split, the vt of the collapses taken last to first.
-  std::vector<VertexId> pm_vertex(mesh.vertex_count(), kNoId);
+  // split, the vt of the collapses taken last to first. (A vertex collapses away once: the
+  // chunks mark distinct vertices; relaxed stores all the same, should records repeat one.)
   std::vector<uint8_t> removed(mesh.vertex_count(), 0);
-  for (const CollapseRecord& r : records) removed[r.vt] = 1;
-  VertexId next_vertex = 0;
-  for (VertexId v = 0; v < mesh.vertex_count(); ++v) {
-    if (removed[v]) continue;
-    pm_vertex[v] = next_vertex++;
-    pm.base.positions.push_back(final_mesh.position(v));
-  }
-  for (size_t i = records.size(); i-- > 0;) pm_vertex[records[i].vt] = next_vertex++;
+  loops.run(splits, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i)
+      std::atomic_ref<uint8_t>(removed[records[i].vt]).store(1, std::memory_order_relaxed);
+  });
+  KeptItems survivors =
+      number_kept(loops, mesh.vertex_count(), [&](size_t v) { return removed[v] == 0; });
+  std::vector<VertexId> pm_vertex = std::move(survivors.new_id);
+  const size_t base_vertices = survivors.old_id.size();
+  pm.base.positions.resize(base_vertices);
+  loops.run(base_vertices, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v)
+      pm.base.positions[v] = final_mesh.position(survivors.old_id[v]);
+  });
+  // Split j brings back the vt of record splits - 1 - j.
+  auto record_of = [&](size_t j) -> const CollapseRecord& { return records[splits - 1 - j]; };
+  loops.run(splits, [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) pm_vertex[record_of(j).vt] = VertexId(base_vertices + j);
+  });
 
   // Faces: the survivors in their original order, then fl, fr of each split.
-  std::vector<FaceId> pm_face(mesh.face_count(), kNoId);
-  FaceId next_face = 0;
+  KeptItems alive = number_kept(loops, mesh.face_count(),
+                                [&](size_t f) { return final_mesh.face_alive(FaceId(f)); });
+  std::vector<FaceId> pm_face = std::move(alive.new_id);
+  const size_t base_faces = alive.old_id.size();
+  pm.base.faces.resize(base_faces);
+  loops.run(base_faces, [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      const Triangle& t = final_mesh.face(alive.old_id[j]);
+      pm.base.faces[j] = {pm_vertex[t[0]], pm_vertex[t[1]], pm_vertex[t[2]]};
+    }
+  });
   const bool attributes = mesh.layout.any();
   const size_t floats = size_t(mesh.layout.floats_per_wedge());
   std::vector<float> replaced;  // per wedge change, in record order: the values before it
-  const std::vector<float> base_values = replay_wedge_changes(mesh, records, replaced);
-  // Where each record's changes start in `replaced` (walked last to first below).
-  std::vector<size_t> replaced_begin(records.size() + 1, 0);
-  for (size_t i = 0; i < records.size(); ++i)
-    replaced_begin[i + 1] = replaced_begin[i] + records[i].changed_wedges.size() * floats;
+  const std::vector<float> base_values =
+      attributes ? replay_wedge_changes(mesh, records, replaced) : std::vector<float>{};
   WedgeNumbering wedges(base_values, mesh.wedge_count(), int(floats), pm);
-  for (FaceId f = 0; f < mesh.face_count(); ++f) {
-    if (!final_mesh.face_alive(f)) continue;
-    pm_face[f] = next_face++;
-    const Triangle& t = final_mesh.face(f);
-    pm.base.faces.push_back({pm_vertex[t[0]], pm_vertex[t[1]], pm_vertex[t[2]]});
-    if (attributes) {
+  if (attributes) {
+    // Wedges are numbered in order of first use: one pass, in the faces' order.
+    pm.base.face_wedges.reserve(base_faces);
+    for (size_t j = 0; j < base_faces; ++j) {
+      const FaceId f = alive.old_id[j];
+      const Triangle& t = final_mesh.face(f);
       std::array<WedgeId, 3> w;
       for (int k = 0; k < 3; ++k) {
         w[k] = wedges.base(mesh.face_wedges[f][k]);
@@ -121,27 +142,63 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
     }
   }
 
-  for (const CollapseRecord& r : records)
-    if (r.to_complete)
-      throw_internal("build_pm_from_collapses: a record the replay did not complete");
-  pm.splits.reserve(records.size());
-  float error_bound = 0;  // running maximum, so that the bound never decreases with coarsening
-  std::vector<float> bound(records.size());
-  for (size_t i = 0; i < records.size(); ++i) {
-    error_bound = std::max(error_bound, records[i].error);
-    bound[i] = error_bound;
-  }
-  for (size_t i = records.size(); i-- > 0;) {
-    const CollapseRecord& r = records[i];
-    VertexSplit s;
-    s.vs = pm_vertex[r.vs];
-    s.vl = r.vl == kNoId ? kNoId : pm_vertex[r.vl];
-    s.vr = r.vr == kNoId ? kNoId : pm_vertex[r.vr];
-    s.error = bound[i];
-    s.vs_before = r.position;
-    s.vs_after = r.vs_position;
-    s.vt_after = r.vt_position;
-    if (attributes) {
+  // The error bound of each record: the running maximum of the costs, so that the bound never
+  // decreases with coarsening (per range, then each range from the maximum before it).
+  std::vector<float> range_max(loops.ranges(splits), 0);
+  loops.run_indexed(splits, [&](size_t range, size_t begin, size_t end) {
+    float bound = 0;
+    for (size_t i = begin; i < end; ++i) bound = std::max(bound, records[i].error);
+    range_max[range] = bound;
+  });
+  std::vector<float> bound(splits);
+  std::vector<size_t> new_faces(loops.ranges(splits) + 1, 0);  // before each range of splits
+  loops.run_indexed(splits, [&](size_t range, size_t begin, size_t end) {
+    float before = 0;
+    for (size_t r = 0; r < range; ++r) before = std::max(before, range_max[r]);
+    for (size_t i = begin; i < end; ++i) {
+      before = std::max(before, records[i].error);
+      bound[i] = before;
+    }
+    size_t count = 0;
+    for (size_t j = begin; j < end; ++j) {
+      const CollapseRecord& r = record_of(j);
+      if (r.to_complete)
+        throw_internal("build_pm_from_collapses: a record the replay did not complete");
+      if (!attributes && !r.changed_values.empty())
+        throw_internal("PM builder: a record's wedge changes and values disagree");
+      count += (r.fl != kNoId ? 1 : 0) + (r.fr != kNoId ? 1 : 0);
+    }
+    new_faces[range + 1] = count;
+  });
+  for (size_t r = 0; r + 1 < new_faces.size(); ++r) new_faces[r + 1] += new_faces[r];
+  pm.splits.resize(splits);
+  loops.run_indexed(splits, [&](size_t range, size_t begin, size_t end) {
+    FaceId next_face = FaceId(base_faces + new_faces[range]);
+    for (size_t j = begin; j < end; ++j) {
+      const size_t i = splits - 1 - j;
+      const CollapseRecord& r = records[i];
+      VertexSplit& s = pm.splits[j];
+      s.vs = pm_vertex[r.vs];
+      s.vl = r.vl == kNoId ? kNoId : pm_vertex[r.vl];
+      s.vr = r.vr == kNoId ? kNoId : pm_vertex[r.vr];
+      s.error = bound[i];
+      s.vs_before = r.position;
+      s.vs_after = r.vs_position;
+      s.vt_after = r.vt_position;
+      for (FaceId f : {r.fl, r.fr})
+        if (f != kNoId) pm_face[f] = next_face++;
+    }
+  });
+  if (attributes) {
+    // Where each record's changes start in `replaced`.
+    std::vector<size_t> replaced_begin(splits + 1, 0);
+    for (size_t i = 0; i < splits; ++i)
+      replaced_begin[i + 1] = replaced_begin[i] + records[i].changed_wedges.size() * floats;
+    // Wedges new with a split are numbered in the splits' order: one pass.
+    for (size_t j = 0; j < splits; ++j) {
+      const size_t i = splits - 1 - j;
+      const CollapseRecord& r = records[i];
+      VertexSplit& s = pm.splits[j];
       for (int k = 0; k < 6; ++k)
         if (r.corner_wedges[k] != kNoId)
           s.corner_wedges[k] = wedges.split(r.corner_wedges[k], s.new_wedge_count);
@@ -157,11 +214,9 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
         pm.wedge_change_values.insert(pm.wedge_change_values.end(), fine, fine + floats);
       }
     }
-    for (FaceId f : {r.fl, r.fr})
-      if (f != kNoId) pm_face[f] = next_face++;
-    pm.splits.push_back(s);
   }
-  if (next_vertex != mesh.vertex_count() || next_face != mesh.face_count())
+  if (base_vertices + splits != mesh.vertex_count() ||
+      base_faces + new_faces.back() != mesh.face_count())
     throw_internal("PM builder: the collapses do not account for every vertex and face");
 
   // Copies made by the repair step go back to their original (the first vertex that came

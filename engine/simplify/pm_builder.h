@@ -9,11 +9,16 @@
 #include "pm/progressive_mesh.h"
 #include "simplify/collapse_mesh.h"
 #include "simplify/simplifier.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
 struct PmBuildOptions {
   bool keep_order = false;  // store the input's vertex and face order (--keep-order)
+  // Where the passes over the vertices, faces and splits run in chunks side by side (the same
+  // PM; the wedges' numbering, in order of first use, stays one pass); null: on the calling
+  // thread.
+  ChunkedLoops* loops = nullptr;
 };
 
 // `repaired` is the mesh the simplifier started from; `final_mesh` the CollapseMesh after

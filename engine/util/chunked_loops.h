@@ -98,6 +98,36 @@ std::vector<std::vector<uint32_t>> items_of_ranges(ChunkedLoops& loops, size_t n
   return items;
 }
 
+// The items of [0, n) that keep(i) keeps, numbered in order, in `loops`' chunks (a count per
+// range, then the numbers): per item its new number (kNoKey if dropped), and per new number,
+// its item.
+struct KeptItems {
+  std::vector<uint32_t> new_id;
+  std::vector<uint32_t> old_id;
+};
+template <class Keep>
+KeptItems number_kept(ChunkedLoops& loops, size_t n, Keep keep) {
+  KeptItems out;
+  out.new_id.assign(n, kNoKey);
+  std::vector<size_t> first(loops.ranges(n) + 1, 0);  // per range, its first new number
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    size_t count = 0;
+    for (size_t i = begin; i < end; ++i) count += keep(i) ? 1 : 0;
+    first[range + 1] = count;
+  });
+  for (size_t r = 0; r + 1 < first.size(); ++r) first[r + 1] += first[r];
+  out.old_id.resize(first.back());
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    uint32_t next = uint32_t(first[range]);
+    for (size_t i = begin; i < end; ++i)
+      if (keep(i)) {
+        out.new_id[i] = next;
+        out.old_id[next++] = uint32_t(i);
+      }
+  });
+  return out;
+}
+
 // A section's time with a core per chunk: the wall seconds since it was made, with the loops
 // run meanwhile counted at their critical path.
 class LoopClock {
