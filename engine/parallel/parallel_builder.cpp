@@ -610,10 +610,14 @@ void ParallelBuilder::extract_jobs(Round& r) {
   jobs.resize(subsets);
   std::vector<uint64_t> removable(subsets, 0);
   std::vector<SubsetSample> samples(sample ? subsets : 0);
-  // A cheap metric's sample is costed by the master (sample_on_master): the tasks only pick
-  // its edges. A costly one's is costed side by side in the tasks.
+  // A cheap metric's sample is costed by the master (sample_on_master): in the tasks, each
+  // through a costing view of the master (the same costs), unless the master has none or the
+  // mesh has copy groups (a seam's costing walks the whole mesh's marks); else the tasks only
+  // pick its edges. A costly one's is costed side by side in the tasks, by their jobs' states.
   const bool sample_in_tasks = sample && master_->costly();
-  std::vector<SampledEdges> sampled(sample && !sample_in_tasks ? subsets : 0);
+  const bool master_in_tasks =
+      sample && !sample_in_tasks && copy_groups_.empty() && master_->costing_view() != nullptr;
+  std::vector<SampledEdges> sampled(sample && !sample_in_tasks && !master_in_tasks ? subsets : 0);
   // Per face, the subset whose job owns its three corners: the only state that may list it.
   face_subset_.assign(whole.face_capacity(), kNoId);
   std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
@@ -635,10 +639,15 @@ void ParallelBuilder::extract_jobs(Round& r) {
     if (carry_keys_) jobs[i].keys = keys_of_job(*keys_, jobs[i], free);
     if (sample) {
       const double sample_start = thread_cpu_seconds();
-      if (sample_in_tasks)
+      if (sample_in_tasks) {
         samples[i] = sample_subset(jobs[i], free, carry_keys_, jobs[i].keys);
-      else
+      } else if (master_in_tasks) {
+        const std::unique_ptr<PriorityModule> view = master_->costing_view();
+        Simplifier master_costs(*whole_, *view, {});
+        samples[i] = sample_on_master(jobs[i], sampled_edges(jobs[i], free), master_costs, *view);
+      } else {
         sampled[i] = sampled_edges(jobs[i], free);
+      }
       sample_cpu[i] = thread_cpu_seconds() - sample_start;
     }
     if (carry_deferred_) jobs[i].deferred = deferred_of_job(deferred_, jobs[i], free, jobs[i].keys);
@@ -648,7 +657,7 @@ void ParallelBuilder::extract_jobs(Round& r) {
   RoundCosts round_costs;
   if (sample) {
     const auto ts = std::chrono::steady_clock::now();
-    if (!sample_in_tasks) {
+    if (!sample_in_tasks && !master_in_tasks) {
       const double sample_start = thread_cpu_seconds();
       Simplifier master_costs(*whole_, *master_, {});
       if (!copy_groups_.empty()) master_costs.join_copies(&copy_groups_);

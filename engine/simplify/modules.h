@@ -82,6 +82,12 @@ class PriorityModule {
   // Frees what the module can rebuild when it next costs an edge (caches), without changing
   // any costing: the parallel build's master while the jobs of a round run.
   virtual void release_caches() {}
+  // For costing edges on several threads at once (the parallel build's round samples): a
+  // module whose evaluate and evaluate_seam cost as this one's do, reading this one's state,
+  // with working memory and a costings count of its own; it performs nothing (collapsed
+  // throws). It lives while this one does and this one changes nothing meanwhile. Null (the
+  // default, and a wrapper's): this module costs on one thread only.
+  virtual std::unique_ptr<PriorityModule> costing_view() const { return nullptr; }
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every

@@ -87,7 +87,8 @@ Vec3 QuadricPriority::place(const Quadric& q, const Vec3& pa, const Vec3& pb) co
 }
 
 bool QuadricPriority::place_on_constraints(const CollapseMesh& mesh, VertexId a, VertexId b,
-                                           const Quadric& q, Quadric& total, Vec3& out) {
+                                           const Quadric& q, Quadric& total, Vec3& out,
+                                           StarTermsScratch& scratch) const {
   const Vec3& pa = mesh.position(a);
   const Vec3& pb = mesh.position(b);
   const Vec3 o = scale(add(pa, pb), 0.5);  // (the origin of the sums, for precision)
@@ -99,7 +100,7 @@ bool QuadricPriority::place_on_constraints(const CollapseMesh& mesh, VertexId a,
     Vec3 g;
     double h;
     Quadric star;
-    star_volume(mesh, a, b, o, star_scratch_, g, h, planes ? &star : nullptr);
+    star_volume(mesh, a, b, o, scratch, g, h, planes ? &star : nullptr);
     if (options_.keep_volume && dot(g, g) > 1e-12 * edge_sq * edge_sq) constraints.require(g, h);
     if (planes) {
       star *= options_.star_planes_weight;
@@ -108,7 +109,7 @@ bool QuadricPriority::place_on_constraints(const CollapseMesh& mesh, VertexId a,
   }
   Vec3 e1, e2;
   if (options_.keep_border && (mesh.is_boundary(a) || mesh.is_boundary(b)) &&
-      star_border(mesh, a, b, o, star_scratch_, e1, e2) && dot(e1, e1) > 1e-12 * edge_sq) {
+      star_border(mesh, a, b, o, scratch, e1, e2) && dot(e1, e1) > 1e-12 * edge_sq) {
     constraints.require_cross(e1, e2);
   }
   return constraints.minimize(total, out);
@@ -117,6 +118,11 @@ bool QuadricPriority::place_on_constraints(const CollapseMesh& mesh, VertexId a,
 bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
                                CollapseCandidate& out, Costing costing) {
   ++costings_;
+  return cost(mesh, a, b, out, costing, star_scratch_);
+}
+
+bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                           Costing costing, StarTermsScratch& scratch) const {
   const bool locked_a = !locked_.empty() && locked_[a];
   const bool locked_b = !locked_.empty() && locked_[b];
   if (locked_a && locked_b) return false;
@@ -137,7 +143,7 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
     // Placed with the star's planes; costed by the accumulated quadric alone, whose free
     // optimum's cost (the queue key) stays a lower bound.
     Quadric total;
-    if (place_on_constraints(mesh, a, b, q, total, kept) && near_edge(kept, pa, pb)) {
+    if (place_on_constraints(mesh, a, b, q, total, kept, scratch) && near_edge(kept, pa, pb)) {
       // An end that meets the constraints comes out of the solve up to rounding: a corner
       // stays exactly where it was.
       const double edge_sq = dot(sub(pb, pa), sub(pb, pa));
@@ -158,6 +164,11 @@ bool QuadricPriority::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b,
 bool QuadricPriority::evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt,
                                     const Vec3* at, CollapseCandidate& out, Costing) {
   ++costings_;
+  return cost_seam(mesh, vs, vt, at, out);
+}
+
+bool QuadricPriority::cost_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                                CollapseCandidate& out) const {
   Quadric q = quadrics_[std::min(vs, vt)];
   q += quadrics_[std::max(vs, vt)];
   out.vs = vs;
@@ -167,6 +178,39 @@ bool QuadricPriority::evaluate_seam(const CollapseMesh& mesh, VertexId vs, Verte
   out.cost = std::max(0.0, q.evaluate(out.position));
   out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
   return std::isfinite(out.cost);
+}
+
+// QuadricPriority::costing_view: the owner's costings with a scratch and a count of its own.
+class QuadricCostingView : public PriorityModule {
+ public:
+  explicit QuadricCostingView(const QuadricPriority& owner) : owner_(owner) {}
+  std::string name() const override { return owner_.name(); }
+  void initialize(const CollapseMesh&) override {
+    throw_internal("a quadric costing view reads its owner's state: it has none to initialise");
+  }
+  bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+                Costing costing) override {
+    ++costings_;
+    return owner_.cost(mesh, a, b, out, costing, scratch_);
+  }
+  bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                     CollapseCandidate& out, Costing) override {
+    ++costings_;
+    return owner_.cost_seam(mesh, vs, vt, at, out);
+  }
+  void collapsed(const CollapseMesh&, CollapseCandidate&, const EdgeFaces&) override {
+    throw_internal("a quadric costing view performs no collapse");
+  }
+  uint64_t costings() const override { return costings_; }
+
+ private:
+  const QuadricPriority& owner_;
+  StarTermsScratch scratch_;
+  uint64_t costings_ = 0;
+};
+
+std::unique_ptr<PriorityModule> QuadricPriority::costing_view() const {
+  return std::make_unique<QuadricCostingView>(*this);
 }
 
 void QuadricPriority::collapsed(const CollapseMesh&, CollapseCandidate& done, const EdgeFaces&) {

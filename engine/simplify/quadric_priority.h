@@ -51,6 +51,7 @@ class QuadricPriority : public PriorityModule {
                      CollapseCandidate& out, Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override { return costings_; }
+  std::unique_ptr<PriorityModule> costing_view() const override;
 
   // State transfer for the parallel construction (module_state.h). export_local: the
   // quadrics of a job's vertices (maps: its local -> global ids), in its local ids.
@@ -76,7 +77,14 @@ class QuadricPriority : public PriorityModule {
   // for (placement_constraints.h); false where there is none. `total` is q plus the star's
   // planes (QuadricOptions::star_planes_weight).
   bool place_on_constraints(const CollapseMesh& mesh, VertexId a, VertexId b, const Quadric& q,
-                            Quadric& total, Vec3& out);
+                            Quadric& total, Vec3& out, StarTermsScratch& scratch) const;
+  // evaluate and evaluate_seam without counting, with the working memory given: what a
+  // costing view calls too.
+  bool cost(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
+            Costing costing, StarTermsScratch& scratch) const;
+  bool cost_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
+                 CollapseCandidate& out) const;
+  friend class QuadricCostingView;
 
   uint64_t costings_ = 0;
   std::vector<uint8_t> locked_;

@@ -4,7 +4,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <memory>
+#include <thread>
 #include <vector>
 
 #include "drawn_meshes.h"
@@ -16,6 +19,7 @@
 #include "simplify/simplify.h"
 #include "simplify/vec_math.h"
 #include "test_support.h"
+#include "util/error.h"
 
 namespace parapm {
 namespace {
@@ -113,6 +117,63 @@ TEST(QuadricPlacement, TheStarsPlanesKeepACoarseLevelsRims) {
               faces, with, without);
   EXPECT_GT(QuadricOptions{}.star_planes_weight, 0);
   EXPECT_LT(with, 0.95 * without);
+}
+
+// A costing view (PriorityModule::costing_view) costs every edge as its owner does, queue keys
+// and performed placements, midway through a simplification (accumulated quadrics, stars with
+// borders), two views on two threads at once; it counts its own costings and performs nothing.
+TEST(QuadricCostingView, CostsAsItsOwnerOnSeveralThreads) {
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh working(repaired.mesh);
+  QuadricPriority owner(locked, QuadricOptions{});
+  Simplifier simplifier(working, owner, standard_constraints(locked));
+  simplifier.run({repaired.mesh.face_count() / 3}, {}, nullptr);
+  std::vector<std::pair<VertexId, VertexId>> edges;
+  std::vector<VertexId> ring;
+  for (VertexId v = 0; v < working.vertex_capacity(); ++v) {
+    if (!working.vertex_alive(v)) continue;
+    working.neighbors(v, ring);
+    for (VertexId u : ring)
+      if (v < u) edges.push_back({v, u});
+  }
+  ASSERT_GT(edges.size(), 10000u);
+  struct Cost {
+    bool placed;
+    CollapseCandidate c;
+  };
+  auto costs_of = [&](PriorityModule& module, Costing costing) {
+    std::vector<Cost> out(edges.size());
+    for (size_t i = 0; i < edges.size(); ++i)
+      out[i].placed = module.evaluate(working, edges[i].first, edges[i].second, out[i].c, costing);
+    return out;
+  };
+  for (Costing costing : {Costing::kQueue, Costing::kPerform}) {
+    const std::vector<Cost> expected = costs_of(owner, costing);
+    const uint64_t owner_costings = owner.costings();
+    const std::unique_ptr<PriorityModule> a = owner.costing_view(), b = owner.costing_view();
+    ASSERT_TRUE(a && b);
+    std::vector<Cost> beside;
+    std::thread other([&] { beside = costs_of(*b, costing); });
+    const std::vector<Cost> here = costs_of(*a, costing);
+    other.join();
+    auto expect_as_owner = [&](const std::vector<Cost>& got) {
+      for (size_t i = 0; i < edges.size(); ++i) {
+        const Cost &x = got[i], &y = expected[i];
+        ASSERT_EQ(x.placed, y.placed) << i;
+        ASSERT_EQ(x.c.vs, y.c.vs) << i;
+        ASSERT_EQ(x.c.position, y.c.position) << i;
+        ASSERT_EQ(std::memcmp(&x.c.cost, &y.c.cost, sizeof(double)), 0) << i;
+        ASSERT_EQ(std::memcmp(&x.c.error, &y.c.error, sizeof(double)), 0) << i;
+      }
+    };
+    expect_as_owner(here);
+    expect_as_owner(beside);
+    EXPECT_EQ(a->costings(), edges.size());
+    EXPECT_EQ(owner.costings(), owner_costings);
+    CollapseCandidate done = expected.front().c;
+    EXPECT_THROW(a->collapsed(working, done, EdgeFaces{}), Error);
+  }
 }
 
 }  // namespace
