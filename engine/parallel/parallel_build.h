@@ -106,7 +106,7 @@ struct RoundStats {
   uint64_t faces_after = 0;
   double partition_seconds = 0;  // with finding its border (bound_vertices, border_faces)
   // The previous round's subsets' lists, merged by cost, go into the PM's list beside its band
-  // pass, or beside this round's partition.
+  // pass, or beside this round's partition or (round 1) jobs.
   double append_seconds = 0;
   // Drawn ahead, when the round has as many subsets as foreseen: beside the previous round's
   // band pass, on a copy of the mesh before it (partition_seconds then counts the copy), or,
@@ -115,7 +115,7 @@ struct RoundStats {
   bool partition_foreseen = false;
   // Round 0's partition is drawn beside the master's initialisation, round 1's beside the rest
   // of the set-up and round 0, a later round's beside the append or beside the last band pass:
-  // what of it the critical path leaves out.
+  // what of it (and of the append) the critical path leaves out.
   double partition_overlap_seconds = 0;
   double extract_seconds = 0;  // jobs and their state, shares included (wall)
   // The edge sample (water level, shares), costed in the extraction's tasks: their CPU summed.

@@ -526,15 +526,13 @@ void ParallelBuilder::partition(Round& r) {
     rs.partition_seconds = first_partition_seconds_;
     rs.partition_overlap_seconds = std::min(first_partition_seconds_, initialize_seconds_);
   } else if (early_taken) {
-    // Drawn beside round 0: the critical path counts what of it outlasted round 0, its check,
-    // and the previous round's records, appended now.
+    // Drawn beside round 0: the critical path counts what of it outlasted round 0, and its
+    // check. The previous round's records are appended beside this round's jobs.
     r.vertex_subset = std::move(foreseen_.vertex_subset);
     rs.partition_foreseen = true;
     rs.partition_seconds = foreseen_.partition_seconds + early_check_seconds;
     rs.partition_overlap_seconds = std::min(foreseen_.partition_seconds, foreseen_.beside_seconds);
-    const auto ta = std::chrono::steady_clock::now();
-    append_pending();
-    rs.append_seconds = seconds_since(ta);
+    r.append_beside_jobs = true;
   } else if (foreseen_.drawn && foreseen_.beside_band && foreseen_.subsets == r.subsets) {
     // Drawn beside the last band pass, the previous round's records appended beside it too:
     // the critical path counts what of them outlasted the band pass.
@@ -751,10 +749,14 @@ void ParallelBuilder::run_subsets(Round& r) {
   RoundStats& rs = r.rs;
   // The master costs nothing while the jobs run: its caches make way for theirs.
   master_->release_caches();
-  const auto t = std::chrono::steady_clock::now();
-  r.results = runner_->run(r.jobs, cancel_);
+  std::vector<std::function<void()>> beside_jobs;
+  if (r.append_beside_jobs) beside_jobs.push_back([this] { append_pending(); });
+  const Beside timed = run_beside(
+      parallel_.threads, [&] { r.results = runner_->run(r.jobs, cancel_); }, beside_jobs);
   r.jobs.clear();
-  rs.subsets_seconds = seconds_since(t);
+  rs.subsets_seconds = timed.work_seconds;
+  if (r.append_beside_jobs) rs.append_seconds = timed.side_seconds[0];
+  subsets_cpu_ += timed.side_cpu_elsewhere;
   if (cancel_) cancel_->check();
   if (r.results.size() != r.subsets)
     throw Error(ErrorCode::kInternal, "the subset runner returned " +
@@ -801,6 +803,9 @@ void ParallelBuilder::merge(Round& r) {
     pending_lists_ = std::move(r.lists);
   }
   rs.merge_seconds = seconds_since(t);
+  // An append beside the jobs: the critical path counts what of it outlasted the slowest.
+  if (r.append_beside_jobs)
+    rs.partition_overlap_seconds += std::min(rs.append_seconds, rs.slowest_subset_cpu_seconds);
 }
 
 double ParallelBuilder::take_results(Round& r) {

@@ -70,7 +70,8 @@ class ParallelBuilder {
     std::vector<SubsetJob> jobs;
     std::vector<SubsetResult> results;
     std::vector<std::vector<CollapseRecord>> lists;  // the jobs' records
-    double ceiling = 0;  // its water level: 95% of its collapses cost less
+    double ceiling = 0;               // its water level: 95% of its collapses cost less
+    bool append_beside_jobs = false;  // the last round's records go into the PM's beside its jobs
     ReplayReport replay;
   };
   struct LiveGraph;
