@@ -17,7 +17,7 @@ set(PARAPM_ENGINE_HEADERS io/gltf_writer.h io/mesh_io.h mesh/mesh.h mesh/repair.
   pm/levels.h pm/pm_file.h pm/progressive_mesh.h simplify/collapse_mesh.h simplify/module_state.h
   simplify/copy_groups.h simplify/modules.h simplify/quad_heap.h simplify/quadric.h
   simplify/simplifier.h
-  simplify/simplify.h util/chunked_loops.h util/error.h util/progress.h)
+  simplify/simplify.h util/chunked_loops.h util/error.h util/progress.h util/zeroed_array.h)
 
 install(TARGETS ${PARAPM_ENGINE_LIBRARIES} parapm_openmesh EXPORT ParaPMTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})

@@ -41,29 +41,41 @@ struct LiveCopy {
   Mesh mesh;
   std::vector<VertexId> compact;
 };
-LiveCopy live_copy(const CollapseMesh& mesh, const CopyGroups& groups) {
+// In `loops`' chunks: the live vertices numbered per range (a group's first live copy numbers
+// it), then the others of a group given its number, then the live faces.
+LiveCopy live_copy(const CollapseMesh& mesh, const CopyGroups& groups, ChunkedLoops& loops) {
+  // The live vertex whose number v takes: itself, or its group's first live copy.
+  auto numbered_as = [&](VertexId v) {
+    if (!groups.is_copy(v)) return v;
+    const auto copies = groups.of(groups.group[v]);
+    return *std::find_if(copies.begin(), copies.end(),
+                         [&](VertexId c) { return mesh.vertex_alive(c); });
+  };
+  const size_t capacity = mesh.vertex_capacity();
+  KeptItems vertices = number_kept(loops, capacity, [&](size_t v) {
+    return mesh.vertex_alive(VertexId(v)) && numbered_as(VertexId(v)) == v;
+  });
   LiveCopy out;
-  out.compact.assign(mesh.vertex_capacity(), kNoId);
-  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
-    if (!mesh.vertex_alive(v)) continue;
-    if (groups.is_copy(v)) {
-      const auto copies = groups.of(groups.group[v]);
-      const auto first = std::find_if(copies.begin(), copies.end(),
-                                      [&](VertexId c) { return mesh.vertex_alive(c); });
-      if (*first != v) {  // (copies are in increasing order: the first is numbered already)
-        out.compact[v] = out.compact[*first];
-        continue;
-      }
+  out.compact = std::move(vertices.new_id);
+  out.mesh.positions.resize(vertices.old_id.size());
+  loops.run(vertices.old_id.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) out.mesh.positions[i] = mesh.position(vertices.old_id[i]);
+  });
+  if (!groups.empty())  // (each range writes only its later copies, reads only first ones)
+    loops.run(capacity, [&](size_t begin, size_t end) {
+      for (size_t v = begin; v < end; ++v)
+        if (out.compact[v] == kNoId && mesh.vertex_alive(VertexId(v)))
+          out.compact[v] = out.compact[numbered_as(VertexId(v))];
+    });
+  const KeptItems faces = number_kept(loops, mesh.face_capacity(),
+                                      [&](size_t f) { return mesh.face_alive(FaceId(f)); });
+  out.mesh.faces.resize(faces.old_id.size());
+  loops.run(faces.old_id.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const Triangle& t = mesh.face(faces.old_id[i]);
+      out.mesh.faces[i] = {out.compact[t[0]], out.compact[t[1]], out.compact[t[2]]};
     }
-    out.compact[v] = VertexId(out.mesh.positions.size());
-    out.mesh.positions.push_back(mesh.position(v));
-  }
-  out.mesh.faces.reserve(mesh.live_faces());
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f)
-    if (mesh.face_alive(f)) {
-      const Triangle& t = mesh.face(f);
-      out.mesh.faces.push_back({out.compact[t[0]], out.compact[t[1]], out.compact[t[2]]});
-    }
+  });
   return out;
 }
 
@@ -84,7 +96,9 @@ std::vector<uint32_t> partition_copy(const LiveCopy& live, uint32_t p,
 
 std::vector<uint32_t> partition_live(const CollapseMesh& mesh, const CopyGroups& groups, uint32_t p,
                                      const PartitionOptions& options) {
-  return partition_copy(live_copy(mesh, groups), p, options);
+  ChunkedLoops one_thread;
+  return partition_copy(live_copy(mesh, groups, options.loops ? *options.loops : one_thread), p,
+                        options);
 }
 
 // Runs `work` on this thread and each of `sides` beside it, each on a thread of its own when
@@ -300,8 +314,8 @@ uint64_t border_bounded_goal(uint64_t faces, uint64_t border, double excess) {
 
 // A live copy of the mesh and its partition graph, for several partitions of the same mesh.
 struct ParallelBuilder::LiveGraph {
-  LiveGraph(const CollapseMesh& mesh, const CopyGroups& groups, ChunkedLoops* loops)
-      : live(live_copy(mesh, groups)), graph(live.mesh, Balance::kFaces, loops) {}
+  LiveGraph(const CollapseMesh& mesh, const CopyGroups& groups, ChunkedLoops& loops)
+      : live(live_copy(mesh, groups, loops)), graph(live.mesh, Balance::kFaces, &loops) {}
   // Per vertex of the mesh, its subset (subsets_of_copied).
   std::vector<uint32_t> draw(uint32_t p, const PartitionOptions& options) const {
     return subsets_of_copied(live, graph.draw(p, options));
@@ -369,7 +383,7 @@ void ParallelBuilder::set_up() {
   const double before_seconds = before_clock.critical_seconds();
   auto partition_first_round = [&] {
     const LoopClock clock(master_loops_);
-    auto source = std::make_shared<const LiveGraph>(whole, copy_groups_, &master_loops_);
+    auto source = std::make_shared<const LiveGraph>(whole, copy_groups_, master_loops_);
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, 0);
     partition_options.loops = &master_loops_;
@@ -751,11 +765,14 @@ void ParallelBuilder::run_subsets(Round& r) {
   master_->release_caches();
   std::vector<std::function<void()>> beside_jobs;
   if (r.append_beside_jobs) beside_jobs.push_back([this] { append_pending(); });
+  // The whole mesh's components, which the band passes and the final pass take (collapses
+  // neither merge nor split them), found beside round 0's jobs: the mesh stands still.
+  if (rs.round == 0 && !components_) beside_jobs.push_back([this] { whole_components(); });
   const Beside timed = run_beside(
       parallel_.threads, [&] { r.results = runner_->run(r.jobs, cancel_); }, beside_jobs);
   r.jobs.clear();
   rs.subsets_seconds = timed.work_seconds;
-  if (r.append_beside_jobs) rs.append_seconds = timed.side_seconds[0];
+  if (r.append_beside_jobs) rs.append_seconds = timed.side_seconds.front();
   subsets_cpu_ += timed.side_cpu_elsewhere;
   if (cancel_) cancel_->check();
   if (r.results.size() != r.subsets)
@@ -865,12 +882,18 @@ void ParallelBuilder::band_pass(Round& r) {
   CollapseMesh& whole = *whole_;
   const auto t = std::chrono::steady_clock::now();
   if (parallel_.band_pass && rs.round >= 1) {
+    const LoopClock prepared_clock(master_loops_);
     // The last round's bound vertices become the lagging ones: bound in this round too.
+    std::vector<std::vector<VertexId>> lagging_of(master_loops_.ranges(r.bound.size()));
+    master_loops_.run_indexed(r.bound.size(), [&](size_t range, size_t begin, size_t end) {
+      for (size_t v = begin; v < end; ++v) {
+        bound_before_[v] &= r.bound[v];
+        if (bound_before_[v]) lagging_of[range].push_back(VertexId(v));
+      }
+    });
     std::vector<VertexId> lagging;
-    for (size_t v = 0; v < r.bound.size(); ++v) {
-      bound_before_[v] &= r.bound[v];
-      if (bound_before_[v]) lagging.push_back(VertexId(v));
-    }
+    for (const std::vector<VertexId>& some : lagging_of)
+      lagging.insert(lagging.end(), some.begin(), some.end());
     BandPriority band(*master_queue_, std::move(bound_before_), r.ceiling);
     Simplifier pass(whole, band, standard_constraints(locked_, whole_components()));
     if (!copy_groups_.empty()) pass.join_copies(&copy_groups_);
@@ -886,16 +909,16 @@ void ParallelBuilder::band_pass(Round& r) {
                    scheduled_left_ - (r.scheduled && counts(before_band) ? 1 : 0), &before_band);
     LiveCopy copy;
     if (next.go) {
-      const auto tc = std::chrono::steady_clock::now();
-      copy = live_copy(whole, copy_groups_);
-      foreseen_.copy_seconds = seconds_since(tc);
+      const LoopClock copy_clock(master_loops_);
+      copy = live_copy(whole, copy_groups_, master_loops_);
+      foreseen_.copy_seconds = copy_clock.critical_seconds();
       foreseen_.subsets = next.subsets;
     }
     std::vector<CollapseRecord> band_records;
     PartitionOptions next_options;
     next_options.seed = round_seed(options_.seed, rs.round + 1);
     next_options.loops = &master_loops_;
-    const double prepared = seconds_since(t);
+    const double prepared = prepared_clock.critical_seconds();
     double partition_seconds = 0;
     const Beside timed =
         run_beside(parallel_.threads, [&] { band_records = pass.run(band_limits, {}, cancel_); },

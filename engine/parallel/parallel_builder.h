@@ -151,8 +151,9 @@ class ParallelBuilder {
   // The edges jobs left deferred (global ids, sorted), kept until a collapse changes an end:
   // the next round's jobs and the final pass queue them deferred (SubsetJob::deferred).
   std::vector<DeferredEdge> deferred_;
-  // The whole mesh's connected components, found once, at the first band pass or the final
-  // pass, for the size rule of each one after it (collapses neither merge nor split them).
+  // The whole mesh's connected components, found once (beside round 0's jobs, else at the first
+  // band pass or the final pass), for the size rule of each one after it (collapses neither
+  // merge nor split them).
   std::shared_ptr<const std::vector<uint32_t>> components_;
 
   // Every collapse so far, in the PM's order. At most one per vertex: reserved once, so no

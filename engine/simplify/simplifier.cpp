@@ -159,7 +159,11 @@ void Simplifier::forget_outdated_requeued() {
 
 // Each side lists a vetoed edge at most once, so the lists stay as short as the valence.
 void Simplifier::remember_rejected(VertexId v, VertexId other) {
-  auto& list = rejected_[v];
+  if (!rejected_slot_[v]) {
+    rejected_lists_.emplace_back();
+    rejected_slot_[v] = uint32_t(rejected_lists_.size());
+  }
+  std::vector<VertexId>& list = rejected_lists_[rejected_slot_[v] - 1];
   if (std::find(list.begin(), list.end(), other) == list.end()) list.push_back(other);
 }
 
@@ -226,19 +230,20 @@ void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits
   // Edges vetoed earlier around the changed star may be legal now: cost them again, after
   // the edges of vs. All are taken off the lists first: a push may veto its edge again, onto
   // the lists (screening).
-  rejected_[vt].clear();
-  rejected_[vs].clear();
+  for (VertexId end : {vt, vs})
+    if (std::vector<VertexId>* list = rejected_list(end)) list->clear();
   retry_.clear();
   for (VertexId n : ring_) {
-    auto& list = rejected_[n];
-    for (VertexId other : list) {
+    std::vector<VertexId>* list = rejected_list(n);
+    if (!list) continue;
+    for (VertexId other : *list) {
       if (other == vs || !mesh_.vertex_alive(other)) continue;
       // The edge is pushed once, from this side: forget it on the other side too.
-      auto& mirror = rejected_[other];
-      mirror.erase(std::remove(mirror.begin(), mirror.end(), n), mirror.end());
+      if (std::vector<VertexId>* mirror = rejected_list(other))
+        mirror->erase(std::remove(mirror->begin(), mirror->end(), n), mirror->end());
       retry_.emplace_back(n, other);
     }
-    list.clear();
+    list->clear();
   }
   const bool defer = defer_ && mesh_.live_faces() > limits.defer_above_faces;
   for (VertexId n : ring_)
@@ -453,11 +458,12 @@ void Simplifier::begin_run(const SimplifierLimits& limits) {
   stats_ = {};
   priority_.initialize(mesh_);
   for (const auto& module : constraints_) module->initialize(mesh_);
-  version_.assign(mesh_.vertex_capacity(), 0);
-  star_changed_at_.assign(mesh_.vertex_capacity(), 0);
+  version_.assign_zeroed(mesh_.vertex_capacity());
+  star_changed_at_.assign_zeroed(mesh_.vertex_capacity());
   collapses_ = 0;
   requeued_.clear();
-  rejected_.assign(mesh_.vertex_capacity(), {});
+  rejected_slot_.assign_zeroed(mesh_.vertex_capacity());
+  rejected_lists_.clear();
   defer_ = priority_.costly() && limits.defer_above_faces != SIZE_MAX;
   face_keys_.assign(defer_ ? 3 * size_t(mesh_.face_capacity()) : 0,
                     std::numeric_limits<float>::quiet_NaN());

@@ -18,6 +18,7 @@
 #include "simplify/modules.h"
 #include "simplify/quad_heap.h"
 #include "util/progress.h"
+#include "util/zeroed_array.h"
 
 namespace parapm {
 
@@ -264,8 +265,15 @@ class Simplifier {
   size_t compacted_size_ = 0;  // the heap's size after the last compact_heap()
   // priority_.costly(): retried and top edges meet the topological rules before any costing.
   bool screen_ = false;
-  std::vector<uint32_t> version_;
-  std::vector<std::vector<VertexId>> rejected_;  // per vertex: edges vetoed since its last change
+  // Per vertex, from zeroed pages (a run over a band of a large mesh touches the band's).
+  ZeroedArray<uint32_t> version_;
+  // Per vertex: the edges vetoed since its last change, a list of rejected_lists_ (its index
+  // + 1 in rejected_slot_; 0: none yet).
+  ZeroedArray<uint32_t> rejected_slot_;
+  std::vector<std::vector<VertexId>> rejected_lists_;
+  std::vector<VertexId>* rejected_list(VertexId v) {
+    return rejected_slot_[v] ? &rejected_lists_[rejected_slot_[v] - 1] : nullptr;
+  }
   // Requeued edges' costings, kept while no collapse changes the edge's star (a collapse
   // changes the faces around vs, vt and the neighbours of vs): the edge needs no new costing
   // when it comes out again.
@@ -278,7 +286,7 @@ class Simplifier {
   }
   void forget_outdated_requeued();
   std::unordered_map<uint64_t, std::pair<uint32_t, CollapseCandidate>> requeued_;
-  std::vector<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
+  ZeroedArray<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
   bool defer_ = false;                     // costly() and a limit below SIZE_MAX
   // 3 per face: the key of the edge from corner k; NaN: none yet, infinite: refused
   std::vector<float> face_keys_;
