@@ -615,8 +615,10 @@ void ParallelBuilder::extract_jobs(Round& r) {
   const CollapseMesh& whole = *whole_;
   const uint32_t subsets = r.subsets;
   const auto t = std::chrono::steady_clock::now();
-  const std::vector<std::vector<VertexId>> owned = owned_vertices(whole, r.vertex_subset, subsets);
-  double sequential_extract = seconds_since(t);
+  const LoopClock owned_clock(master_loops_);
+  const std::vector<std::vector<VertexId>> owned =
+      owned_vertices(whole, r.vertex_subset, subsets, master_loops_);
+  double sequential_extract = owned_clock.critical_seconds();
   const bool sample = parallel_.water_level_factor > 0 || parallel_.cost_shares;
   std::vector<SubsetJob>& jobs = r.jobs;
   jobs.resize(subsets);

@@ -1,6 +1,7 @@
 #include "parallel/subset_job.h"
 
 #include <algorithm>
+#include <utility>
 
 #include "util/error.h"
 #include "util/zeroed_array.h"
@@ -145,17 +146,40 @@ SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout
 std::vector<std::vector<VertexId>> owned_vertices(const CollapseMesh& mesh,
                                                   const std::vector<uint32_t>& vertex_subset,
                                                   uint32_t subsets) {
-  if (vertex_subset.size() != mesh.vertex_capacity())
+  ChunkedLoops one_thread;
+  return owned_vertices(mesh, vertex_subset, subsets, one_thread);
+}
+
+std::vector<std::vector<VertexId>> owned_vertices(const CollapseMesh& mesh,
+                                                  const std::vector<uint32_t>& vertex_subset,
+                                                  uint32_t subsets, ChunkedLoops& loops) {
+  const size_t n = mesh.vertex_capacity();
+  if (vertex_subset.size() != n)
     throw_invalid("extract_subsets: the partition has " + std::to_string(vertex_subset.size()) +
-                  " vertices, the mesh " + std::to_string(mesh.vertex_capacity()));
+                  " vertices, the mesh " + std::to_string(n));
+  // Per range of vertices, its count in each subset, then where its vertices go in each list.
+  std::vector<std::vector<size_t>> at(loops.ranges(n), std::vector<size_t>(subsets, 0));
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      if (!mesh.vertex_alive(VertexId(v))) continue;
+      if (vertex_subset[v] >= subsets)
+        throw_invalid("extract_subsets: vertex " + std::to_string(v) + " has subset " +
+                      std::to_string(vertex_subset[v]) + " of " + std::to_string(subsets));
+      ++at[range][vertex_subset[v]];
+    }
+  });
   std::vector<std::vector<VertexId>> owned(subsets);
-  for (VertexId v = 0; v < mesh.vertex_capacity(); ++v) {
-    if (!mesh.vertex_alive(v)) continue;
-    if (vertex_subset[v] >= subsets)
-      throw_invalid("extract_subsets: vertex " + std::to_string(v) + " has subset " +
-                    std::to_string(vertex_subset[v]) + " of " + std::to_string(subsets));
-    owned[vertex_subset[v]].push_back(v);
+  for (uint32_t k = 0; k < subsets; ++k) {
+    size_t total = 0;
+    for (std::vector<size_t>& range : at) total += std::exchange(range[k], total);
+    owned[k].resize(total);
   }
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    std::vector<size_t>& next = at[range];
+    for (size_t v = begin; v < end; ++v)
+      if (mesh.vertex_alive(VertexId(v)))
+        owned[vertex_subset[v]][next[vertex_subset[v]]++] = VertexId(v);
+  });
   return owned;
 }
 

@@ -26,6 +26,7 @@
 #include "simplify/module_state.h"
 #include "simplify/simplifier.h"
 #include "simplify/simplify.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -113,11 +114,15 @@ std::vector<SubsetJob> extract_subsets(const CollapseMesh& mesh, const Attribute
                                        const CopyGroups* groups = nullptr);
 
 // The two steps of extract_subsets, for a caller that builds the jobs concurrently: the live
-// vertices of each subset, in id order (checked against the mesh, O(vertices)), then one
-// subset's job from its list (const reads of `mesh` only: jobs may be built in parallel).
+// vertices of each subset, in id order (checked against the mesh, O(vertices); in `loops`'
+// chunks, the same lists), then one subset's job from its list (const reads of `mesh` only:
+// jobs may be built in parallel).
 std::vector<std::vector<VertexId>> owned_vertices(const CollapseMesh& mesh,
                                                   const std::vector<uint32_t>& vertex_subset,
                                                   uint32_t subsets);
+std::vector<std::vector<VertexId>> owned_vertices(const CollapseMesh& mesh,
+                                                  const std::vector<uint32_t>& vertex_subset,
+                                                  uint32_t subsets, ChunkedLoops& loops);
 SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout,
                          const std::vector<float>& wedge_values, bool positions_are_float,
                          const std::vector<uint8_t>& locked,

@@ -14,6 +14,7 @@
 #include "partition/partition.h"
 #include "simplify/modules.h"
 #include "simplify/simplify.h"
+#include "util/error.h"
 
 namespace parapm {
 namespace {
@@ -56,6 +57,32 @@ std::vector<std::pair<FaceId, Triangle>> live_faces(const CollapseMesh& mesh) {
   for (FaceId f = 0; f < mesh.face_capacity(); ++f)
     if (mesh.face_alive(f)) faces.emplace_back(f, mesh.face(f));
   return faces;
+}
+
+// The live vertices of each subset, in id order, in chunks side by side as in one pass, some of
+// them dead after a round of collapses; a subset out of range is named, chunked or not.
+TEST(SubsetRule, OwnedVerticesInChunksAreTheOnePassLists) {
+  Round round = run_round("stratocaster-9k.ply", "quadric", 8);
+  CollapseMesh whole(round.repaired.mesh);
+  std::vector<CollapseRecord> merged = merge_by_cost(lists_of(round));
+  replay_collapses(whole, merged, nullptr);
+  ASSERT_LT(whole.live_vertices(), whole.vertex_capacity());
+  const std::vector<uint32_t>& subsets = round.partition.vertex_subset;
+  const auto one_pass = owned_vertices(whole, subsets, 8);
+  size_t listed = 0;
+  for (const auto& list : one_pass) {
+    EXPECT_TRUE(std::is_sorted(list.begin(), list.end()));
+    listed += list.size();
+  }
+  EXPECT_EQ(listed, whole.live_vertices());
+  ChunkedLoops loops(5, 2, 16);
+  EXPECT_EQ(owned_vertices(whole, subsets, 8, loops), one_pass);
+  std::vector<uint32_t> bad = subsets;
+  VertexId live = 0;
+  while (!whole.vertex_alive(live)) ++live;
+  bad[live] = 8;
+  EXPECT_THROW(owned_vertices(whole, bad, 8, loops), Error);
+  EXPECT_THROW(owned_vertices(whole, bad, 8), Error);
 }
 
 TEST(SubsetRule, JobsHoldTheirSubsetAndAOneRingHaloOnly) {
