@@ -104,9 +104,10 @@ class ParallelBuilder {
   const CancelToken* cancel_;
   ThreadPoolRunner pool_;
   // The master's passes over the whole mesh while no job runs, in p chunks on the pool's
-  // threads: the graphs of the partitions (round 0's beside the set-up, a round's beside the
-  // band pass before it, or alone; round 1's, drawn on round 0's graph beside round 0, runs on
-  // one thread of its own) and the PM's assembly.
+  // threads: the partitions' live copies and graphs (round 0's beside the set-up, a round's
+  // beside the band pass before it, or alone; round 1's walk, on round 0's graph beside round
+  // 0, runs on one thread of its own), each round's owned vertices, the band pass's lagging
+  // vertices and the PM's assembly.
   ChunkedLoops master_loops_;
   SubsetRunner* runner_;
   const ParallelEvents& events_;
