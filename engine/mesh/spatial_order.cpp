@@ -46,8 +46,8 @@ void permute(std::vector<T>& values, const std::vector<uint32_t>& new_index, Chu
 // ranges' lists one after the other.
 std::vector<uint32_t> stable_order_by(const std::vector<uint32_t>& keys, size_t key_count,
                                       ChunkedLoops& loops) {
-  const auto items = items_of_ranges(loops, keys.size(), key_count,
-                                     [&](size_t i) { return keys[i]; });
+  const auto items =
+      items_of_ranges(loops, keys.size(), key_count, [&](size_t i) { return keys[i]; });
   std::vector<size_t> offset(loops.ranges(key_count) + 1, 0);
   for (size_t r = 0; r + 1 < offset.size(); ++r)
     offset[r + 1] = offset[r] + RangeItems(items, r, keys.size()).size();

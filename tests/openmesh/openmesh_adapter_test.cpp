@@ -50,12 +50,6 @@ std::vector<fs::path> meshes_to_try() {
   return out;
 }
 
-std::string pm_bytes(const ProgressiveMesh& pm) {
-  std::ostringstream out;
-  write_pm(pm, out);
-  return out.str();
-}
-
 // Each face's corners: position and attribute values (wedge numbering aside).
 std::vector<std::vector<double>> corners(const Mesh& mesh) {
   std::vector<std::vector<double>> out;
@@ -117,7 +111,7 @@ TEST(OpenMeshAdapter, AMeshThroughOpenMeshBuildsTheSamePm) {
     for (WedgeId w = 0; canonical_wedges && w < mesh.wedge_count(); ++w)
       canonical_wedges = mesh.wedge_vertex[w] == w;
     if (canonical_wedges) {
-      EXPECT_TRUE(pm_bytes(through) == pm_bytes(direct)) << "another PM";
+      EXPECT_TRUE(testing::pm_bytes(through) == testing::pm_bytes(direct)) << "another PM";
       ++same_bytes;
     } else {
       EXPECT_TRUE(face_set(level_of_detail(through, through.splits.size())) == face_set(back))

@@ -40,12 +40,6 @@ inline ProgressiveMesh build_with_subsets(const RepairedMesh& repaired,
   return build_progressive_mesh_parallel(repaired, options, parallel);
 }
 
-inline std::string pm_bytes(const ProgressiveMesh& pm) {
-  std::ostringstream out;
-  write_pm(pm, out);
-  return out.str();
-}
-
 // Round 0 of a p-subset build of a test mesh, as the parallel build starts it: the whole mesh,
 // the master's module initialised on it, and every subset's job with the master's state (no
 // target, no keys: the test sets them).

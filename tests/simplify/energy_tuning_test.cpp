@@ -18,12 +18,6 @@
 namespace parapm {
 namespace {
 
-std::string pm_bytes(const ProgressiveMesh& pm) {
-  std::ostringstream out;
-  write_pm(pm, out);
-  return out.str();
-}
-
 // The textured bunny (a scan: short noise creases, which the crease knobs decide about once
 // creases are on) to 10%, with one knob changed from its default: a different PM for every
 // knob, and the same bytes again with the defaults spelled out.
@@ -34,10 +28,10 @@ TEST(EnergyTuning, EveryKnobReachesTheMetric) {
   options.metric = "energy";
   options.target_ratio = 0.1;
   options.crease_angle_degrees = 60;  // creases on (off by default), for the crease knobs
-  const std::string defaults = pm_bytes(build_progressive_mesh(repaired, options));
+  const std::string defaults = testing::pm_bytes(build_progressive_mesh(repaired, options));
   SimplifyOptions spelled = options;
   spelled.energy = EnergyTuning{30, 64, 0.03, 8, 0.05};
-  EXPECT_EQ(pm_bytes(build_progressive_mesh(repaired, spelled)), defaults);
+  EXPECT_EQ(testing::pm_bytes(build_progressive_mesh(repaired, spelled)), defaults);
 
   const std::vector<std::pair<const char*, std::function<void(EnergyTuning&)>>> knobs = {
       {"star planes' weight", [](EnergyTuning& e) { e.star_planes_weight = 0; }},
@@ -48,7 +42,7 @@ TEST(EnergyTuning, EveryKnobReachesTheMetric) {
   for (const auto& [name, change] : knobs) {
     SimplifyOptions changed = options;
     change(changed.energy);
-    EXPECT_NE(pm_bytes(build_progressive_mesh(repaired, changed)), defaults) << name;
+    EXPECT_NE(testing::pm_bytes(build_progressive_mesh(repaired, changed)), defaults) << name;
   }
 }
 

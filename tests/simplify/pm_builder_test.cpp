@@ -21,12 +21,6 @@
 namespace parapm {
 namespace {
 
-std::string pm_bytes(const ProgressiveMesh& pm) {
-  std::ostringstream out;
-  write_pm(pm, out);
-  return out.str();
-}
-
 TEST(PmBuilder, InChunksTheSamePmAsInOnePass) {
   for (const char* name : {"pymeshlab-bunny-textured-10k.obj", "pymeshlab-colored-airplane-11k.ply",
                            "cad-cycloidal-43k.ply"}) {
@@ -48,7 +42,7 @@ TEST(PmBuilder, InChunksTheSamePmAsInOnePass) {
     ASSERT_GT(records.size(), repaired.mesh.vertex_count() / 2);
 
     const ProgressiveMesh one_pass = build_pm_from_collapses(repaired, working, records, {});
-    const std::string expected = pm_bytes(one_pass);
+    const std::string expected = testing::pm_bytes(one_pass);
     const MeshDifference restored =
         compare_meshes_exact(restore_input(one_pass), repaired_input(repaired), false);
     EXPECT_TRUE(restored.equal) << restored.first_difference;
@@ -56,8 +50,8 @@ TEST(PmBuilder, InChunksTheSamePmAsInOnePass) {
       ChunkedLoops loops(chunks, threads, min_chunk);
       PmBuildOptions in_chunks;
       in_chunks.loops = &loops;
-      EXPECT_TRUE(pm_bytes(build_pm_from_collapses(repaired, working, records, in_chunks)) ==
-                  expected)
+      EXPECT_TRUE(testing::pm_bytes(
+                      build_pm_from_collapses(repaired, working, records, in_chunks)) == expected)
           << chunks << " chunks";
     }
   }

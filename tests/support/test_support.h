@@ -9,10 +9,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <initializer_list>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "pm/pm_file.h"
 #include "simplify/collapse_mesh.h"
 #include "util/error.h"
 
@@ -60,6 +62,13 @@ std::string expect_error(F&& f, ErrorCode code, std::initializer_list<std::strin
   }
   ADD_FAILURE() << "did not throw";
   return "";
+}
+
+// A PM's .pm bytes, for comparing two PMs exactly.
+inline std::string pm_bytes(const ProgressiveMesh& pm) {
+  std::ostringstream out;
+  write_pm(pm, out);
+  return out.str();
 }
 
 // The live faces of a simplified mesh, as a Mesh (unused vertices stay: they do not count).
