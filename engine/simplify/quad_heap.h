@@ -1,13 +1,40 @@
-// A 4-ary min-heap. The collapse queue is large (millions of entries on big meshes) and
+// A 4-ary min-heap, the collapse queue's lowest tier (tiered_queue.h). Its sifts are
 // memory-bound: with four 16-byte children per node a sift visits half the levels of a
-// binary heap and reads one cache line per level. `Before(x, y)` is true when x must come out
-// before y; with a total order the output sequence does not depend on the heap's shape.
+// binary heap and reads one cache line per level (the items are laid out so that every
+// node's four children share a line). `Before(x, y)` is true when x must come out before y;
+// with a total order the output sequence does not depend on the heap's shape.
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
+#include <new>
 #include <vector>
 
 namespace parapm {
+
+// Allocates T arrays whose item 1 starts a 64-byte cache line, so that the children of node i,
+// items 4 i + 1 to 4 i + 4, fill one line when sizeof(T) is 16.
+template <typename T>
+struct ChildLineAllocator {
+  using value_type = T;
+  static constexpr size_t kLine = 64;
+  static constexpr size_t kShift = kLine - sizeof(T) % kLine;  // item 1 at a line's start
+  ChildLineAllocator() = default;
+  template <typename U>
+  ChildLineAllocator(const ChildLineAllocator<U>&) {}
+  T* allocate(size_t n) {
+    auto* base =
+        static_cast<std::byte*>(::operator new(n * sizeof(T) + kLine, std::align_val_t(kLine)));
+    return reinterpret_cast<T*>(base + kShift % kLine);
+  }
+  void deallocate(T* p, size_t) {
+    ::operator delete(reinterpret_cast<std::byte*>(p) - kShift % kLine, std::align_val_t(kLine));
+  }
+  template <typename U>
+  bool operator==(const ChildLineAllocator<U>&) const {
+    return true;
+  }
+};
 
 template <typename T, typename Before>
 class QuadHeap {
@@ -16,7 +43,9 @@ class QuadHeap {
   size_t size() const { return items_.size(); }
   void reserve(size_t n) { items_.reserve(n); }
   void clear() { items_.clear(); }
-  std::vector<T>& items() { return items_; }  // edit freely, then call rebuild()
+  // Edit freely, then call rebuild().
+  std::vector<T, ChildLineAllocator<T>>& items() { return items_; }
+  const std::vector<T, ChildLineAllocator<T>>& items() const { return items_; }
 
   void push(const T& item) {
     size_t i = items_.size();
@@ -66,7 +95,7 @@ class QuadHeap {
     items_[i] = item;
   }
 
-  std::vector<T> items_;
+  std::vector<T, ChildLineAllocator<T>> items_;
   Before before_;
 };
 

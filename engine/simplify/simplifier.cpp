@@ -27,14 +27,14 @@ void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
       if (listed[u] && u < v)
         continue;  // an edge between two listed vertices: from its smaller end
       Entry entry;
-      if (queue_entry(v, u, entry)) heap_.items().push_back(entry);
+      if (queue_entry(v, u, entry)) queue_.push(entry);
     }
   }
 }
 
 void Simplifier::push_edge(VertexId a, VertexId b) {
   Entry entry;
-  if (queue_entry(a, b, entry)) heap_.push(entry);
+  if (queue_entry(a, b, entry)) queue_.push(entry);
 }
 
 bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
@@ -87,20 +87,20 @@ bool Simplifier::deferred_entry(VertexId a, VertexId b, Entry& entry) {
 bool Simplifier::defer_edge(VertexId a, VertexId b) {
   Entry entry;
   if (!deferred_entry(a, b, entry)) return false;
-  heap_.push(entry);
+  queue_.push(entry);
   return true;
 }
 
 std::vector<DeferredEdge> Simplifier::deferred_edges() {
   std::vector<DeferredEdge> out;
   if (!defer_) return out;
-  for (const Entry& e : heap_.items()) {
-    if (!(e.stamp & kDeferred) || is_stale(e)) continue;
+  queue_.for_each([&](const Entry& e) {
+    if (!(e.stamp & kDeferred) || is_stale(e)) return;
     // The key it was deferred from: its faces' remembered keys, which only a costing of the
     // edge itself rewrites (and that would have made this entry current, not deferred).
     const float key = remembered_key(e.a, e.b);
     if (!std::isnan(key)) out.push_back({e.a, e.b, key});
-  }
+  });
   // An edge deferred twice without an end changing in between is listed once.
   sort_unique_edges(out);
   return out;
@@ -133,20 +133,9 @@ bool Simplifier::topologically_legal(VertexId a, VertexId b) const {
   return true;
 }
 
-bool Simplifier::is_stale(const Entry& entry) const {
-  return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
-         version_[entry.a] + version_[entry.b] != (entry.stamp & kVersions);
-}
-
-void Simplifier::compact_heap() {
-  auto& items = heap_.items();
-  const size_t before = items.size();
-  items.erase(
-      std::remove_if(items.begin(), items.end(), [this](const Entry& e) { return is_stale(e); }),
-      items.end());
-  heap_.rebuild();
-  stats_.stale += before - items.size();
-  compacted_size_ = items.size();
+void Simplifier::compact_queue() {
+  stats_.stale += queue_.remove_if([this](const Entry& e) { return is_stale(e); });
+  compacted_size_ = queue_.size();
   ++stats_.compactions;
   forget_outdated_requeued();
 }
@@ -471,13 +460,13 @@ void Simplifier::begin_run(const SimplifierLimits& limits) {
 }
 
 void Simplifier::build_first_queue(const SimplifierLimits& limits, const CancelToken* cancel) {
-  // Every undirected edge once. The heap's order does not depend on the order of insertion.
-  heap_.clear();
+  // Every undirected edge once. The queue's order does not depend on the order of insertion.
+  queue_.clear();
   compacted_size_ = 0;
   if (limits.first_queue_around) {
     queue_edges_around(*limits.first_queue_around, cancel);
   } else {
-    heap_.reserve(mesh_.face_capacity() * 3);
+    queue_.reserve(mesh_.face_capacity() * 3);
     const std::vector<DeferredEdge>* hints = defer_ && limits.first_deferred &&
                                                      !limits.first_deferred->empty() &&
                                                      mesh_.live_faces() > limits.defer_above_faces
@@ -509,14 +498,13 @@ void Simplifier::build_first_queue(const SimplifierLimits& limits, const CancelT
             std::find_if(hint_first, hint_end, [&](const DeferredEdge& h) { return h.b == b; });
         if (hint != hint_end && !std::isnan(hint->key)) {  // (a NaN key is no key)
           remember_key(a, b, hint->key);
-          if (deferred_entry(a, b, entry)) heap_.items().push_back(entry);
+          if (deferred_entry(a, b, entry)) queue_.push(entry);
           continue;
         }
-        if (queue_entry(a, b, entry)) heap_.items().push_back(entry);
+        if (queue_entry(a, b, entry)) queue_.push(entry);
       }
     }
   }
-  heap_.rebuild();
 }
 
 std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
@@ -532,28 +520,27 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   size_t next_report = 1024;  // records made when progress is next reported
   stats_.stop_reason = "no legal collapse left";
 
-  while (!heap_.empty()) {
+  while (!queue_.empty()) {
     if (mesh_.live_faces() <= limits.target_faces) {
       stats_.stop_reason = "target face count reached";
       break;
     }
-    // Lazy deletion leaves stale entries behind (about seven per collapse). Once the queue
+    // Lazy deletion leaves stale entries behind (about nine per collapse). Once the queue
     // holds more than two entries per live face (live edges are ~1.5 per face) they are
-    // dropped in one sequential pass, far cheaper than popping each through the
-    // cache-missing heap; amortised, each entry is compacted away at most once. Not again
-    // before the heap has doubled since the last pass: a mesh of many tiny pieces holds more
-    // current entries than that (3 edges per face for loose triangles), and a pass per pop
+    // dropped in one sequential pass; amortised, each entry is compacted away at most once.
+    // Not again before the queue has doubled since the last pass: a mesh of many tiny pieces holds
+    // more current entries than that (3 edges per face for loose triangles), and a pass per pop
     // made it quadratic (the motorbike with --free-copies: 789 s, chair-dupfaces 0.95 s for
     // no collapse at all).
-    if (heap_.size() > std::max<size_t>(2 * mesh_.live_faces() + 1024, 2 * compacted_size_))
-      compact_heap();
-    const Entry entry = heap_.pop();
+    if (queue_.size() > std::max<size_t>(2 * mesh_.live_faces() + 1024, 2 * compacted_size_))
+      compact_queue();
+    const Entry entry = queue_.pop();
     if (is_stale(entry)) {
       ++stats_.stale;
       continue;
     }
     if (entry.cost > limits.max_cost) {  // and so does every entry after it
-      heap_.push(entry);                 // (deferred_edges() lists what the queue holds)
+      queue_.push(entry);                // (deferred_edges() lists what the queue holds)
       stats_.stop_reason = "cost ceiling reached";
       break;
     }
@@ -604,13 +591,13 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     // behind lets its edge jump the queue: when the cost now is above the next key, the edge
     // goes back with it (lazy re-evaluation). It comes out again at its true cost, so the
     // loop ends: a requeue changes no state.
-    while (!heap_.empty() && is_stale(heap_.top())) {
-      heap_.pop();
+    while (!queue_.empty() && is_stale(queue_.top())) {
+      queue_.pop();
       ++stats_.stale;
     }
     const Entry now{static_cast<float>(candidate.cost), entry.a, entry.b, entry.stamp | kRequeued};
-    if (!heap_.empty() && heap_.top().cost < now.cost) {
-      heap_.push(now);
+    if (!queue_.empty() && queue_.top().cost < now.cost) {
+      queue_.push(now);
       ++stats_.requeued;
       // (a cheap module costs the edge again for less than keeping its costing takes)
       if (priority_.costly())

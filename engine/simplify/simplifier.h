@@ -16,7 +16,7 @@
 #include "simplify/collapse_mesh.h"
 #include "simplify/copy_groups.h"
 #include "simplify/modules.h"
-#include "simplify/quad_heap.h"
+#include "simplify/tiered_queue.h"
 #include "util/progress.h"
 #include "util/zeroed_array.h"
 
@@ -222,8 +222,11 @@ class Simplifier {
   void remember_rejected(VertexId v, VertexId other);
   void reject(VertexId a, VertexId b);
   bool topologically_legal(VertexId a, VertexId b) const;
-  bool is_stale(const Entry& entry) const;
-  void compact_heap();
+  bool is_stale(const Entry& entry) const {
+    return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
+           version_[entry.a] + version_[entry.b] != (entry.stamp & kVersions);
+  }
+  void compact_queue();
   // All constraints; with topology_checked, those that are not topological().
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
              bool topology_checked = false) const;
@@ -261,8 +264,8 @@ class Simplifier {
   CollapseMesh& mesh_;
   PriorityModule& priority_;
   std::vector<std::unique_ptr<ConstraintModule>> constraints_;
-  QuadHeap<Entry, Before> heap_;
-  size_t compacted_size_ = 0;  // the heap's size after the last compact_heap()
+  TieredQueue<Entry, Before> queue_;
+  size_t compacted_size_ = 0;  // the queue's size after the last compact_queue()
   // priority_.costly(): retried and top edges meet the topological rules before any costing.
   bool screen_ = false;
   // Per vertex, from zeroed pages (a run over a band of a large mesh touches the band's).
