@@ -4,6 +4,7 @@
 #include "simplify/quadric_priority.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "simplify/back_to_back.h"
@@ -31,38 +32,73 @@ void QuadricPriority::initialize(const CollapseMesh& mesh) {
   initialize_in_chunks(mesh, plain);
 }
 
+// Face f's plane, weighted by its area, and the boundary planes of its edges (those with no
+// face across, and those whose faces lie back to back: back_to_back.h, their planes are one,
+// blind to the rim moving within it; counted once, from the face holding a->b with a < b):
+// the plane through the edge perpendicular to the face keeps the border from shrinking
+// inwards. add(v, q) is called for the face's three corners, then for each such edge k (in
+// order) for its two ends. A zero-area face has no plane and adds nothing.
+template <typename Add>
+void QuadricPriority::face_planes(const CollapseMesh& mesh, const std::vector<FaceId>& twin,
+                                  FaceId f, Add add) const {
+  const Triangle& t = mesh.face(f);
+  const Vec3& p0 = mesh.position(t[0]);
+  const Vec3 n2 = triangle_normal(p0, mesh.position(t[1]), mesh.position(t[2]));
+  const double len = length(n2);
+  if (len == 0) return;
+  const Vec3 n = scale(n2, 1.0 / len);
+  const Quadric q = Quadric::from_plane(n, -dot(n, p0), 0.5 * len);
+  for (VertexId v : t) add(v, q);
+  for (int k = 0; k < 3; ++k) {
+    const VertexId a = t[k], b = t[(k + 1) % 3];
+    const FaceId across = twin[3 * size_t(f) + k];  // the face holding b->a
+    if (across != kNoId && (b < a || !back_to_back(n2, normal_of(mesh, across)))) continue;
+    const Vec3 e = sub(mesh.position(b), mesh.position(a));
+    const Vec3 side = cross(e, n);
+    const double side_len = length(side);
+    if (side_len == 0) continue;
+    const Vec3 m = scale(side, 1.0 / side_len);
+    const Quadric qb =
+        Quadric::from_plane(m, -dot(m, mesh.position(a)), options_.boundary_weight * dot(e, e));
+    add(a, qb);
+    add(b, qb);
+  }
+}
+
 void QuadricPriority::initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) {
   quadrics_.assign(mesh.vertex_capacity(), Quadric{});
   const std::vector<FaceId> twin = mesh.twin_faces(loops);
+  if (loops.chunks() > 1 && sum_by_vertex(mesh, twin, loops)) return;
+  quadrics_.assign(mesh.vertex_capacity(), Quadric{});
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    const Vec3& p0 = mesh.position(t[0]);
-    const Vec3 n2 = triangle_normal(p0, mesh.position(t[1]), mesh.position(t[2]));
-    const double len = length(n2);
-    if (len == 0) continue;  // a zero-area face has no plane
-    const Vec3 n = scale(n2, 1.0 / len);
-    const Quadric q = Quadric::from_plane(n, -dot(n, p0), 0.5 * len);
-    for (VertexId v : t) quadrics_[v] += q;
-    // Boundary edges, and edges whose faces lie back to back (back_to_back.h: their planes
-    // are one, blind to the rim moving within it; counted once, from the face holding a->b
-    // with a < b): the plane through the edge perpendicular to the face keeps the border from
-    // shrinking inwards.
-    for (int k = 0; k < 3; ++k) {
-      const VertexId a = t[k], b = t[(k + 1) % 3];
-      const FaceId across = twin[3 * size_t(f) + k];  // the face holding b->a
-      if (across != kNoId && (b < a || !back_to_back(n2, normal_of(mesh, across)))) continue;
-      const Vec3 e = sub(mesh.position(b), mesh.position(a));
-      const Vec3 side = cross(e, n);
-      const double side_len = length(side);
-      if (side_len == 0) continue;
-      const Vec3 m = scale(side, 1.0 / side_len);
-      const Quadric qb =
-          Quadric::from_plane(m, -dot(m, mesh.position(a)), options_.boundary_weight * dot(e, e));
-      quadrics_[a] += qb;
-      quadrics_[b] += qb;
-    }
+    face_planes(mesh, twin, f, [&](VertexId v, const Quadric& q) { quadrics_[v] += q; });
   }
+}
+
+bool QuadricPriority::sum_by_vertex(const CollapseMesh& mesh, const std::vector<FaceId>& twin,
+                                    ChunkedLoops& loops) {
+  // Each vertex sums its own fan's planes, faces in increasing order (as the mesh lists them
+  // when built), so it adds what the pass over the faces adds it, in the same order: the same
+  // bits. Each face's planes are found once per corner, three times in all, on every chunk.
+  std::atomic<bool> in_order{true};
+  loops.run(mesh.vertex_capacity(), [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      const std::vector<FaceId>& fan = mesh.faces_of(VertexId(v));
+      if (!std::is_sorted(fan.begin(), fan.end()) ||
+          std::adjacent_find(fan.begin(), fan.end()) != fan.end()) {
+        in_order = false;
+        return;
+      }
+      Quadric& sum = quadrics_[v];
+      for (FaceId f : fan)
+        if (mesh.face_alive(f))
+          face_planes(mesh, twin, f, [&](VertexId corner, const Quadric& q) {
+            if (corner == v) sum += q;
+          });
+    }
+  });
+  return in_order;
 }
 
 Vec3 QuadricPriority::place(const Quadric& q, const Vec3& pa, const Vec3& pb) const {

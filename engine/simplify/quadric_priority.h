@@ -43,7 +43,8 @@ class QuadricPriority : public PriorityModule {
       : locked_(std::move(locked)), options_(options) {}
   std::string name() const override { return "quadric"; }
   void initialize(const CollapseMesh& mesh) override;
-  // The faces' twins found in `loops`' chunks; the quadrics summed on one thread.
+  // The faces' twins found in `loops`' chunks; with more than one chunk, each vertex's
+  // quadric summed in its chunk (the same bits).
   void initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override;  // kQueue: the unconstrained optimum's cost
@@ -71,6 +72,15 @@ class QuadricPriority : public PriorityModule {
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
 
  private:
+  // Face f's planes, given to add(vertex, quadric) in the order a pass over the faces sums
+  // them (twin: CollapseMesh::twin_faces).
+  template <typename Add>
+  void face_planes(const CollapseMesh& mesh, const std::vector<FaceId>& twin, FaceId f,
+                   Add add) const;
+  // Every vertex's quadric summed from its own fan, in `loops`' chunks; false (quadrics
+  // incomplete) when a fan is not in increasing face order, as a mesh lists it when built.
+  bool sum_by_vertex(const CollapseMesh& mesh, const std::vector<FaceId>& twin,
+                     ChunkedLoops& loops);
   // Where the collapse of the edge (pa, pb) with quadric q puts its survivor.
   Vec3 place(const Quadric& q, const Vec3& pa, const Vec3& pb) const;
   // The minimiser of `total` among the placements that meet the constraints the options ask
