@@ -3,6 +3,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 
@@ -12,29 +13,14 @@ namespace parapm {
 
 // ---- ByteWriter ---------------------------------------------------------------------------
 
-ByteWriter::ByteWriter(std::ostream* out) : out_(out), crc_(crc32(0L, Z_NULL, 0)) {
-  buffer_.reserve(kBufferSize);
-}
+ByteWriter::ByteWriter(std::ostream* out)
+    : out_(out), buffer_(new char[kBufferSize]), crc_(crc32(0L, Z_NULL, 0)) {}
 
 // Bytes not flush()ed are dropped: a writer abandoned by an exception leaves no half record.
 ByteWriter::~ByteWriter() = default;
 
-void ByteWriter::u32(uint32_t v) {
-  for (int k = 0; k < 4; ++k) u8(uint8_t(v >> (8 * k)));
-}
-void ByteWriter::u64(uint64_t v) {
-  for (int k = 0; k < 8; ++k) u8(uint8_t(v >> (8 * k)));
-}
 void ByteWriter::f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
 void ByteWriter::f64(double v) { u64(std::bit_cast<uint64_t>(v)); }
-
-void ByteWriter::varint(uint64_t v) {
-  while (v >= 0x80) {
-    u8(uint8_t(v | 0x80));
-    v >>= 7;
-  }
-  u8(uint8_t(v));
-}
 
 size_t ByteWriter::varint_size(uint64_t v) {
   size_t size = 1;
@@ -48,19 +34,20 @@ size_t ByteWriter::varint_size(uint64_t v) {
 void ByteWriter::bytes(const void* data, size_t size) {
   const char* p = static_cast<const char*>(data);
   while (size > 0) {
-    if (buffer_.size() == kBufferSize) flush_buffer();
-    const size_t n = std::min(size, kBufferSize - buffer_.size());
-    buffer_.append(p, n);
+    room(1);
+    const size_t n = std::min(size, kBufferSize - used_);
+    std::memcpy(buffer_.get() + used_, p, n);
+    used_ += n;
     p += n;
     size -= n;
   }
 }
 
 void ByteWriter::update_crc() {
-  if (crc_done_ < buffer_.size())
-    crc_ = crc32(crc_, reinterpret_cast<const Bytef*>(buffer_.data() + crc_done_),
-                 uInt(buffer_.size() - crc_done_));
-  crc_done_ = buffer_.size();
+  if (crc_done_ < used_)
+    crc_ = crc32(crc_, reinterpret_cast<const Bytef*>(buffer_.get() + crc_done_),
+                 uInt(used_ - crc_done_));
+  crc_done_ = used_;
 }
 
 uint32_t ByteWriter::crc() {
@@ -75,9 +62,9 @@ void ByteWriter::reset_crc() {
 
 void ByteWriter::flush_buffer() {
   update_crc();
-  if (out_) out_->write(buffer_.data(), std::streamsize(buffer_.size()));
-  flushed_ += buffer_.size();
-  buffer_.clear();
+  if (out_) out_->write(buffer_.get(), std::streamsize(used_));
+  flushed_ += used_;
+  used_ = 0;
   crc_done_ = 0;
 }
 

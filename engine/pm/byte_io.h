@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <istream>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -20,26 +21,40 @@ namespace parapm {
 class ByteWriter {
  public:
   // `out` may be null: the writer then only counts bytes (and computes the CRC). Nothing
-  // reaches `out` before flush() except whole 64 KiB buffers.
+  // reaches `out` before flush() except full buffers (64 KiB, less at most the 9 bytes a
+  // number needed that did not fit).
   explicit ByteWriter(std::ostream* out);
   ~ByteWriter();
   ByteWriter(const ByteWriter&) = delete;
   ByteWriter& operator=(const ByteWriter&) = delete;
 
   void u8(uint8_t v) {
-    if (buffer_.size() == kBufferSize) flush_buffer();
-    buffer_.push_back(char(v));
+    room(1);
+    buffer_[used_++] = char(v);
   }
-  void u32(uint32_t v);
-  void u64(uint64_t v);
+  void u32(uint32_t v) {
+    room(4);
+    for (int k = 0; k < 4; ++k) buffer_[used_++] = char(v >> (8 * k));
+  }
+  void u64(uint64_t v) {
+    room(8);
+    for (int k = 0; k < 8; ++k) buffer_[used_++] = char(v >> (8 * k));
+  }
   void f32(float v);
   void f64(double v);
-  void varint(uint64_t v);
+  void varint(uint64_t v) {
+    room(10);
+    while (v >= 0x80) {
+      buffer_[used_++] = char(v | 0x80);
+      v >>= 7;
+    }
+    buffer_[used_++] = char(v);
+  }
   void zigzag32(int32_t v) { varint((uint32_t(v) << 1) ^ uint32_t(v >> 31)); }
   void zigzag64(int64_t v) { varint((uint64_t(v) << 1) ^ uint64_t(v >> 63)); }
   void bytes(const void* data, size_t size);
 
-  uint64_t offset() const { return flushed_ + buffer_.size(); }
+  uint64_t offset() const { return flushed_ + used_; }
   // CRC-32 of the bytes written since construction or the last reset_crc().
   uint32_t crc();
   void reset_crc();
@@ -50,11 +65,16 @@ class ByteWriter {
 
  private:
   static constexpr size_t kBufferSize = 1 << 16;
+  // Flushes the buffer unless it has room for n more bytes.
+  void room(size_t n) {
+    if (kBufferSize - used_ < n) flush_buffer();
+  }
   void update_crc();
   void flush_buffer();
 
   std::ostream* out_;
-  std::string buffer_;
+  std::unique_ptr<char[]> buffer_;
+  size_t used_ = 0;      // bytes in buffer_
   size_t crc_done_ = 0;  // buffer_ bytes already in crc_
   uint64_t flushed_ = 0;
   unsigned long crc_;
