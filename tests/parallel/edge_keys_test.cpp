@@ -172,9 +172,10 @@ TEST(DeferredEdges, ARunGivenTheDeferredEdgesQueuesThemUncosted) {
   for (size_t i = 0; i < deferred.size(); ++i) {
     const DeferredEdge& d = deferred[i];
     ASSERT_TRUE(d.a < d.b && !std::isnan(d.key)) << i;
-    if (i > 0)
+    if (i > 0) {
       ASSERT_TRUE(deferred[i - 1].a < d.a || (deferred[i - 1].a == d.a && deferred[i - 1].b < d.b))
           << "sorted, once each: " << i;
+    }
     const EdgeFaces e = mesh.edge_faces(d.a, d.b);
     ASSERT_TRUE(mesh.vertex_alive(d.a) && mesh.vertex_alive(d.b) &&
                 (e.left != kNoId || e.right != kNoId))
