@@ -8,7 +8,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${PARAPM_BUILD_DIR:-$root/build}"
 
 pkgs=(cmake ninja-build g++ ccache libeigen3-dev libspdlog-dev libfmt-dev libcli11-dev
-      nlohmann-json3-dev zlib1g-dev libgrpc++-dev libprotobuf-dev protobuf-compiler
+      nlohmann-json3-dev zlib1g-dev libdeflate-dev libgrpc++-dev libprotobuf-dev protobuf-compiler
       protobuf-compiler-grpc libsqlite3-dev libssl-dev libgtest-dev libgmock-dev
       pkg-config libcpp-httplib-dev prometheus-cpp-dev libopenmesh-dev python3 python3-grpcio
       python3-protobuf chromium)

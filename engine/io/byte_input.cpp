@@ -1,5 +1,6 @@
 #include "io/byte_input.h"
 
+#include <libdeflate.h>
 #include <sys/stat.h>
 #include <zlib.h>
 
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 
 #include "util/error.h"
 
@@ -79,8 +81,10 @@ uint64_t declared_size(std::string_view compressed) {
          uint64_t(tail[3]) << 24;
 }
 
-std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes,
-                   const StartCheck& check_start) {
+// Inflates with zlib's stream, member after member, checking the limit as the output grows:
+// the reference path, and the one that names the offset of what is wrong.
+std::string gunzip_stream(std::string_view compressed, const std::string& name, uint64_t max_bytes,
+                          const StartCheck& check_start) {
   z_stream zs{};
   // 15 + 16: gzip wrapper only (zlib or raw deflate data is not accepted as .gz).
   if (inflateInit2(&zs, 15 + 16) != Z_OK)
@@ -160,6 +164,57 @@ std::string gunzip(std::string_view compressed, const std::string& name, uint64_
   out.resize(size_t(out_pos));
   check_once(out_pos);
   return out;
+}
+
+// The first kStartCheckBytes inflated bytes, or the whole output when the only member ends
+// before them; empty when zlib's stream would give the check something else (the data is
+// corrupt or cut short there, or another member follows), which gunzip_stream then decides.
+std::optional<std::string> inflated_start(std::string_view compressed) {
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 16) != Z_OK) return std::nullopt;
+  std::string start(size_t(kStartCheckBytes), '\0');
+  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
+  zs.avail_in = uInt(std::min<uint64_t>(kZlibSlice, compressed.size()));
+  zs.next_out = reinterpret_cast<Bytef*>(start.data());
+  zs.avail_out = uInt(start.size());
+  const int rc = inflate(&zs, Z_SYNC_FLUSH);
+  const bool whole = rc == Z_STREAM_END && zs.avail_in == 0 && compressed.size() <= kZlibSlice;
+  const bool full = (rc == Z_OK || rc == Z_BUF_ERROR) && zs.avail_out == 0;
+  start.resize(start.size() - zs.avail_out);
+  inflateEnd(&zs);
+  if (!whole && !full) return std::nullopt;
+  return start;
+}
+
+// libdeflate in one call, into a buffer of the size the trailer declares: about three times
+// as fast as zlib's stream. Empty when it does not apply: a declared size above the limit,
+// several members, data that does not inflate to exactly the declared size, corrupt data.
+std::optional<std::string> gunzip_whole(std::string_view compressed, uint64_t max_bytes) {
+  const uint64_t declared = declared_size(compressed);
+  if (compressed.size() < 18 || declared > max_bytes) return std::nullopt;
+  std::string out(size_t(declared), '\0');
+  libdeflate_decompressor* decompressor = libdeflate_alloc_decompressor();
+  if (!decompressor) return std::nullopt;
+  size_t in_bytes = 0, out_bytes = 0;
+  const libdeflate_result rc =
+      libdeflate_gzip_decompress_ex(decompressor, compressed.data(), compressed.size(), out.data(),
+                                    out.size(), &in_bytes, &out_bytes);
+  libdeflate_free_decompressor(decompressor);
+  if (rc != LIBDEFLATE_SUCCESS || in_bytes != compressed.size() || out_bytes != out.size())
+    return std::nullopt;
+  return out;
+}
+
+std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes,
+                   const StartCheck& check_start) {
+  if (max_bytes < kStartCheckBytes) return gunzip_stream(compressed, name, max_bytes, check_start);
+  if (check_start) {
+    const std::optional<std::string> start = inflated_start(compressed);
+    if (!start) return gunzip_stream(compressed, name, max_bytes, check_start);
+    check_start(*start);
+  }
+  if (std::optional<std::string> whole = gunzip_whole(compressed, max_bytes)) return *whole;
+  return gunzip_stream(compressed, name, max_bytes, {});
 }
 
 }  // namespace parapm::io

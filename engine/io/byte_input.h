@@ -19,7 +19,9 @@ bool is_gzip(std::string_view bytes);
 // Inflates gzip data, concatenated members too (as `cat a.gz b.gz` or pigz produce). The
 // output never grows beyond max_bytes + 1 bytes: passing max_bytes is kResourceExhausted as
 // soon as it happens, so a gzip bomb costs at most the limit. Corrupt or truncated data is
-// kInvalidInput naming `name` and the compressed byte offset.
+// kInvalidInput naming `name` and the compressed byte offset. One member whose trailer
+// declares a size within the limit is inflated by libdeflate in one call (about three times
+// as fast as zlib's stream); anything else, or a call that fails, by zlib's stream.
 //
 // `check_start`, when given, is called once with the first kStartCheckBytes inflated bytes
 // (fewer when the data is shorter) before more is inflated, and throws to stop there: a file
