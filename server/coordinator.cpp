@@ -268,6 +268,7 @@ parapm::v1::Job Coordinator::cancel(const std::string& job_id) {
     record.updated_unix_ms = unix_ms_now();
     parapm::v1::JobEvent event;
     event.mutable_cancelled();
+    metrics_.jobs_ended.Add({{"state", "cancelled"}}).Increment();
     end_job(record, event);
     spdlog::info("job {}: cancelled while queued", job_id);
   }

@@ -123,6 +123,39 @@ TEST_F(Metrics, ScrapedDuringAndAfterARealJobTheyCountWhatHappened) {
   EXPECT_EQ(w["parapm_worker_subsets_running"], 0);
 }
 
+// A job cancelled before it started ended too: counted like one cancelled while it ran.
+TEST_F(Metrics, AJobCancelledWhileQueuedIsCountedAsEnded) {
+  const auto upload = service().upload_file(mesh("cad-cycloidal-43k.ply"));
+  std::vector<std::string> ids;
+  for (int i = 0; i < 3; ++i)
+    ids.push_back(
+        service().submit(upload.mesh_id(), options(4, parapm::v1::METRIC_ENERGY, 0.05)).job_id());
+  // Two are built at once (--max-running-jobs' default): the third waits in the queue.
+  std::string queued;
+  for (int i = 0; i < 200 && queued.empty(); ++i) {
+    for (const std::string& id : ids)
+      if (service().get_job(id).state() == parapm::v1::QUEUED) queued = id;
+    if (queued.empty()) std::this_thread::sleep_for(milliseconds(10));
+  }
+  ASSERT_FALSE(queued.empty()) << "no job waited in the queue";
+  service().cancel_job(queued);
+  EXPECT_EQ(service().wait_for_job(queued, seconds(10)).state(), parapm::v1::CANCELLED);
+  EXPECT_EQ(scrape(*coordinator_)["parapm_jobs_ended_total{state=\"cancelled\"}"], 1);
+  double ended = 1;
+  for (const std::string& id : ids) {
+    if (id == queued) continue;
+    service().cancel_job(id);
+    const parapm::v1::JobState state = service().wait_for_job(id, seconds(120)).state();
+    EXPECT_TRUE(state == parapm::v1::CANCELLED || state == parapm::v1::DONE) << state;
+    ++ended;
+  }
+  const auto c = scrape(*coordinator_);
+  EXPECT_EQ(c.at("parapm_jobs_ended_total{state=\"cancelled\"}") +
+                c.at("parapm_jobs_ended_total{state=\"done\"}"),
+            ended);
+  EXPECT_EQ(c.at("parapm_queue_depth"), 0);
+}
+
 TEST_F(Metrics, AScrapeWithoutTheTokenIsRefused) {
   for (httplib::Client* client : {coordinator_.get(), worker_client_.get()}) {
     const auto bare = client->Get("/metrics");
