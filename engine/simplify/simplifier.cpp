@@ -466,7 +466,6 @@ void Simplifier::build_first_queue(const SimplifierLimits& limits, const CancelT
   if (limits.first_queue_around) {
     queue_edges_around(*limits.first_queue_around, cancel);
   } else {
-    queue_.reserve(mesh_.face_capacity() * 3);
     const std::vector<DeferredEdge>* hints = defer_ && limits.first_deferred &&
                                                      !limits.first_deferred->empty() &&
                                                      mesh_.live_faces() > limits.defer_above_faces

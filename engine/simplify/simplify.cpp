@@ -12,6 +12,7 @@
 #include "simplify/simplifier.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/memory.h"
 #include "util/number_text.h"
 
 namespace parapm {
@@ -118,6 +119,7 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
   limits.target_faces = target_face_count(mesh.face_count(), options);
   if (options.defer_recosting) limits.defer_above_faces = defer_recosting_line(mesh.face_count());
   const auto records = simplifier.run(limits, progress, cancel);
+  release_free_memory();  // what the run freed (its queue's ranges), before the PM's arrays
 
   PmBuildOptions build_options;
   build_options.keep_order = options.keep_order;
