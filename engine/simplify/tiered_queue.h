@@ -136,10 +136,14 @@ class TieredQueue {
       threshold_ = std::numeric_limits<float>::infinity();
       return;
     }
+    // Every stride-th item (blocks hold fewer than kBlock once remove_if has run).
     const size_t stride = count / kSample;
     sample_.clear();
-    for (size_t i = 0; i < kSample; ++i)
-      sample_.push_back(blocks[i * stride / kBlock][i * stride % kBlock].cost);
+    size_t block = 0, before = 0;  // the block holding item i * stride, and the items before it
+    for (size_t i = 0; i < kSample; ++i) {
+      while (i * stride >= before + blocks[block].size()) before += blocks[block++].size();
+      sample_.push_back(blocks[block][i * stride - before].cost);
+    }
     std::sort(sample_.begin(), sample_.end());
     for (size_t k = 1; k < kParts; ++k) {
       const float bound = sample_[k * kSample / kParts - 1];
