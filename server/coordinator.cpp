@@ -259,7 +259,7 @@ parapm::v1::Job Coordinator::cancel(const std::string& job_id) {
       it->second->cancel.cancel();
       spdlog::info("job {}: cancel requested while running", job_id);
     } else if (record.status == JobStatus::kQueued) {
-      std::erase(queue_, job_id);
+      std::erase(queue_, job_id);  // (not there: the job waits for the next start)
       cancelled_queued = true;
     }
   }
@@ -438,19 +438,29 @@ std::shared_ptr<const LoadedPm> Coordinator::pm(const std::string& job_id) {
 void Coordinator::scheduler_loop() {
   while (true) {
     std::string job_id;
+    std::shared_ptr<Running> running;
     {
       std::unique_lock lock(mutex_);
       queue_changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
       if (stopping_) return;
       job_id = queue_.front();
       queue_.pop_front();
+      // Off the queue and among the running in one step: a cancel finds the job in one or the
+      // other (a job cancelled between the two was started all the same).
+      running = std::make_shared<Running>();
+      running_[job_id] = running;
     }
     try {
-      run_job(job_id);
+      run_job(job_id, *running);
     } catch (const std::exception& e) {
       // Only the store failing gets here: the job stays as the database has it.
       spdlog::error("job {}: {}", job_id, e.what());
     }
+    {
+      std::lock_guard lock(mutex_);
+      running_.erase(job_id);
+    }
+    give_back_free_memory();
   }
 }
 
@@ -469,14 +479,12 @@ void Coordinator::refresh_metrics() {
   metrics_.workers_registered.Set(double(registry_.live_count()));
 }
 
-void Coordinator::run_job(const std::string& job_id) {
+void Coordinator::run_job(const std::string& job_id, Running& running) {
   JobRecord record = load_job(job_id);
   if (record.status != JobStatus::kQueued) return;  // cancelled meanwhile
-  auto running = std::make_shared<Running>();
   {
     std::lock_guard lock(mutex_);
-    if (stopping_) return;
-    running_[job_id] = running;
+    if (stopping_) return;  // still queued: the next start runs it
   }
   record.status = JobStatus::kRunning;
   ++record.attempts;
@@ -485,7 +493,7 @@ void Coordinator::run_job(const std::string& job_id) {
   const auto start = std::chrono::steady_clock::now();
   try {
     parapm::v1::JobEvent::Transport transport;
-    execute(record, *running, transport);
+    execute(record, running, transport);
     record.status = JobStatus::kDone;
     record.seconds = seconds_since(start);
     record.updated_unix_ms = unix_ms_now();
@@ -538,11 +546,6 @@ void Coordinator::run_job(const std::string& job_id) {
     end_job(record, event);
     spdlog::error("job {} failed: {}", job_id, record.failure_reason);
   }
-  {
-    std::lock_guard lock(mutex_);
-    running_.erase(job_id);
-  }
-  give_back_free_memory();
 }
 
 void Coordinator::execute(JobRecord& record, Running& running,

@@ -145,7 +145,8 @@ class Coordinator {
   // Removes the blobs no row names (committed more than a minute ago: a blob is written
   // before its row).
   DeleteResult collect_garbage();
-  void run_job(const std::string& job_id);
+  // Builds a job the scheduler took off the queue and listed in running_ (`running`).
+  void run_job(const std::string& job_id, Running& running);
   void execute(JobRecord& record, Running& running, parapm::v1::JobEvent::Transport& transport);
   void emit(const std::string& job_id, parapm::v1::JobEvent event);
   // Stores the job's final state and its terminal event together (JobStore::end_job).
