@@ -446,7 +446,7 @@ void Coordinator::scheduler_loop() {
       job_id = queue_.front();
       queue_.pop_front();
       // Off the queue and among the running in one step: a cancel finds the job in one or the
-      // other (a job cancelled between the two was started all the same).
+      // other, never between them.
       running = std::make_shared<Running>();
       running_[job_id] = running;
     }
