@@ -41,7 +41,6 @@ class QuadHeap {
  public:
   bool empty() const { return items_.empty(); }
   size_t size() const { return items_.size(); }
-  void reserve(size_t n) { items_.reserve(n); }
   void clear() { items_.clear(); }
   // Edit freely, then call rebuild().
   std::vector<T, ChildLineAllocator<T>>& items() { return items_; }
