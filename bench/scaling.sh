@@ -13,8 +13,11 @@
 # and their ratio.
 # The large meshes: `build/bin/parapm-tile MESH OUT.ply --grid 2x2` (bench/tile_mesh.cpp), e.g.
 # the 871k dragon tiled 2 x 2 (3.49M faces).
-# Environment: METRICS, PS, RATIO, REPEATS, THREADS, BENCH_OUT (default ./bench-out-scaling),
-# PARAPM_BUILD_DIR (default build/).
+# ALL_ALIVE=1: every p on p threads with the process told it has p cores (the preloaded
+# build/bin/libparapm-cores.so, bench/cores_shim.cpp), so that every job of a round is alive at
+# once as on a p-core machine: for its peak memory; its times mean nothing on fewer cores.
+# Environment: METRICS, PS, RATIO, REPEATS, THREADS, ALL_ALIVE, BENCH_OUT (default
+# ./bench-out-scaling), PARAPM_BUILD_DIR (default build/).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 # shellcheck source=bench/common.sh
@@ -29,12 +32,19 @@ out="${BENCH_OUT:-$PWD/bench-out-scaling}"
 bin="$(parapm_program "$root")"
 command -v jq > /dev/null || { echo "$0 needs jq" >&2; exit 2; }
 mkdir -p "$out"
+cores_shim="$(dirname "$bin")/libparapm-cores.so"
+if [[ "${ALL_ALIVE:-0}" == 1 && ! -f "$cores_shim" ]]; then
+  echo "ALL_ALIVE=1 needs $cores_shim (build the parapm-cores target)" >&2
+  exit 2
+fi
 
-# One run: prints "wall_seconds json" (the --json object on one line).
+# One run: prints "wall_seconds json" (the --json object on one line). With FAKE_CORES set,
+# the process sees that many cores.
 timed_run() {
-  local t0 t1 json
+  local t0 t1 json preload=()
+  [[ -n "${FAKE_CORES:-}" ]] && preload=(env "LD_PRELOAD=$cores_shim" "FAKE_CORES=$FAKE_CORES")
   t0=$(date +%s.%N)
-  json="$("$bin" --log-level warn simplify "$@" --ratio "$ratio" --json | jq -c 'del(.parallel.round_stats)')"
+  json="$("${preload[@]}" "$bin" --log-level warn simplify "$@" --ratio "$ratio" --json | jq -c 'del(.parallel.round_stats)')"
   t1=$(date +%s.%N)
   echo "$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }') $json"
 }
@@ -60,8 +70,10 @@ for mesh in "$@"; do
       seq_peaks+=("$(jq -r .peak_memory_bytes <<< "$seq_json")")
       for p in $ps; do
         echo "[scaling] $name $metric p=$p" >&2
-        read -r par_wall par_json <<< "$(timed_run "$mesh" -o "$out/$name.$metric.p$p.pm" \
-          --metric "$metric" --parallel "$p" "${thread_opt[@]}")"
+        fake_cores="" opts=("${thread_opt[@]}")
+        if [[ "${ALL_ALIVE:-0}" == 1 ]]; then fake_cores="$p" opts=(--threads "$p"); fi
+        read -r par_wall par_json <<< "$(FAKE_CORES="$fake_cores" timed_run "$mesh" \
+          -o "$out/$name.$metric.p$p.pm" --metric "$metric" --parallel "$p" "${opts[@]}")"
         walls[$p]+=" $par_wall"
         speedups[$p]+=" $(ratio_of "$seq_wall" "$par_wall")"
         peaks[$p]+=" $(jq -r .peak_memory_bytes <<< "$par_json")"

@@ -107,7 +107,10 @@ int run_simplify(const SimplifyArgs& args) {
   repair_options.keep_unreferenced = args.keep_order;  // the input's numbering needs them
   // A parallel build reads and repairs in p chunks on its threads too.
   ChunkedLoops loops(args.parallel, args.threads);
-  if (args.parallel > 1) repair_options.loops = &loops;
+  if (args.parallel > 1) {
+    repair_options.loops = &loops;
+    map_large_blocks_alone();
+  }
   LoadedMesh loaded = load_and_repair(args.input, repair_options);
 
   SimplifyOptions options;
@@ -313,7 +316,8 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--threads", args->threads,
                   "With --parallel: threads of the pool, which also read, repair and set up in "
-                  "P chunks (0: min(P, hardware threads)); the .pm does not depend on it")
+                  "P chunks, and share the energy's last collapses (0: min(P, hardware "
+                  "threads)); the .pm does not depend on it")
       ->capture_default_str();
   cmd->add_option("--rounds", args->rounds,
                   "With --parallel: parallel rounds, each on a new partition (the borders "

@@ -1,7 +1,5 @@
 #include "coordinator.h"
 
-#include <malloc.h>
-
 #include <chrono>
 #include <sstream>
 
@@ -15,6 +13,7 @@
 #include "storage/ids.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/memory.h"
 
 namespace parapm::service {
 namespace {
@@ -23,7 +22,7 @@ namespace {
 // large mesh) is freed in blocks glibc keeps for reuse in its per-thread arenas; give the
 // free pages back to the system, so that an idle coordinator's memory falls back near where
 // it started.
-void give_back_free_memory() { ::malloc_trim(0); }
+void give_back_free_memory() { release_free_memory(); }
 
 parapm::v1::JobState state_of(JobStatus status) {
   switch (status) {

@@ -16,6 +16,7 @@
 #include "mesh_service.h"
 #include "rpc_server.h"
 #include "storage/blob_store.h"
+#include "util/memory.h"
 #include "viewer_http.h"
 
 namespace {
@@ -138,6 +139,7 @@ int run(CoordinatorArgs args) {
 
 int main(int argc, char** argv) {
   parapm::rpc::block_shutdown_signals();
+  parapm::map_large_blocks_alone();  // jobs run on pools of threads
   CoordinatorArgs args;
   CLI::App app{
       "parapm-coordinator: the ParaPM service. Clients upload meshes and submit jobs (parapm "

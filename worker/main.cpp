@@ -14,6 +14,7 @@
 #include "metrics.h"
 #include "rpc_server.h"
 #include "subset_service.h"
+#include "util/memory.h"
 #include "worker_metrics.h"
 
 namespace {
@@ -80,6 +81,7 @@ int run(const WorkerArgs& args) {
 
 int main(int argc, char** argv) {
   parapm::rpc::block_shutdown_signals();
+  parapm::map_large_blocks_alone();  // jobs run on pools of threads
   WorkerArgs args;
   CLI::App app{
       "parapm-worker: simplifies subsets of meshes for a ParaPM coordinator. It listens for the "

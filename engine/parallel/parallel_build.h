@@ -81,6 +81,10 @@ struct ParallelOptions {
   // With carry_keys, the edges the jobs left deferred travel too (SubsetJob::deferred),
   // deferred again as the sequential build would hold them. Off: for measuring what it saves.
   bool carry_deferred = true;
+  // A band pass's or the final pass's collapse that moves at least this many of the energy's
+  // points projects them on a team of p chunks on the pool's threads (the same PM: fewer take
+  // less time than waking the team does); 0: none.
+  uint32_t team_min_points = 512;
   // Tests only: the master follows each round by re-running its module's collapsed() on every
   // merged record (the first step's path) instead of importing the jobs' returned states.
   bool replay_state = false;

@@ -373,6 +373,10 @@ void ParallelBuilder::set_up() {
   whole_.emplace(mesh_, loops);
   CollapseMesh& whole = *whole_;
   master_ = make_priority_module(options_, mesh_, locked_);
+  if (master_->costly() && requested_.team_min_points > 0) {
+    team_.emplace(requested_.subsets, requested_.threads, requested_.team_min_points);
+    master_->use_team(&*team_);
+  }
   parallel_ = with_metric_floor(requested_, *master_);
   // The first round's partition needs the mesh only: it is drawn beside the master's
   // initialisation, which reads `whole` too (none through its marks).
@@ -883,6 +887,7 @@ void ParallelBuilder::band_pass(Round& r) {
   RoundStats& rs = r.rs;
   CollapseMesh& whole = *whole_;
   const auto t = std::chrono::steady_clock::now();
+  double team_saved = 0;  // what the team's chunks save with a core each
   if (parallel_.band_pass && rs.round >= 1) {
     const LoopClock prepared_clock(master_loops_);
     // The last round's bound vertices become the lagging ones: bound in this round too.
@@ -922,6 +927,7 @@ void ParallelBuilder::band_pass(Round& r) {
     next_options.loops = &master_loops_;
     const double prepared = prepared_clock.critical_seconds();
     double partition_seconds = 0;
+    const double team_before = team_saving();
     const Beside timed =
         run_beside(parallel_.threads, [&] { band_records = pass.run(band_limits, {}, cancel_); },
                    {[this] { append_pending(); },
@@ -931,9 +937,10 @@ void ParallelBuilder::band_pass(Round& r) {
                         foreseen_.vertex_subset = partition_copy(copy, next.subsets, next_options);
                       partition_seconds = clock.critical_seconds();
                     }});
+    team_saved = team_saving() - team_before;
     foreseen_.beside_band = true;
     foreseen_.drawn = next.go;
-    foreseen_.band_seconds = prepared + timed.work_seconds - foreseen_.copy_seconds;
+    foreseen_.band_seconds = prepared + timed.work_seconds - team_saved - foreseen_.copy_seconds;
     foreseen_.append_seconds = timed.side_seconds[0];
     foreseen_.partition_seconds = partition_seconds;
     subsets_cpu_ += timed.side_cpu_elsewhere;
@@ -943,7 +950,7 @@ void ParallelBuilder::band_pass(Round& r) {
     records_.insert(records_.end(), std::make_move_iterator(band_records.begin()),
                     std::make_move_iterator(band_records.end()));
   }
-  rs.band_pass_seconds = seconds_since(t);
+  rs.band_pass_seconds = seconds_since(t) - team_saved;
   // With one thread, the band pass's time holds the append's and the partition's, which the
   // critical path counts, beyond the band pass, in the next round (or forgo_foreseen), and
   // the copy, counted with the partition.
@@ -1001,12 +1008,13 @@ void ParallelBuilder::final_pass() {
     if (progress_) progress_(std::min<uint64_t>(done_before + done, total), total);
   };
   // The last round's records go into records_ beside it (append_pending).
+  const double team_before = team_saving();
   const Beside timed =
       run_beside(parallel_.threads, [&] { final_records = pass.run(limits, progress, cancel_); },
                  {[this] { append_pending(); }});
-  st_.final_work_seconds = timed.work_seconds;
+  st_.final_work_seconds = timed.work_seconds - (team_saving() - team_before);
   st_.final_pass_collapses = final_records.size();
-  st_.final_pass_seconds = setup_seconds + timed.work_seconds;
+  st_.final_pass_seconds = setup_seconds + st_.final_work_seconds;
   st_.final_append_seconds = timed.side_seconds[0];
   subsets_cpu_ += timed.side_cpu_elsewhere;
   st_.stop_reason = pass.stats().stop_reason;
@@ -1034,7 +1042,8 @@ ProgressiveMesh ParallelBuilder::progressive_mesh() {
   st_.collapses = records_.size();
   st_.critical_path_seconds = critical_path_seconds(st_);
   st_.seconds = seconds_since(start_);
-  st_.cpu_seconds = subsets_cpu_ + (thread_cpu_seconds() - master_cpu_start_);
+  st_.cpu_seconds = subsets_cpu_ + (team_ ? team_->worker_cpu_seconds() : 0) +
+                    (thread_cpu_seconds() - master_cpu_start_);
   // The master's: band passes and final pass.
   const uint64_t master_costings = master_->costings() - master_sample_costings_;
   st_.costings = job_costings_ + sample_costings_ + master_costings;

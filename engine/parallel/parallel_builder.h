@@ -22,6 +22,7 @@
 #include "parallel/parallel_build.h"
 #include "simplify/collapse_mesh.h"
 #include "simplify/copy_groups.h"
+#include "util/thread_team.h"
 
 namespace parapm {
 
@@ -91,6 +92,9 @@ class ParallelBuilder {
   // band pass outlasted it.
   void forgo_foreseen();
   void append_pending();
+  // What the team's loops so far took beyond their time with a core per chunk (seconds): the
+  // critical path counts the latter.
+  double team_saving() const { return team_ ? team_->seconds() - team_->critical_seconds() : 0; }
   std::shared_ptr<const std::vector<uint32_t>> whole_components();
 
   // The build's inputs.
@@ -109,6 +113,10 @@ class ParallelBuilder {
   // 0, runs on one thread of its own), each round's owned vertices, the band pass's lagging
   // vertices and the PM's assembly.
   ChunkedLoops master_loops_;
+  // The band passes' and the final pass's collapses that split into independent pieces (the
+  // energy's point projections: PriorityModule::use_team), in p chunks on threads that wait
+  // between collapses. A costly metric's only.
+  std::optional<ThreadTeam> team_;
   SubsetRunner* runner_;
   const ParallelEvents& events_;
   const std::chrono::steady_clock::time_point start_;

@@ -69,6 +69,13 @@ class EnergyEvaluator {
   void forget(FaceId f) {
     if (!moments_ready_.empty()) moments_ready_[f] = 0;
   }
+  // forget(f), then f's moments computed now rather than at its next costing (the same
+  // values): for a collapse's faces on the team's threads, one face per thread at a time.
+  void recompute(FaceId f) {
+    if (moments_ready_.empty()) return;
+    moments_ready_[f] = 0;
+    moments_of(f);
+  }
   double corners_moved(FaceId f);
   void release();
 

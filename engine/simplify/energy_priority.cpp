@@ -15,6 +15,7 @@
 #include "simplify/surface_samples.h"
 #include "simplify/vec_math.h"
 #include "util/error.h"
+#include "util/thread_team.h"
 
 namespace parapm {
 namespace {
@@ -221,20 +222,47 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
     }
   }
   prepare_fan(mesh, done.vs);
-  moved_.faces.resize(moved_.points.size());
-  moved_.bary.resize(moved_.points.size());
+  const size_t moving = moved_.points.size();
+  moved_.faces.resize(moving);
+  moved_.bary.resize(moving);
+  // Each point's face and projection, independent of the others': on the team when there
+  // are enough of them.
+  moved_.in_fan.resize(moving);
+  auto project = [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      FacePoint& point = moved_.points[i];
+      const auto [j, best] = closest_fan_face(mesh, faces, point, moved_.homes[i]);
+      moved_.in_fan[i] = j;
+      moved_.faces[i] = faces[j];
+      moved_.bary[i] = best.bary;
+      point.distance_sq = best.distance_sq;
+    }
+  };
   // Last point first: each face then lists its points newest first (see initialize()).
-  for (size_t i = moved_.points.size(); i-- > 0;) {
-    FacePoint& point = moved_.points[i];
-    const auto [j, best] = closest_fan_face(mesh, faces, point, moved_.homes[i]);
-    const FaceId face = faces[j];
-    moved_.faces[i] = face;
-    moved_.bary[i] = best.bary;
-    point.distance_sq = best.distance_sq;
-    face_points_[face].push_back(point);
-    evaluator_.forget(face);
-    max_distance_sq = std::max(max_distance_sq, best.distance_sq);
+  if (team_ && moving >= team_->min_items()) {
+    team_->run(moving, project);
+    // By face on the team: its points, then its moments, which the next costings of the
+    // edges around vs need (a star this rich is costed on them).
+    team_->run(faces.size(), [&](size_t begin, size_t end) {
+      for (size_t j = begin; j < end; ++j) {
+        bool gained = false;
+        for (size_t i = moving; i-- > 0;)
+          if (moved_.in_fan[i] == int(j)) {
+            face_points_[faces[j]].push_back(moved_.points[i]);
+            gained = true;
+          }
+        if (gained) evaluator_.recompute(faces[j]);
+      }
+    });
+  } else {
+    project(0, moving);
+    for (size_t i = moving; i-- > 0;) {
+      face_points_[moved_.faces[i]].push_back(moved_.points[i]);
+      evaluator_.forget(moved_.faces[i]);
+    }
   }
+  for (const FacePoint& point : moved_.points)
+    max_distance_sq = std::max(max_distance_sq, point.distance_sq);
   if (scalar_.enabled()) update_attributes(mesh, done, edge);
   // The largest distance of the star's points, where the evaluation may have looked at a
   // subset.

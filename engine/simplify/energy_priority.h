@@ -176,6 +176,9 @@ class EnergyPriority : public PriorityModule {
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override { return evaluator_.costings(); }
   void release_caches() override { evaluator_.release(); }
+  // A collapse moving at least the team's min_items() points projects them, and lists them
+  // and sums their moments by face, on the team.
+  void use_team(ThreadTeam* team) override { team_ = team; }
 
   // State export/import for the parallel construction (module_state.h). export_local: the
   // state of a job's faces and vertices (maps: its local -> global ids; the points on its
@@ -286,6 +289,7 @@ class EnergyPriority : public PriorityModule {
   std::vector<uint32_t> point_id_;  // a job's: per point, the master's id (empty: identity)
   bool star_terms_on_ = false;      // either of the star's weights is non-zero
   EnergyEvaluator evaluator_{*this};
+  ThreadTeam* team_ = nullptr;  // use_team
 
   // collapsed()'s working memory: the points it moves, where they go, the fan around vs.
   struct FanFace {
@@ -299,7 +303,8 @@ class EnergyPriority : public PriorityModule {
     std::vector<int> homes;
     std::vector<PreparedTriangle> prepared;  // vs's faces
     std::vector<FanFace> fan;
-    std::vector<FaceId> faces;                // per point, its new face
+    std::vector<int> in_fan;                  // per point, its new face's index among vs's
+    std::vector<FaceId> faces;                // and the face
     std::vector<std::array<double, 3>> bary;  // and its barycentric coordinates there
   };
   Reprojection moved_;

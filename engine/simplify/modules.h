@@ -12,6 +12,8 @@
 
 namespace parapm {
 
+class ThreadTeam;
+
 // The collapse of edge (vs, vt): vt is merged into vs, which moves to `position`.
 struct CollapseCandidate {
   VertexId vs = kNoId;
@@ -88,6 +90,10 @@ class PriorityModule {
   // throws). It lives while this one does and this one changes nothing meanwhile. Null (the
   // default, and a wrapper's): this module costs on one thread only.
   virtual std::unique_ptr<PriorityModule> costing_view() const { return nullptr; }
+  // Threads the module may use within collapsed() for work that splits into independent
+  // pieces (the energy's point projections), with the same results as on one thread; null
+  // (the default): none. The team outlives its use, which ends with use_team(nullptr).
+  virtual void use_team(ThreadTeam* /*team*/) {}
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every
@@ -100,6 +106,7 @@ class PriorityWrapper : public PriorityModule {
   bool costly() const override { return inner_.costly(); }
   uint64_t costings() const override { return inner_.costings(); }
   void release_caches() override { inner_.release_caches(); }
+  void use_team(ThreadTeam* team) override { inner_.use_team(team); }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override {

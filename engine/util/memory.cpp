@@ -37,4 +37,10 @@ void release_free_memory() {
 #endif
 }
 
+void map_large_blocks_alone() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
+}
+
 }  // namespace parapm

@@ -14,4 +14,11 @@ uint64_t current_memory_bytes();  // resident set now (VmRSS)
 // on the master's thread, come on top of it.
 void release_free_memory();
 
+// Has every block of 1 MiB or more mapped for itself and unmapped when freed (glibc: a fixed
+// M_MMAP_THRESHOLD; elsewhere nothing), for the rest of the process. For processes that build
+// on a pool of threads: glibc's default raises the threshold to the largest block freed (up to
+// 32 MiB), after which a job's large arrays, freed on a pool's thread, stay in that thread's
+// arena and the next job's come on top of them. The price: fresh pages for each large block.
+void map_large_blocks_alone();
+
 }  // namespace parapm

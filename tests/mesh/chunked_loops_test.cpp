@@ -5,30 +5,20 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "loop_ranges.h"
+
 namespace parapm {
 namespace {
-
-std::vector<std::pair<size_t, size_t>> ranges_of(ChunkedLoops& loops, size_t n) {
-  std::mutex m;
-  std::vector<std::pair<size_t, size_t>> ranges;
-  loops.run(n, [&](size_t begin, size_t end) {
-    std::lock_guard<std::mutex> lock(m);
-    ranges.emplace_back(begin, end);
-  });
-  std::sort(ranges.begin(), ranges.end());
-  return ranges;
-}
 
 TEST(ChunkedLoops, RangesCoverTheLoopInOrderAtMostChunksOfThemNoneBelowTheMinimum) {
   ChunkedLoops loops(5, 3, 10);
   for (size_t n : {0, 1, 19, 20, 49, 50, 1001}) {
-    const auto ranges = ranges_of(loops, n);
+    const auto ranges = testing::loop_ranges(loops, n);
     ASSERT_FALSE(ranges.empty()) << n;
     EXPECT_LE(ranges.size(), 5u) << n;
     EXPECT_EQ(ranges.front().first, 0u) << n;
@@ -38,10 +28,10 @@ TEST(ChunkedLoops, RangesCoverTheLoopInOrderAtMostChunksOfThemNoneBelowTheMinimu
       for (const auto& [begin, end] : ranges) EXPECT_GE(end - begin, 10u) << n;
     }
   }
-  EXPECT_EQ(ranges_of(loops, 1001).size(), 5u);
-  EXPECT_EQ(ranges_of(loops, 29).size(), 2u);
+  EXPECT_EQ(testing::loop_ranges(loops, 1001).size(), 5u);
+  EXPECT_EQ(testing::loop_ranges(loops, 29).size(), 2u);
   ChunkedLoops plain;
-  EXPECT_EQ(ranges_of(plain, 1000000).size(), 1u);
+  EXPECT_EQ(testing::loop_ranges(plain, 1000000).size(), 1u);
 }
 
 TEST(ChunkedLoops, ALoopCountsItsSlowestChunkOnTheCriticalPath) {

@@ -297,6 +297,31 @@ TEST(ParallelBuild, SameBytesWhateverTheThreadCount) {
   }
 }
 
+// The band passes' and the final pass's collapses that move many points project them, list
+// them and sum their moments on a team of threads (ParallelOptions::team_min_points): the
+// same PM whether every collapse does, none, or only the rich ones, on one thread or four;
+// and lossless. With colours, the points go where their attributes fit too (E_scalar).
+TEST(ParallelBuild, TheMastersTeamChangesNoByte) {
+  for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
+    const RepairedMesh repaired = testing::repaired_test_mesh(name);
+    SimplifyOptions options = metric_options("energy");
+    options.samples_per_face = 4;
+    auto build = [&](uint32_t on_team, unsigned threads) {
+      ParallelOptions parallel = with_p(4, threads);
+      parallel.team_min_points = on_team;
+      return build_progressive_mesh_parallel(repaired, options, parallel);
+    };
+    const std::string none = testing::pm_bytes(build(0, 4));
+    EXPECT_TRUE(testing::pm_bytes(build(1, 4)) == none) << name << ": every collapse on the team";
+    EXPECT_TRUE(testing::pm_bytes(build(1, 1)) == none) << name << ": on one thread";
+    const ProgressiveMesh rich = build(64, 3);
+    EXPECT_TRUE(testing::pm_bytes(rich) == none) << name << ": the rich ones on the team";
+    const MeshDifference diff =
+        compare_meshes_exact(restore_input(rich), repaired_input(repaired), false);
+    EXPECT_TRUE(diff.equal) << name << ": " << diff.first_difference;
+  }
+}
+
 // Partitions are drawn ahead: round 1's beside round 0's jobs (on the mesh as round 0 found
 // it), every later one beside the band pass before it (on a copy of the mesh as it was before
 // the band pass); a round takes it when it has as many subsets as foreseen. On two threads
