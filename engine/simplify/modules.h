@@ -92,7 +92,7 @@ class PriorityModule {
   virtual std::unique_ptr<PriorityModule> costing_view() const { return nullptr; }
   // Threads the module may use within collapsed() for work that splits into independent
   // pieces (the energy's point projections), with the same results as on one thread; null
-  // (the default): none. The team outlives its use, which ends with use_team(nullptr).
+  // (the default): none. The team outlives the module, or its use ends with use_team(nullptr).
   virtual void use_team(ThreadTeam* /*team*/) {}
 };
 

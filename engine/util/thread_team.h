@@ -1,9 +1,9 @@
 // A team of threads for short loops run many times over (one collapse's point projections:
 // tens to hundreds of microseconds each). Its threads live as long as the team and wait for
-// the next loop, spinning briefly and then asleep, where ChunkedLoops starts threads for each
-// loop. A loop is cut into at most `chunks` consecutive ranges; range r runs on member
-// r % threads (member 0: the calling thread), so what each range computes does not depend on
-// the threads. One loop at a time, from one calling thread.
+// the next loop, awake for a few milliseconds (yielding their cores) and then asleep, where
+// ChunkedLoops starts threads for each loop. A loop is cut into at most `chunks` consecutive
+// ranges; range r runs on member r % threads (member 0: the calling thread), so what each
+// range computes does not depend on the threads. One loop at a time, from one calling thread.
 #pragma once
 
 #include <atomic>
