@@ -18,12 +18,6 @@
 namespace parapm::service {
 namespace {
 
-// A job's and an upload's memory (the mesh, the engine's state, the PM: hundreds of MB on a
-// large mesh) is freed in blocks glibc keeps for reuse in its per-thread arenas; give the
-// free pages back to the system, so that an idle coordinator's memory falls back near where
-// it started.
-void give_back_free_memory() { release_free_memory(); }
-
 parapm::v1::JobState state_of(JobStatus status) {
   switch (status) {
     case JobStatus::kQueued:
@@ -142,9 +136,12 @@ UploadResult Coordinator::finish_upload(Upload upload) {
     ~Release() { slots.release(); }
   } release{parse_slots_};
   const RepairedMesh repaired = [&] {
+    // An upload's parse frees hundreds of MB on a large mesh into glibc's per-thread arenas:
+    // given back to the system after it, whether it succeeded or not, so that an idle
+    // coordinator's memory falls back near where it started.
     struct GiveBack {
-      ~GiveBack() { give_back_free_memory(); }
-    } give_back;  // after the parse, whether it succeeded or not
+      ~GiveBack() { release_free_memory(); }
+    } give_back;
     return repair_mesh(
         read_mesh_from_memory(upload.bytes_, upload.file_name_, nullptr, read_limits()));
   }();
@@ -459,7 +456,7 @@ void Coordinator::scheduler_loop() {
       std::lock_guard lock(mutex_);
       running_.erase(job_id);
     }
-    give_back_free_memory();
+    release_free_memory();  // the job's mesh, state and PM, as after an upload's parse
   }
 }
 

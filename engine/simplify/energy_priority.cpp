@@ -254,15 +254,16 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
         if (gained) evaluator_.recompute(faces[j]);
       }
     });
+    for (const FacePoint& point : moved_.points)
+      max_distance_sq = std::max(max_distance_sq, point.distance_sq);
   } else {
     project(0, moving);
     for (size_t i = moving; i-- > 0;) {
       face_points_[moved_.faces[i]].push_back(moved_.points[i]);
       evaluator_.forget(moved_.faces[i]);
+      max_distance_sq = std::max(max_distance_sq, moved_.points[i].distance_sq);
     }
   }
-  for (const FacePoint& point : moved_.points)
-    max_distance_sq = std::max(max_distance_sq, point.distance_sq);
   if (scalar_.enabled()) update_attributes(mesh, done, edge);
   // The largest distance of the star's points, where the evaluation may have looked at a
   // subset.
