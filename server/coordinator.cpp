@@ -11,6 +11,7 @@
 #include "parallel/parallel_build.h"
 #include "pm/pm_file.h"
 #include "storage/ids.h"
+#include "util/chunked_loops.h"
 #include "util/clock.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -32,6 +33,17 @@ parapm::v1::JobState state_of(JobStatus status) {
       return parapm::v1::CANCELLED;
   }
   return parapm::v1::JOB_STATE_UNSPECIFIED;
+}
+
+// A mesh file's bytes read and repaired, in chunks on the hardware's threads (the same mesh
+// as on one thread).
+std::shared_ptr<const RepairedMesh> parse_mesh(const std::string& bytes, const std::string& name,
+                                               const ReadLimits& limits) {
+  ChunkedLoops loops(std::max(1u, std::thread::hardware_concurrency()), 0);
+  RepairOptions options;
+  options.loops = &loops;
+  return std::make_shared<const RepairedMesh>(
+      repair_mesh(read_mesh_from_memory(bytes, name, nullptr, limits, &loops), options));
 }
 
 std::string repairs_text(const RepairReport& r) {
@@ -74,7 +86,8 @@ Coordinator::Coordinator(CoordinatorConfig config)
       store_(config_.data_dir / "parapm.db"),
       registry_(config_.heartbeat),
       channels_(config_.worker_credentials ? config_.worker_credentials
-                                           : grpc::InsecureChannelCredentials()) {
+                                           : grpc::InsecureChannelCredentials()),
+      handoff_(config_.upload_handoff) {
   // What a previous process left unfinished runs again, oldest first.
   for (JobRecord& job : store_.jobs_with_status({JobStatus::kQueued, JobStatus::kRunning})) {
     if (job.status == JobStatus::kRunning) {
@@ -135,16 +148,16 @@ UploadResult Coordinator::finish_upload(Upload upload) {
     std::counting_semaphore<>& slots;
     ~Release() { slots.release(); }
   } release{parse_slots_};
-  const RepairedMesh repaired = [&] {
+  const std::shared_ptr<const RepairedMesh> parsed = [&] {
     // An upload's parse frees hundreds of MB on a large mesh into glibc's per-thread arenas:
     // given back to the system after it, whether it succeeded or not, so that an idle
     // coordinator's memory falls back near where it started.
     struct GiveBack {
       ~GiveBack() { release_free_memory(); }
     } give_back;
-    return repair_mesh(
-        read_mesh_from_memory(upload.bytes_, upload.file_name_, nullptr, read_limits()));
+    return parse_mesh(upload.bytes_, upload.file_name_, read_limits());
   }();
+  const RepairedMesh& repaired = *parsed;
   if (repaired.mesh.face_count() == 0)
     throw_invalid(upload.file_name_ + ": no faces left after repair");
   result.repairs = repairs_text(repaired.report);
@@ -154,6 +167,7 @@ UploadResult Coordinator::finish_upload(Upload upload) {
     result.mesh = *known;
     spdlog::info("upload {} ({} bytes) is mesh {} already", upload.file_name_, upload.bytes_.size(),
                  known->mesh_id);
+    handoff_.put(result.mesh.sha256, parsed);
     return result;
   }
   result.mesh.sha256 = blobs_.put(upload.bytes_);
@@ -166,6 +180,7 @@ UploadResult Coordinator::finish_upload(Upload upload) {
   store_.add_mesh(result.mesh);
   spdlog::info("mesh {} uploaded: {} ({} bytes, {} vertices, {} faces)", result.mesh.mesh_id,
                result.mesh.file_name, result.mesh.bytes, result.mesh.vertices, result.mesh.faces);
+  handoff_.put(result.mesh.sha256, parsed);
   return result;
 }
 
@@ -553,8 +568,11 @@ void Coordinator::execute(JobRecord& record, Running& running,
   const std::optional<MeshRecord> mesh_record = store_.find_mesh(record.mesh_id);
   if (!mesh_record) throw Error(ErrorCode::kNotFound, "mesh " + record.mesh_id + " is gone");
   auto t = std::chrono::steady_clock::now();
-  const RepairedMesh repaired = repair_mesh(read_mesh_from_memory(
-      blobs_.read(mesh_record->sha256), mesh_record->file_name, nullptr, read_limits()));
+  std::shared_ptr<const RepairedMesh> parsed = handoff_.take(mesh_record->sha256);
+  const bool from_upload = parsed != nullptr;
+  if (!parsed)
+    parsed = parse_mesh(blobs_.read(mesh_record->sha256), mesh_record->file_name, read_limits());
+  const RepairedMesh& repaired = *parsed;
   transport.set_read_seconds(seconds_since(t));
   record.input_faces = repaired.mesh.face_count();
   {
@@ -565,9 +583,11 @@ void Coordinator::execute(JobRecord& record, Running& running,
     started->set_target_faces(target_face_count(record.input_faces, spec.simplify));
     emit(job_id, event);
   }
-  spdlog::info("job {} started (attempt {}): {} faces, p = {}, {} scheduled rounds, metric {}",
-               job_id, record.attempts, record.input_faces, spec.parallel.subsets,
-               scheduled_rounds(spec.parallel), spec.simplify.metric);
+  spdlog::info(
+      "job {} started (attempt {}): {} faces, p = {}, {} scheduled rounds, metric {}; the mesh {}",
+      job_id, record.attempts, record.input_faces, spec.parallel.subsets,
+      scheduled_rounds(spec.parallel), spec.simplify.metric,
+      from_upload ? "as parsed at its upload" : "read from its blob");
 
   RemoteOptions remote;
   remote.job_id = job_id;
@@ -638,12 +658,21 @@ void Coordinator::execute(JobRecord& record, Running& running,
     emit(job_id, event);
   };
   ParallelStats stats;
-  const ProgressiveMesh pm = build_progressive_mesh_parallel(
+  ProgressiveMesh pm = build_progressive_mesh_parallel(
       repaired, spec.simplify, spec.parallel, &stats, progress, &running.cancel, &runner, events);
   t = std::chrono::steady_clock::now();
-  std::ostringstream bytes;
-  write_pm(pm, bytes);
-  record.pm_sha256 = blobs_.put(bytes.str());
+  record.base_faces = pm.base.face_count();
+  record.vsplits = pm.splits.size();
+  auto stored = std::make_shared<LoadedPm>();
+  {
+    std::ostringstream bytes;
+    write_pm(pm, bytes, &stored->split_begin);
+    stored->bytes = std::move(bytes).str();
+  }
+  record.pm_sha256 = blobs_.put(stored->bytes);
+  stored->splits_begin = stored->split_begin.front();
+  stored->pm = std::move(pm);
+  library_.put(record.pm_sha256, std::move(stored));  // its first download reads no blob
   transport.set_store_seconds(seconds_since(t));
   const TransportStats& moved = runner.transport();
   transport.set_encode_seconds(moved.encode_seconds);
@@ -657,8 +686,6 @@ void Coordinator::execute(JobRecord& record, Running& running,
       job_id, moved.calls, double(moved.job_bytes) / 1e6, moved.encode_seconds,
       double(moved.result_bytes) / 1e6, moved.call_overhead_seconds, transport.read_seconds(),
       transport.store_seconds());
-  record.base_faces = pm.base.face_count();
-  record.vsplits = pm.splits.size();
 }
 
 }  // namespace parapm::service

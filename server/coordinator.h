@@ -35,6 +35,7 @@
 #include "remote_runner.h"
 #include "storage/blob_store.h"
 #include "storage/job_store.h"
+#include "upload_handoff.h"
 #include "util/progress.h"
 #include "worker_registry.h"
 
@@ -58,6 +59,8 @@ struct CoordinatorConfig {
   std::chrono::milliseconds retain_for{0};
   uint64_t retain_bytes = 0;
   std::chrono::milliseconds retention_check{std::chrono::minutes(10)};
+  // How long the last upload's parsed mesh waits for a job to take it (UploadHandoff).
+  std::chrono::milliseconds upload_handoff{std::chrono::seconds(30)};
 };
 
 // What a deletion removed: rows, and the blobs no row refers to any more.
@@ -163,6 +166,7 @@ class Coordinator {
   WorkerRegistry registry_;
   WorkerChannels channels_;
   PmLibrary library_;
+  UploadHandoff handoff_;
 
   std::mutex upload_mutex_;  // the sha256 lookup and the insert of a new mesh
   // Uploads parsed at once: each holds its inflated file and mesh, up to max_mesh_bytes and

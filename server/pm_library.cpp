@@ -49,7 +49,19 @@ std::shared_ptr<const LoadedPm> PmLibrary::get(const std::string& sha256, const 
   }
   std::shared_ptr<const LoadedPm> loaded = load(sha256, blobs);
   std::lock_guard lock(mutex_);
-  recent_.emplace_front(sha256, loaded);
+  keep(sha256, loaded);
+  return loaded;
+}
+
+void PmLibrary::put(const std::string& sha256, std::shared_ptr<const LoadedPm> pm) {
+  std::lock_guard lock(mutex_);
+  keep(sha256, std::move(pm));
+}
+
+// Newest first, one entry per hash (two loads of one PM at once keep one).
+void PmLibrary::keep(const std::string& sha256, std::shared_ptr<const LoadedPm> pm) {
+  std::erase_if(recent_, [&](const auto& entry) { return entry.first == sha256; });
+  recent_.emplace_front(sha256, std::move(pm));
   uint64_t kept = 0;
   for (auto it = recent_.begin(); it != recent_.end();) {
     kept += it->second->bytes.size();
@@ -58,7 +70,6 @@ std::shared_ptr<const LoadedPm> PmLibrary::get(const std::string& sha256, const 
     else
       ++it;
   }
-  return loaded;
 }
 
 }  // namespace parapm::service

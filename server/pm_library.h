@@ -31,8 +31,13 @@ class PmLibrary {
   // Error(kDataLoss) when the blob no longer matches its hash or does not decode (its message
   // names the blob, not a path), kNotFound when it is missing.
   std::shared_ptr<const LoadedPm> get(const std::string& sha256, const BlobStore& blobs);
+  // A PM the coordinator has just written, with the bytes it stored under `sha256`: served
+  // from memory without reading them back (its first download need not wait for a load).
+  void put(const std::string& sha256, std::shared_ptr<const LoadedPm> pm);
 
  private:
+  void keep(const std::string& sha256, std::shared_ptr<const LoadedPm> pm);  // mutex_ held
+
   uint64_t budget_bytes_;
   std::mutex mutex_;
   std::list<std::pair<std::string, std::shared_ptr<const LoadedPm>>> recent_;  // front: newest

@@ -1,5 +1,6 @@
 #include "remote_runner.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -41,17 +42,26 @@ struct Flight {
   std::chrono::steady_clock::time_point start;
   grpc::ClientContext context;
   std::thread thread;
+  std::atomic<bool> begun{false};  // the worker took it into a slot (or it runs in-process)
+  bool announced = false;          // its "started" event sent (the dispatching thread's)
   std::atomic<bool> finished{false};
   grpc::Status status;
   SubsetResult result;
-  double call_seconds = 0;  // wall, at the coordinator
+  double call_seconds = 0;    // wall, at the coordinator
+  double queued_seconds = 0;  // at the worker, decoded, waiting for a slot (queued ahead)
   uint64_t result_bytes = 0;
 };
 
+// The call's time beyond the worker's own, not counting its wait for a slot there.
+double transfer_seconds(const Flight& f) {
+  return std::max(0.0, f.call_seconds - f.result.wall_seconds - f.queued_seconds);
+}
+
 // Reads the worker's stream into flight.result; the status says how it ended. A worker that
 // sends what does not decode is treated like one that failed (its subset goes elsewhere).
+// `on_begun` runs when the worker says the subset holds a slot.
 void call_worker(Flight& flight, parapm::v1::WorkerService::Stub& stub,
-                 const parapm::v1::SubsetRequest& request) {
+                 const parapm::v1::SubsetRequest& request, const std::function<void()>& on_begun) {
   const auto start = std::chrono::steady_clock::now();
   auto reader = stub.SimplifySubset(&flight.context, request);
   parapm::v1::SubsetProgress message;
@@ -59,7 +69,12 @@ void call_worker(Flight& flight, parapm::v1::WorkerService::Stub& stub,
   std::string broken;
   while (reader->Read(&message)) {
     try {
-      if (message.has_record_batch()) {
+      if (message.has_begun()) {
+        // Clamped: the worker's figure only splits the call's own time.
+        flight.queued_seconds =
+            std::clamp(message.begun().queued_seconds(), 0.0, seconds_since(start));
+        on_begun();
+      } else if (message.has_record_batch()) {
         decode_collapse_records(message.record_batch(), flight.result.records);
         flight.result_bytes += message.record_batch().size();
       } else if (message.has_summary()) {
@@ -109,9 +124,10 @@ class RemoteRunner::Dispatch {
     encode_requests();
     for (size_t i = 0; i < jobs_.size(); ++i) pending_.push_back(i);
     try {
-      while (done_ < jobs_.size()) {
+      for (;;) {
         if (cancel_) cancel_->check();
         harvest();
+        if (done_ == jobs_.size()) break;
         dispatch_pending();
         wait_for_a_flight();
       }
@@ -149,8 +165,7 @@ class RemoteRunner::Dispatch {
     if (kind == SubsetEvent::Kind::kDone) {
       e.seconds = f.result.wall_seconds;
       e.cpu_seconds = f.result.cpu_seconds;
-      if (!f.slot.worker_id.empty())
-        e.transfer_seconds = std::max(0.0, f.call_seconds - f.result.wall_seconds);
+      if (!f.slot.worker_id.empty()) e.transfer_seconds = transfer_seconds(f);
       e.collapses = f.result.records.size();
     } else if (kind == SubsetEvent::Kind::kRetry) {
       e.reason = f.status.error_message();
@@ -182,10 +197,10 @@ class RemoteRunner::Dispatch {
     f.index = i;
     f.attempt = ++attempts_[i];
     f.start = std::chrono::steady_clock::now();
-    auto finish = [&f, this] {
+    auto mark = [this](std::atomic<bool>& flag) {
       {
         std::lock_guard lock(mutex_);
-        f.finished = true;
+        flag = true;
       }
       changed_.notify_all();
     };
@@ -193,31 +208,40 @@ class RemoteRunner::Dispatch {
       f.slot = *slot;
       rpc::attach_token(f.context, runner_.options_.token);
       auto stub = parapm::v1::WorkerService::NewStub(runner_.channels_.get(slot->address));
-      f.thread = std::thread([&f, request = &requests_[i], stub = std::move(stub), finish] {
-        call_worker(f, *stub, *request);
-        finish();
+      f.thread = std::thread([&f, request = &requests_[i], stub = std::move(stub), mark] {
+        call_worker(f, *stub, *request, [&] { mark(f.begun); });
+        mark(f.finished);
       });
     } else {
       ++local_running_;
-      f.thread = std::thread([&f, job = &jobs_[i], cancel = cancel_, finish] {
+      f.begun = true;
+      f.thread = std::thread([&f, job = &jobs_[i], cancel = cancel_, mark] {
         try {
           f.result = simplify_subset(*job, {}, cancel);
         } catch (...) {
           f.status = rpc::status_of_current_exception();
         }
-        finish();
+        mark(f.finished);
       });
     }
-    event(SubsetEvent::Kind::kStarted, f);
     flights_.push_back(std::move(flight));
   }
 
-  // Takes the finished flights' outcomes; cancels the calls of workers that stopped beating
-  // (they will not answer: their subsets go to another).
+  // "Started" when the subset holds a slot, not when its call is sent (it may wait at the
+  // worker, queued ahead); at the latest with its result (a worker that does not say).
+  void announce(Flight& f) {
+    if (f.announced) return;
+    f.announced = true;
+    event(SubsetEvent::Kind::kStarted, f);
+  }
+
+  // Announces the flights that began; takes the finished flights' outcomes; cancels the calls
+  // of workers that stopped beating (they will not answer: their subsets go to another).
   void harvest() {
     for (auto it = flights_.begin(); it != flights_.end();) {
-      if (!(*it)->finished) {
-        Flight& f = **it;
+      Flight& f = **it;
+      if (f.begun) announce(f);
+      if (!f.finished) {
         if (!f.slot.worker_id.empty() && !runner_.registry_.alive(f.slot.worker_id))
           f.context.TryCancel();
         ++it;
@@ -226,10 +250,10 @@ class RemoteRunner::Dispatch {
       // Out of the list before anything can throw: stop_all must not see it again.
       const std::unique_ptr<Flight> done_flight = std::move(*it);
       it = flights_.erase(it);
-      Flight& f = *done_flight;
-      f.thread.join();
-      release(f);
-      take_outcome(f);
+      done_flight->thread.join();
+      release(*done_flight);
+      if (done_flight->status.ok()) announce(*done_flight);
+      take_outcome(*done_flight);
     }
   }
 
@@ -244,7 +268,7 @@ class RemoteRunner::Dispatch {
     if (f.status.ok()) {
       if (!f.slot.worker_id.empty()) {
         TransportStats& transport = runner_.transport_;
-        transport.call_overhead_seconds += std::max(0.0, f.call_seconds - f.result.wall_seconds);
+        transport.call_overhead_seconds += transfer_seconds(f);
         transport.result_bytes += f.result_bytes;
         ++transport.calls;
       }
@@ -281,6 +305,10 @@ class RemoteRunner::Dispatch {
       const size_t i = pending_.front();
       std::optional<WorkerSlot> slot = registry.acquire({last_worker_[i]});
       if (!slot) slot = registry.acquire();
+      // Queued ahead only while more subsets wait than the live workers have slots: the
+      // round's last subsets go to free slots, not behind another subset.
+      if (!slot && pending_.size() > registry.live_slots())
+        slot = registry.acquire({last_worker_[i]}, true);
       if (slot) {
         pending_.pop_front();
         launch(i, slot);
@@ -304,13 +332,13 @@ class RemoteRunner::Dispatch {
     }
   }
 
-  // Until a flight finishes, or 100 ms (heartbeats, cancellation and new workers are
-  // checked between waits).
+  // Until a flight begins or finishes, or 100 ms (heartbeats, cancellation and new workers
+  // are checked between waits).
   void wait_for_a_flight() {
     std::unique_lock lock(mutex_);
     changed_.wait_for(lock, std::chrono::milliseconds(100), [&] {
       for (auto& f : flights_)
-        if (f->finished) return true;
+        if (f->finished || (f->begun && !f->announced)) return true;
       return false;
     });
   }

@@ -37,7 +37,7 @@ struct SubsetEvent {
   std::string worker;  // its name; "coordinator" when it ran in-process
   uint32_t attempt = 1;
   double seconds = 0, cpu_seconds = 0;
-  double transfer_seconds = 0;  // the call's time beyond the worker's own (TransportStats)
+  double transfer_seconds = 0;  // the call's time beyond the worker's (TransportStats)
   uint64_t collapses = 0;
   std::string reason;  // kRetry: why
 };
@@ -55,8 +55,9 @@ struct RemoteOptions {
 // What moving the jobs cost, summed over every subset call of the runner's life.
 struct TransportStats {
   double encode_seconds = 0;  // subset jobs to bytes, in the coordinator
-  // Per call: its wall time at the coordinator minus the worker's own time for the subset
-  // (sending the job, decoding it, streaming and decoding the records), summed.
+  // Per call: its wall time at the coordinator minus the worker's own time for the subset and
+  // its wait for a slot there when queued ahead (left: sending the job, decoding it,
+  // streaming and decoding the records), summed.
   double call_overhead_seconds = 0;
   uint64_t job_bytes = 0;
   uint64_t result_bytes = 0;  // record batches and summaries

@@ -68,14 +68,24 @@ size_t WorkerRegistry::live_count() {
   return workers_.size();
 }
 
-std::optional<WorkerSlot> WorkerRegistry::acquire(const std::set<std::string>& avoid) {
+size_t WorkerRegistry::live_slots() {
+  std::lock_guard lock(mutex_);
+  expire();
+  size_t slots = 0;
+  for (const auto& [id, entry] : workers_) slots += entry.description.threads;
+  return slots;
+}
+
+std::optional<WorkerSlot> WorkerRegistry::acquire(const std::set<std::string>& avoid,
+                                                  bool queue_ahead) {
   std::lock_guard lock(mutex_);
   expire();
   Entry* best = nullptr;
   std::string best_id;
   double best_load = 0;
   for (auto& [id, entry] : workers_) {
-    if (entry.suspected || entry.busy >= entry.description.threads || avoid.count(id)) continue;
+    const uint32_t calls = entry.description.threads * (queue_ahead ? 2 : 1);
+    if (entry.suspected || entry.busy >= calls || avoid.count(id)) continue;
     const double load = double(entry.busy + 1) / entry.description.capacity;
     if (!best || load < best_load) {
       best = &entry;

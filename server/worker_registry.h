@@ -44,8 +44,14 @@ class WorkerRegistry {
   bool alive(const std::string& worker_id);
   size_t live_count();
 
-  // A slot on the least loaded live worker not in `avoid`, if any has a free one.
-  std::optional<WorkerSlot> acquire(const std::set<std::string>& avoid = {});
+  // A slot on the least loaded live worker not in `avoid`, if any has a free one. With
+  // `queue_ahead`, a worker whose slots are all busy takes up to one call more per slot: the
+  // call waits at the worker, its job already sent and decoded, and starts the moment a slot
+  // frees there.
+  std::optional<WorkerSlot> acquire(const std::set<std::string>& avoid = {},
+                                    bool queue_ahead = false);
+  // The slots of the live workers, summed.
+  size_t live_slots();
   void release(const std::string& worker_id);
   // Called after a call to it failed for a reason of its own (unreachable): it takes no more
   // subsets until it beats again.
@@ -55,7 +61,7 @@ class WorkerRegistry {
   struct Entry {
     WorkerDescription description;
     std::chrono::steady_clock::time_point last_beat;
-    uint32_t busy = 0;
+    uint32_t busy = 0;  // calls it holds, running or queued ahead
     bool suspected = false;
   };
   // Forgets workers that missed their beats. Caller holds mutex_.

@@ -1,7 +1,8 @@
 #include "subset_service.h"
 
-#include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 
 #include <spdlog/spdlog.h>
@@ -22,6 +23,40 @@ namespace {
 constexpr size_t kRecordsPerBatch = 16384;
 constexpr auto kProgressInterval = std::chrono::milliseconds(250);
 constexpr auto kCancelPoll = std::chrono::milliseconds(20);
+
+// Passes the call's cancellation (the coordinator cancelled the job, or went away) to the
+// engine within kCancelPoll, whatever the engine is doing; stops at once when destroyed (the
+// subset's slot is not held while it sleeps).
+class CancelWatcher {
+ public:
+  CancelWatcher(grpc::ServerContext& context, CancelToken& cancel)
+      : thread_([this, &context, &cancel] {
+          std::unique_lock lock(mutex_);
+          while (!stopped_) {
+            if (context.IsCancelled()) {
+              cancel.cancel();
+              return;
+            }
+            stop_.wait_for(lock, kCancelPoll);
+          }
+        }) {}
+  ~CancelWatcher() {
+    {
+      std::lock_guard lock(mutex_);
+      stopped_ = true;
+    }
+    stop_.notify_one();
+    thread_.join();
+  }
+  CancelWatcher(const CancelWatcher&) = delete;
+  CancelWatcher& operator=(const CancelWatcher&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable stop_;
+  bool stopped_ = false;
+  std::thread thread_;  // last: starts once the members above exist
+};
 
 }  // namespace
 
@@ -71,11 +106,18 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
     SubsetJob job = decode_subset_job(request->job());
     const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +
                              " subset " + std::to_string(job.subset);
+    const auto decoded = std::chrono::steady_clock::now();
     if (!acquire_slot(context)) return {grpc::StatusCode::CANCELLED, "cancelled while queued"};
     struct SlotGuard {
       SubsetService* service;
       ~SlotGuard() { service->release_slot(); }
     } guard{this};
+    {
+      parapm::v1::SubsetProgress begun;
+      begun.mutable_begun()->set_queued_seconds(seconds_since(decoded));
+      if (!writer->Write(begun))
+        return grpc::Status(grpc::StatusCode::CANCELLED, "the coordinator went away");
+    }
 
     CancelToken cancel;
     if (context->deadline() != std::chrono::system_clock::time_point::max()) {
@@ -83,26 +125,7 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
       cancel.set_deadline(std::chrono::steady_clock::now() +
                           std::chrono::duration_cast<std::chrono::steady_clock::duration>(left));
     }
-    // The call's cancellation (the coordinator cancelled the job, or went away) reaches the
-    // engine within kCancelPoll, whatever the engine is doing.
-    std::atomic<bool> finished{false};
-    std::thread watcher([&] {
-      while (!finished.load()) {
-        if (context->IsCancelled()) {
-          cancel.cancel();
-          return;
-        }
-        std::this_thread::sleep_for(kCancelPoll);
-      }
-    });
-    struct WatcherGuard {
-      std::atomic<bool>& finished;
-      std::thread& watcher;
-      ~WatcherGuard() {
-        finished = true;
-        watcher.join();
-      }
-    } watcher_guard{finished, watcher};
+    const CancelWatcher watcher(*context, cancel);
     auto last_progress = std::chrono::steady_clock::now();
     bool peer_gone = false;
     // Called every 1024 collapses: now and then, reports.

@@ -65,7 +65,8 @@ void write_position_delta(ByteWriter& out, const Vec3& after, const Vec3& before
 }
 
 // The caller has validated `pm` (validate_pm): the encoding relies on its invariants.
-void write_all(const ProgressiveMesh& pm, ByteWriter& out) {
+void write_all(const ProgressiveMesh& pm, ByteWriter& out,
+               std::vector<uint64_t>* split_offsets = nullptr) {
   const Mesh& base = pm.base;
   const bool float32 = base.positions_are_float;
   const bool attributes = base.layout.any();
@@ -113,7 +114,12 @@ void write_all(const ProgressiveMesh& pm, ByteWriter& out) {
   // Splits.
   uint64_t wedges = base.wedge_count();
   size_t next_new_value = 0;  // into pm.new_wedge_values
+  if (split_offsets) {
+    split_offsets->clear();
+    split_offsets->reserve(pm.splits.size() + 1);
+  }
   for (const VertexSplit& s : pm.splits) {
+    if (split_offsets) split_offsets->push_back(out.offset());
     out.varint(s.vs);
     out.varint(s.has_fl() ? uint64_t(s.vl) + 1 : 0);
     out.varint(s.has_fr() ? uint64_t(s.vr) + 1 : 0);
@@ -143,6 +149,8 @@ void write_all(const ProgressiveMesh& pm, ByteWriter& out) {
     }
   }
 
+  if (split_offsets) split_offsets->push_back(out.offset());
+
   // Tail.
   for (const auto& [copy, original] : pm.vertex_copies) {
     out.u32(copy);
@@ -156,10 +164,10 @@ void write_all(const ProgressiveMesh& pm, ByteWriter& out) {
 
 }  // namespace
 
-void write_pm(const ProgressiveMesh& pm, std::ostream& out) {
+void write_pm(const ProgressiveMesh& pm, std::ostream& out, std::vector<uint64_t>* split_offsets) {
   validate_pm(pm);
   ByteWriter writer(&out);
-  write_all(pm, writer);
+  write_all(pm, writer, split_offsets);
 }
 
 size_t pm_encoded_size(const ProgressiveMesh& pm) {

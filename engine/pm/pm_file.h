@@ -113,7 +113,10 @@ class PmReader {
 
 // Writes `pm` (validate_pm() first: an invalid PM throws Error(kInvalidInput) and nothing
 // is written). Positions are float32 when pm.base.positions_are_float, else float64.
-void write_pm(const ProgressiveMesh& pm, std::ostream& out);
+// `split_offsets`, when given, gets where each split begins, then where the last one ends:
+// the offsets PmReader::offset() gives after read_base() and after each next_split().
+void write_pm(const ProgressiveMesh& pm, std::ostream& out,
+              std::vector<uint64_t>* split_offsets = nullptr);
 void write_pm_file(const ProgressiveMesh& pm, const std::string& path);
 // Bytes write_pm() would write.
 size_t pm_encoded_size(const ProgressiveMesh& pm);

@@ -119,6 +119,26 @@ TEST(PmFile, RoundTripIsBitIdentical) {
   }
 }
 
+// The offsets write_pm reports are the reader's, split by split: a server serves byte ranges
+// of a PM it wrote at them without reading it back.
+TEST(PmFile, TheWritersSplitOffsetsAreTheReaders) {
+  for (const ProgressiveMesh& pm : round_trip_pms()) {
+    std::ostringstream out;
+    std::vector<uint64_t> written = {7};  // replaced, not appended to
+    write_pm(pm, out, &written);
+    const std::string bytes = out.str();
+    EXPECT_EQ(bytes, encode(pm));
+    std::istringstream in(bytes);
+    PmReader reader(in);
+    reader.read_base();
+    std::vector<uint64_t> read = {reader.offset()};
+    PmSplitRecord record;
+    while (reader.next_split(record)) read.push_back(reader.offset());
+    EXPECT_EQ(written, read);
+    EXPECT_EQ(written.size(), pm.splits.size() + 1);
+  }
+}
+
 TEST(PmFile, Float64PositionsSurviveExactly) {
   // Positions no float32 can hold, negative zero, tiny and huge magnitudes.
   ProgressiveMesh pm = testing::strip_pm();

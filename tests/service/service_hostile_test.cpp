@@ -187,6 +187,9 @@ TEST_F(ServiceHostile, ChangedStoredBytesAreDataLossNeverServed) {
     write_binary(blob_path(sha), bytes);
   };
   flip_a_byte(done.pm_sha256());
+  // The coordinator serves a PM it wrote from memory, as written; a fresh one reads its blob.
+  service().kill_coordinator();
+  service().restart_coordinator();
   std::string pm;
   const grpc::Status status = service().try_download(done.job_id(), &pm);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::DATA_LOSS) << status_text(status);

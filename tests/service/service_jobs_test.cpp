@@ -103,6 +103,9 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   parapm::v1::JobOptions guitar = options(4, parapm::v1::METRIC_QUADRIC, 0.05, 7);
   guitar.set_min_subset_faces(2000);
   build_and_compare("stratocaster-9k.ply", guitar, names);
+  // The job took the mesh its upload had parsed (UploadHandoff), not the blob again.
+  EXPECT_NE(service().coordinator().log().find("the mesh as parsed at its upload"),
+            std::string::npos);
   // The energy metric's state (points, curves, wedge classes) travels in the subset jobs;
   // the airplane has colours, so the wedge changes do too. So does its tuning, here not the
   // defaults: `--star-planes-weight 3 --volume-weight 0 --spring-scale 0.01
