@@ -9,10 +9,12 @@
 # to end of download), its parts (upload, wait, download), the transport inside the job
 # (coordinator reading the upload, encoding jobs, subset calls' time beyond the workers' own
 # summed over calls, storing the PM), the MB of jobs and of results moved between coordinator
-# and workers and their sum per input face (bytes), transport / service wall, and whether both
-# .pm files are byte-identical (they must be).
-# Environment: P (default 2), METRIC (default energy), WORKERS, WORKER_THREADS, PORT (default
-# 50151), BENCH_OUT (default ./bench-out-service), PARAPM_BUILD_DIR (default build/).
+# and workers and their sum per input face (bytes), transport / service wall, service /
+# in-process wall, and whether both .pm files are byte-identical (they must be). With REPEATS
+# (default 1) above 1, each mesh is run that many times, in turn, and a last line ("# ...")
+# gives the medians of both wall clocks and of their ratio.
+# Environment: P (default 2), METRIC (default energy), WORKERS, WORKER_THREADS, REPEATS, PORT
+# (default 50151), BENCH_OUT (default ./bench-out-service), PARAPM_BUILD_DIR (default build/).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 [[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
@@ -33,33 +35,46 @@ trap 'kill -INT $up_pid 2> /dev/null; wait $up_pid 2> /dev/null || true' EXIT
 for _ in $(seq 100); do [[ -s "$out/data/coordinator.port" ]] && break; sleep 0.1; done
 sleep 1  # the workers register
 server=(--server "127.0.0.1:$port")
-printf "mesh\tp\tinprocess_s\tservice_s\tupload_s\twait_s\tdownload_s\tread_s\tencode_s\tcall_overhead_s\tstore_s\tjob_MB\tresult_MB\ttransport_share\tidentical\n"
+printf "mesh\tp\tinprocess_s\tservice_s\tupload_s\twait_s\tdownload_s\tread_s\tencode_s\tcall_overhead_s\tstore_s\tjob_MB\tresult_MB\tbytes_per_face\ttransport_share\tservice_over_inprocess\tidentical\n"
+median() { sort -g | awk '{v[NR] = $1} END {print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2)}'; }
 for mesh in "$@"; do
   name="$(basename "$mesh")"; name="${name%%.*}"
-  svc="$("$bin" --log-level warn submit "$mesh" --parallel "$p" --metric "$metric" \
-    -o "$out/$name-service.pm" --json "${server[@]}")"
-  job="$(jq -r .job_id <<< "$svc")"
-  fin="$("$bin" watch "$job" --json "${server[@]}" | jq -c 'select(.finished) | .finished')"
-  t0=$(date +%s.%N)
-  "$bin" --log-level warn simplify "$mesh" --parallel "$p" --metric "$metric" \
-    -o "$out/$name-local.pm" > /dev/null
-  t1=$(date +%s.%N)
-  same=no; cmp -s "$out/$name-service.pm" "$out/$name-local.pm" && same=yes
-  faces="$("$bin" info "$out/$name-local.pm" --json | jq .input_faces)"
-  jq -r --argjson fin "$fin" --arg mesh "$name" --arg p "$p" --arg local "$(echo "$t1 - $t0" | bc)" \
-    --arg same "$same" --argjson faces "$faces" '
-    ($fin.transport // {}) as $t
-    | [($t.read_seconds // 0), ($t.encode_seconds // 0), ($t.call_overhead_seconds // 0),
-       ($t.store_seconds // 0)] as $parts
-    | (.client.upload_seconds + .client.download_seconds + ($parts | add)) as $moved
-    | [$mesh, $p, ($local | tonumber | . * 1000 | round / 1000),
-       (.client.total_seconds * 1000 | round / 1000),
-       (.client.upload_seconds * 1000 | round / 1000), (.client.wait_seconds * 1000 | round / 1000),
-       (.client.download_seconds * 1000 | round / 1000),
-       ($parts[] | . * 1000 | round / 1000),
-       ((($t.job_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
-       ((($t.result_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
-       (((($t.job_bytes // "0") | tonumber) + (($t.result_bytes // "0") | tonumber)) / $faces
-        | round),
-       ($moved / .client.total_seconds * 1000 | round / 1000), $same] | @tsv' <<< "$svc"
+  rows=""
+  for _ in $(seq "${REPEATS:-1}"); do
+    svc="$("$bin" --log-level warn submit "$mesh" --parallel "$p" --metric "$metric" \
+      -o "$out/$name-service.pm" --json "${server[@]}")"
+    job="$(jq -r .job_id <<< "$svc")"
+    fin="$("$bin" watch "$job" --json "${server[@]}" | jq -c 'select(.finished) | .finished')"
+    t0=$(date +%s.%N)
+    "$bin" --log-level warn simplify "$mesh" --parallel "$p" --metric "$metric" \
+      -o "$out/$name-local.pm" > /dev/null
+    t1=$(date +%s.%N)
+    same=no; cmp -s "$out/$name-service.pm" "$out/$name-local.pm" && same=yes
+    faces="$("$bin" info "$out/$name-local.pm" --json | jq .input_faces)"
+    row="$(jq -r --argjson fin "$fin" --arg mesh "$name" --arg p "$p" --arg local "$(echo "$t1 - $t0" | bc)" \
+      --arg same "$same" --argjson faces "$faces" '
+      ($fin.transport // {}) as $t
+      | [($t.read_seconds // 0), ($t.encode_seconds // 0), ($t.call_overhead_seconds // 0),
+         ($t.store_seconds // 0)] as $parts
+      | (.client.upload_seconds + .client.download_seconds + ($parts | add)) as $moved
+      | [$mesh, $p, ($local | tonumber | . * 1000 | round / 1000),
+         (.client.total_seconds * 1000 | round / 1000),
+         (.client.upload_seconds * 1000 | round / 1000), (.client.wait_seconds * 1000 | round / 1000),
+         (.client.download_seconds * 1000 | round / 1000),
+         ($parts[] | . * 1000 | round / 1000),
+         ((($t.job_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
+         ((($t.result_bytes // "0") | tonumber) / 1e6 | . * 10 | round / 10),
+         (((($t.job_bytes // "0") | tonumber) + (($t.result_bytes // "0") | tonumber)) / $faces
+          | round),
+         ($moved / .client.total_seconds * 1000 | round / 1000),
+         (.client.total_seconds / ($local | tonumber) * 1000 | round / 1000), $same] | @tsv' <<< "$svc"
+    )"
+    printf "%s\n" "$row"
+    rows+="$row"$'\n'
+  done
+  if [[ "${REPEATS:-1}" -gt 1 ]]; then
+    printf "# %s: medians of %s runs: in-process %s s, service %s s, service / in-process %s\n" \
+      "$name" "$REPEATS" "$(cut -f3 <<< "${rows%$'\n'}" | median)" \
+      "$(cut -f4 <<< "${rows%$'\n'}" | median)" "$(cut -f16 <<< "${rows%$'\n'}" | median)"
+  fi
 done
