@@ -6,6 +6,7 @@
 #include <string>
 
 #include "parallel/simplify_subset.h"
+#include "parallel/subset_rule.h"
 #include "util/clock.h"
 #include "util/job_pool.h"
 
@@ -44,7 +45,8 @@ MetricState export_job_state(const PriorityModule& master, const SubsetJob& job)
   MetricState state;
   state.metric = master.name();
   if (const auto* q = dynamic_cast<const QuadricPriority*>(&master)) {
-    state.quadric = q->export_local(maps_of(job));
+    const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+    state.quadric = q->export_local(maps_of(job), &free);
   } else if (const auto* e = dynamic_cast<const EnergyPriority*>(&master)) {
     state.energy = e->export_local(maps_of(job));
   } else {

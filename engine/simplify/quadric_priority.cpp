@@ -253,13 +253,15 @@ void QuadricPriority::collapsed(const CollapseMesh&, CollapseCandidate& done, co
   quadrics_[done.vs] += quadrics_[done.vt];
 }
 
-QuadricState QuadricPriority::export_local(const IdMaps& maps) const {
+QuadricState QuadricPriority::export_local(const IdMaps& maps,
+                                           const std::vector<uint8_t>* free) const {
   QuadricState state;
   const std::vector<VertexId>& global = *maps.vertex;
-  state.vertices.resize(global.size());
+  state.vertices.reserve(global.size());
   state.quadrics.reserve(global.size());
   for (size_t i = 0; i < global.size(); ++i) {
-    state.vertices[i] = VertexId(i);
+    if (free && !(*free)[i]) continue;
+    state.vertices.push_back(VertexId(i));
     state.quadrics.push_back(quadrics_[global[i]]);
   }
   return state;

@@ -59,7 +59,9 @@ class QuadricPriority : public PriorityModule {
   // import_local: a job's module from that state, instead of initialize(). A job returns no
   // quadrics: its collapses change them only by collapsed() (Q_vs += Q_vt), so the master
   // follows a job from its records (follow_records), exactly and at the cost of a copy.
-  QuadricState export_local(const IdMaps& maps) const;
+  // `free`, when given: per local vertex, whether its quadric goes (a job costs and collapses
+  // only edges between free vertices: subset_rule.h).
+  QuadricState export_local(const IdMaps& maps, const std::vector<uint8_t>* free = nullptr) const;
   void import_local(const CollapseMesh& mesh, const QuadricState& state);
   // Before follow_records of several jobs side by side (job_state.h): throws
   // Error(kInvalidInput) unless both ends of every record are distinct, in range and, with
