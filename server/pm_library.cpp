@@ -36,6 +36,17 @@ std::shared_ptr<const LoadedPm> load(const std::string& sha256, const BlobStore&
   return loaded;
 }
 
+// What a kept PM holds in memory: its file, its decoded arrays and its offsets.
+uint64_t memory_of(const LoadedPm& loaded) {
+  auto of = [](const auto& v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
+  const ProgressiveMesh& pm = loaded.pm;
+  const Mesh& base = pm.base;
+  return loaded.bytes.capacity() + of(loaded.split_begin) + of(base.positions) + of(base.faces) +
+         of(base.wedge_vertex) + of(base.wedge_values) + of(base.face_wedges) + of(pm.splits) +
+         of(pm.new_wedge_values) + of(pm.wedge_changes) + of(pm.wedge_change_values) +
+         of(pm.vertex_copies) + of(pm.input_vertex_order) + of(pm.input_face_order);
+}
+
 }  // namespace
 
 std::shared_ptr<const LoadedPm> PmLibrary::get(const std::string& sha256, const BlobStore& blobs) {
@@ -64,7 +75,7 @@ void PmLibrary::keep(const std::string& sha256, std::shared_ptr<const LoadedPm> 
   recent_.emplace_front(sha256, std::move(pm));
   uint64_t kept = 0;
   for (auto it = recent_.begin(); it != recent_.end();) {
-    kept += it->second->bytes.size();
+    kept += memory_of(*it->second);
     if (it != recent_.begin() && kept > budget_bytes_)
       it = recent_.erase(it);
     else

@@ -1,5 +1,6 @@
 // The finished Progressive Meshes the coordinator serves, read from their blobs on first use
-// and kept (the most recently used, within a byte budget) for downloads, levels and streams:
+// (or put as the coordinator wrote them) and kept (the most recently used, within a budget of
+// the memory they hold: file and decoded PM) for downloads, levels and streams:
 // the file's bytes as stored (checked against their hash when read: a corrupt blob is never
 // served), the PM decoded from them (validated), and where each split record starts, so that
 // StreamPM sends byte ranges of the file as they are.
@@ -25,7 +26,8 @@ struct LoadedPm {
 
 class PmLibrary {
  public:
-  // Keeps PMs whose files add up to at most `budget_bytes` (always the last one used).
+  // Keeps PMs whose memory (file bytes, decoded PM, offsets) adds up to at most `budget_bytes`
+  // (always the last one used).
   explicit PmLibrary(uint64_t budget_bytes = uint64_t(512) << 20) : budget_bytes_(budget_bytes) {}
   // Thread-safe; loads outside the lock, so a slow load does not hold up other PMs. Throws
   // Error(kDataLoss) when the blob no longer matches its hash or does not decode (its message

@@ -1,6 +1,6 @@
 // The coordinator's library of PMs it serves: a PM put as it was written is served from memory
-// (no blob read), within the byte budget; one it no longer holds is read from its blob again
-// and checked; one entry per PM.
+// (no blob read), within a budget that counts the decoded PMs too; one it no longer holds is
+// read from its blob again and checked; one entry per PM.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -59,10 +59,27 @@ TEST_F(PmLibraryTest, APutPmIsServedWithoutItsBlob) {
   EXPECT_EQ(library.get(sha, *blobs_), guitar);
 }
 
+TEST_F(PmLibraryTest, TheBudgetCountsTheDecodedPms) {
+  const std::shared_ptr<LoadedPm> guitar = written_pm("stratocaster-9k.ply", 0.1);
+  const std::shared_ptr<LoadedPm> part = written_pm("cad-featuretype-3k.stl", 0.1);
+  // Room for both files, not for both files and their decoded PMs.
+  PmLibrary library(guitar->bytes.size() + part->bytes.size());
+  const std::string guitar_sha = blobs_->put(guitar->bytes);
+  fs::remove(blobs_->path_of(guitar_sha));
+  library.put(guitar_sha, guitar);
+  library.put(blobs_->put(part->bytes), part);
+  try {
+    library.get(guitar_sha, *blobs_);
+    FAIL() << "the guitar stayed: the budget counted the files only";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kNotFound) << e.what();
+  }
+}
+
 TEST_F(PmLibraryTest, BeyondTheBudgetAPmIsReadFromItsBlobAgainAndChecked) {
   const std::shared_ptr<LoadedPm> guitar = written_pm("stratocaster-9k.ply", 0.1);
   const std::shared_ptr<LoadedPm> part = written_pm("cad-featuretype-3k.stl", 0.1);
-  PmLibrary library(guitar->bytes.size());  // room for one of them
+  PmLibrary library(guitar->bytes.size());  // room for the last one used only
   const std::string guitar_sha = blobs_->put(guitar->bytes);
   const std::string part_sha = blobs_->put(part->bytes);
   library.put(guitar_sha, guitar);
