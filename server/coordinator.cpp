@@ -9,7 +9,6 @@
 #include "job_options.h"
 #include "mesh/repair.h"
 #include "parallel/parallel_build.h"
-#include "pm/pm_file.h"
 #include "storage/ids.h"
 #include "util/chunked_loops.h"
 #include "util/clock.h"
@@ -663,15 +662,8 @@ void Coordinator::execute(JobRecord& record, Running& running,
   t = std::chrono::steady_clock::now();
   record.base_faces = pm.base.face_count();
   record.vsplits = pm.splits.size();
-  auto stored = std::make_shared<LoadedPm>();
-  {
-    std::ostringstream bytes;
-    write_pm(pm, bytes, &stored->split_begin);
-    stored->bytes = std::move(bytes).str();
-  }
+  std::shared_ptr<LoadedPm> stored = written_pm(std::move(pm));
   record.pm_sha256 = blobs_.put(stored->bytes);
-  stored->splits_begin = stored->split_begin.front();
-  stored->pm = std::move(pm);
   library_.put(record.pm_sha256, std::move(stored));  // its first download reads no blob
   transport.set_store_seconds(seconds_since(t));
   const TransportStats& moved = runner.transport();

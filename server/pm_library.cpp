@@ -1,6 +1,7 @@
 #include "pm_library.h"
 
 #include <istream>
+#include <sstream>
 
 #include <spdlog/spdlog.h>
 
@@ -48,6 +49,16 @@ uint64_t memory_of(const LoadedPm& loaded) {
 }
 
 }  // namespace
+
+std::shared_ptr<LoadedPm> written_pm(ProgressiveMesh pm) {
+  auto written = std::make_shared<LoadedPm>();
+  std::ostringstream bytes;
+  write_pm(pm, bytes, &written->split_begin);
+  written->bytes = std::move(bytes).str();
+  written->splits_begin = written->split_begin.front();
+  written->pm = std::move(pm);
+  return written;
+}
 
 std::shared_ptr<const LoadedPm> PmLibrary::get(const std::string& sha256, const BlobStore& blobs) {
   {

@@ -24,6 +24,10 @@ struct LoadedPm {
   std::vector<uint64_t> split_begin;  // per split, its offset; then the offset after the last
 };
 
+// `pm` written as a .pm file, kept with its bytes and the writer's split offsets: what the
+// coordinator stores as a blob and puts in the library (validate_pm first: kInvalidInput).
+std::shared_ptr<LoadedPm> written_pm(ProgressiveMesh pm);
+
 class PmLibrary {
  public:
   // Keeps PMs whose memory (file bytes, decoded PM, offsets) adds up to at most `budget_bytes`

@@ -6,11 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <sstream>
 
 #include "io/mesh_io.h"
 #include "mesh/repair.h"
-#include "pm/pm_file.h"
 #include "pm_library.h"
 #include "simplify/simplify.h"
 #include "storage/blob_store.h"
@@ -21,18 +19,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A PM written as the coordinator stores one: its bytes and the writer's split offsets.
-std::shared_ptr<LoadedPm> written_pm(const std::string& file, double ratio) {
+// A test mesh's PM written as the coordinator stores one.
+std::shared_ptr<LoadedPm> pm_of(const std::string& file, double ratio) {
   SimplifyOptions options;
   options.target_ratio = ratio;
-  auto loaded = std::make_shared<LoadedPm>();
-  loaded->pm = build_progressive_mesh(
-      repair_mesh(read_mesh(std::string(PARAPM_TEST_DATA_DIR) + "/" + file)), options);
-  std::ostringstream out;
-  write_pm(loaded->pm, out, &loaded->split_begin);
-  loaded->bytes = out.str();
-  loaded->splits_begin = loaded->split_begin.front();
-  return loaded;
+  return written_pm(build_progressive_mesh(
+      repair_mesh(read_mesh(std::string(PARAPM_TEST_DATA_DIR) + "/" + file)), options));
 }
 
 class PmLibraryTest : public ::testing::Test {
@@ -52,7 +44,7 @@ class PmLibraryTest : public ::testing::Test {
 
 TEST_F(PmLibraryTest, APutPmIsServedWithoutItsBlob) {
   PmLibrary library;
-  const std::shared_ptr<LoadedPm> guitar = written_pm("stratocaster-9k.ply", 0.1);
+  const std::shared_ptr<LoadedPm> guitar = pm_of("stratocaster-9k.ply", 0.1);
   const std::string sha = blobs_->put(guitar->bytes);
   fs::remove(blobs_->path_of(sha));  // only the library holds it now
   library.put(sha, guitar);
@@ -60,8 +52,8 @@ TEST_F(PmLibraryTest, APutPmIsServedWithoutItsBlob) {
 }
 
 TEST_F(PmLibraryTest, TheBudgetCountsTheDecodedPms) {
-  const std::shared_ptr<LoadedPm> guitar = written_pm("stratocaster-9k.ply", 0.1);
-  const std::shared_ptr<LoadedPm> part = written_pm("cad-featuretype-3k.stl", 0.1);
+  const std::shared_ptr<LoadedPm> guitar = pm_of("stratocaster-9k.ply", 0.1);
+  const std::shared_ptr<LoadedPm> part = pm_of("cad-featuretype-3k.stl", 0.1);
   // Room for both files, not for both files and their decoded PMs.
   PmLibrary library(guitar->bytes.size() + part->bytes.size());
   const std::string guitar_sha = blobs_->put(guitar->bytes);
@@ -77,8 +69,8 @@ TEST_F(PmLibraryTest, TheBudgetCountsTheDecodedPms) {
 }
 
 TEST_F(PmLibraryTest, BeyondTheBudgetAPmIsReadFromItsBlobAgainAndChecked) {
-  const std::shared_ptr<LoadedPm> guitar = written_pm("stratocaster-9k.ply", 0.1);
-  const std::shared_ptr<LoadedPm> part = written_pm("cad-featuretype-3k.stl", 0.1);
+  const std::shared_ptr<LoadedPm> guitar = pm_of("stratocaster-9k.ply", 0.1);
+  const std::shared_ptr<LoadedPm> part = pm_of("cad-featuretype-3k.stl", 0.1);
   PmLibrary library(guitar->bytes.size());  // room for the last one used only
   const std::string guitar_sha = blobs_->put(guitar->bytes);
   const std::string part_sha = blobs_->put(part->bytes);
