@@ -93,13 +93,22 @@ void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& o
                        mesh.position(end), vanishes});
     }
   }
-  std::sort(terms.begin(), terms.end(),
-            [](const StarTermsScratch::FaceTerm& x, const StarTermsScratch::FaceTerm& y) {
-              return x.p1 != y.p1 ? x.p1 < y.p1 : x.p2 < y.p2;
-            });
+  // By p1 then p2 (then the rest, for faces alike in both).
+  auto& order = scratch.order;
+  order.resize(terms.size());
+  for (uint32_t i = 0; i < terms.size(); ++i) order[i] = {terms[i].p1[0], i};
+  std::sort(order.begin(), order.end(), [&](const auto& x, const auto& y) {
+    if (x.first != y.first) return x.first < y.first;
+    const StarTermsScratch::FaceTerm &s = terms[x.second], &t = terms[y.second];
+    if (s.p1 != t.p1) return s.p1 < t.p1;
+    if (s.p2 != t.p2) return s.p2 < t.p2;
+    if (s.end != t.end) return s.end < t.end;
+    return s.vanishes < t.vanishes;
+  });
   g = {0, 0, 0};
   h = 0;
-  for (const auto& term : terms) {
+  for (const auto& [first, i] : order) {
+    const StarTermsScratch::FaceTerm& term = terms[i];
     const Vec3 c = cross(sub(term.p1, origin), sub(term.p2, origin));
     h += dot(sub(term.end, origin), c);
     if (term.vanishes) continue;

@@ -49,6 +49,9 @@ struct StarTermsScratch {
     bool vanishes;     // the face holds both ends
   };
   std::vector<FaceTerm> faces;
+  // The order the faces are summed in: each one's p1[0] and index, sorted (a 16-byte key moves
+  // faster than a term; ties on p1[0] are broken by the terms).
+  std::vector<std::pair<double, uint32_t>> order;
   std::vector<std::pair<VertexId, VertexId>> border;  // directed as their faces hold them
 };
 

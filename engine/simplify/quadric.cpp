@@ -4,42 +4,12 @@
 
 namespace parapm {
 
-Quadric Quadric::from_plane(const Vec3& n, double d, double weight) {
-  Quadric q;
-  q.a00 = weight * n[0] * n[0];
-  q.a01 = weight * n[0] * n[1];
-  q.a02 = weight * n[0] * n[2];
-  q.a11 = weight * n[1] * n[1];
-  q.a12 = weight * n[1] * n[2];
-  q.a22 = weight * n[2] * n[2];
-  q.b0 = weight * n[0] * d;
-  q.b1 = weight * n[1] * d;
-  q.b2 = weight * n[2] * d;
-  q.c = weight * d * d;
-  q.weight = weight;
-  return q;
-}
-
-Quadric& Quadric::operator+=(const Quadric& q) {
-  a00 += q.a00, a01 += q.a01, a02 += q.a02, a11 += q.a11, a12 += q.a12, a22 += q.a22;
-  b0 += q.b0, b1 += q.b1, b2 += q.b2;
-  c += q.c;
-  weight += q.weight;
-  return *this;
-}
-
 Quadric& Quadric::operator*=(double s) {
   a00 *= s, a01 *= s, a02 *= s, a11 *= s, a12 *= s, a22 *= s;
   b0 *= s, b1 *= s, b2 *= s;
   c *= s;
   weight *= s;
   return *this;
-}
-
-double Quadric::evaluate(const Vec3& p) const {
-  const double x = p[0], y = p[1], z = p[2];
-  return a00 * x * x + 2 * a01 * x * y + 2 * a02 * x * z + a11 * y * y + 2 * a12 * y * z +
-         a22 * z * z + 2 * (b0 * x + b1 * y + b2 * z) + c;
 }
 
 bool Quadric::minimizer(Vec3& out, double relative_threshold) const {
