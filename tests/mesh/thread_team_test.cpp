@@ -73,7 +73,9 @@ TEST(ThreadTeam, TheLowestRangesExceptionComesBackAndTheOtherRangesRun) {
 }
 
 // On one thread the ranges run one after the other; the critical path counts the slowest of
-// each loop only.
+// each loop only: about a quarter of the wall clock for four equal ranges, all of it if it
+// summed them. (The bound leaves room for a loaded machine, where one range of a loop may
+// wait out another process's time slice.)
 TEST(ThreadTeam, OneThreadCountsTheSlowestRangeOfEachLoop) {
   ThreadTeam team(4, 1, 1);
   EXPECT_EQ(team.threads(), 1u);
@@ -83,7 +85,7 @@ TEST(ThreadTeam, OneThreadCountsTheSlowestRangeOfEachLoop) {
       for (int i = 0; i < 200000; ++i) sink = sink + 1e-9 * i;
     });
   EXPECT_GT(team.seconds(), 0);
-  EXPECT_LT(team.critical_seconds(), 0.6 * team.seconds());
+  EXPECT_LT(team.critical_seconds(), 0.9 * team.seconds());
   EXPECT_EQ(team.worker_cpu_seconds(), 0);
 }
 
