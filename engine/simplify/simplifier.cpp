@@ -6,6 +6,8 @@
 #include <limits>
 #include <utility>
 
+#include "simplify/vec_math.h"
+
 namespace parapm {
 
 Simplifier::Simplifier(CollapseMesh& mesh, PriorityModule& priority,
@@ -46,9 +48,16 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
     if (defer_) remember_key(a, b, std::numeric_limits<float>::infinity());
     return false;
   }
-  entry = {static_cast<float>(candidate.cost), a, b, version_[a] + version_[b]};
-  if (defer_) remember_key(a, b, static_cast<float>(candidate.cost));
+  entry = {key_of(candidate.cost, a, b), a, b, version_[a] + version_[b]};
+  if (defer_) remember_key(a, b, entry.cost);
   return true;
+}
+
+float Simplifier::key_of(double cost, VertexId a, VertexId b) const {
+  if (cost != 0) return static_cast<float>(cost);
+  const Vec3 d = sub(mesh_.position(b), mesh_.position(a));
+  const double smallest = 1 / double(std::numeric_limits<float>::max());  // -1 / it: -FLT_MAX
+  return static_cast<float>(-1 / std::max(dot(d, d), smallest));
 }
 
 std::array<float*, 2> Simplifier::key_slots(VertexId a, VertexId b) {
@@ -594,7 +603,8 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       queue_.pop();
       ++stats_.stale;
     }
-    const Entry now{static_cast<float>(candidate.cost), entry.a, entry.b, entry.stamp | kRequeued};
+    const Entry now{key_of(candidate.cost, entry.a, entry.b), entry.a, entry.b,
+                    entry.stamp | kRequeued};
     if (!queue_.empty() && queue_.top().cost < now.cost) {
       queue_.push(now);
       ++stats_.requeued;

@@ -217,6 +217,12 @@ class Simplifier {
   std::array<float*, 2> key_slots(VertexId a, VertexId b);
   // Costs edge {a, b}; false when the module cannot place it.
   bool queue_entry(VertexId a, VertexId b, Entry& entry);
+  // The queue key of edge {a, b} costing `cost`: the cost as a float, but a cost of exactly
+  // zero (a flat neighbourhood, where every edge ties) goes below every positive key, shorter
+  // edges first (-1 / length^2). Ties left to the ids let the smallest id absorb its flat
+  // neighbours one after the other: a hub whose slivers veto the collapses around it.
+  // (Lindstrom-Turk's shape term settles the same ties by edge length.)
+  float key_of(double cost, VertexId a, VertexId b) const;
   // Pushes an edge vetoed before, whose star has changed since.
   void retry_edge(VertexId a, VertexId b);
   void remember_rejected(VertexId v, VertexId other);
