@@ -24,17 +24,26 @@ std::vector<uint32_t> component_roots(const Mesh& mesh) {
 }
 
 // The boundary edges of `mesh` (a manifold: an edge without the opposite half-edge), each as
-// its face's (from, to).
+// its face's (from, to), in face order. The opposite half-edge is looked up among the
+// outgoing half-edges of its tail, listed per vertex.
 std::vector<std::pair<VertexId, VertexId>> boundary_edges(const Mesh& mesh) {
-  std::unordered_set<uint64_t> half_edges;
-  half_edges.reserve(3 * mesh.faces.size());
-  const auto key = [](VertexId a, VertexId b) { return uint64_t(a) << 32 | b; };
+  // Vertex v's outgoing half-edges' heads: heads[first[v] .. first[v + 1]).
+  std::vector<uint32_t> first(mesh.vertex_count() + 1, 0);
   for (const Triangle& t : mesh.faces)
-    for (int k = 0; k < 3; ++k) half_edges.insert(key(t[k], t[(k + 1) % 3]));
+    for (VertexId v : t) ++first[v + 1];
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) first[v + 1] += first[v];
+  std::vector<VertexId> heads(first.back());
+  std::vector<uint32_t> filled(first.begin(), first.end() - 1);
+  for (const Triangle& t : mesh.faces)
+    for (int k = 0; k < 3; ++k) heads[filled[t[k]]++] = t[(k + 1) % 3];
+  const auto has_half_edge = [&](VertexId from, VertexId to) {
+    return std::find(heads.begin() + first[from], heads.begin() + first[from + 1], to) !=
+           heads.begin() + first[from + 1];
+  };
   std::vector<std::pair<VertexId, VertexId>> boundary;
   for (const Triangle& t : mesh.faces)
     for (int k = 0; k < 3; ++k)
-      if (!half_edges.count(key(t[(k + 1) % 3], t[k]))) boundary.emplace_back(t[k], t[(k + 1) % 3]);
+      if (!has_half_edge(t[(k + 1) % 3], t[k])) boundary.emplace_back(t[k], t[(k + 1) % 3]);
   return boundary;
 }
 
