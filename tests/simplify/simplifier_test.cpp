@@ -125,8 +125,6 @@ class GrownCost : public PriorityModule {
   VertexId a_, b_;
 };
 
-// The first key's edge costs more now than the next key: it goes back in the queue with
-// its present cost, and the cheaper collapses come first.
 // An n x n grid in the plane z = 0, each vertex moved in the plane by up to a fifth of the
 // spacing (a fixed pattern), two triangles per cell: every edge of its inside costs exactly
 // zero with the quadric.
@@ -165,7 +163,8 @@ TEST(Simplifier, FlatTiesGoShortestEdgeFirst) {
 
 TEST(Simplifier, AFlatGridSimplifiesWithoutAHub) {
   // With the ties of a flat region left to the ids, the smallest id absorbed its neighbours
-  // one after the other: one vertex of 60 faces and more, among slivers.
+  // one after the other: here a vertex of 41 faces among slivers, 6,938 vetoes for 424
+  // collapses.
   const Mesh grid = jittered_flat_grid(24);
   CollapseMesh cm(grid);
   std::vector<uint8_t> locked;
@@ -183,6 +182,8 @@ TEST(Simplifier, AFlatGridSimplifiesWithoutAHub) {
               (unsigned long long)simplifier.stats().rejected);
 }
 
+// The first key's edge costs more now than the next key: it goes back in the queue with
+// its present cost, and the cheaper collapses come first.
 TEST(Simplifier, AnEdgeWhoseCostGrewGoesBackInTheQueue) {
   const Mesh sphere = uv_sphere(12, 16);
   CollapseMesh cm(sphere);
