@@ -389,28 +389,26 @@ bool pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
   }
   std::sort(by_vertices.begin(), by_vertices.end());
   by_vertices.erase(std::unique(by_vertices.begin(), by_vertices.end()), by_vertices.end());
-  const auto reverse_of = [&](uint32_t f) {
-    std::array<VertexId, 3> sorted = faces[f];
-    std::sort(sorted.begin(), sorted.end());
-    auto it = std::lower_bound(by_vertices.begin(), by_vertices.end(), std::pair{sorted, 0u});
-    for (; it != by_vertices.end() && it->first == sorted; ++it)
-      if (it->second != f) return it->second;
-    return kNoId;
-  };
+  // Per face on a non-manifold edge, its reverse: the first other face of its vertex set.
+  std::vector<uint32_t> reverse(faces.size(), kNoId);
+  for (size_t i = 0, end = 0; i < by_vertices.size(); i = end) {
+    while (end < by_vertices.size() && by_vertices[end].first == by_vertices[i].first) ++end;
+    const uint32_t first = by_vertices[i].second;
+    const uint32_t second = end - i > 1 ? by_vertices[i + 1].second : kNoId;
+    for (size_t k = i; k < end; ++k) reverse[by_vertices[k].second] = k == i ? second : first;
+  }
+  const auto reverse_of = [&](uint32_t f) { return reverse[f]; };
   const auto on_edge = [&](uint32_t e, uint32_t f) {
     for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i)
       if (edges[i] / 3 == f) return true;
     return false;
   };
-  // Per halfedge on a non-manifold edge, that edge.
-  std::vector<std::pair<uint32_t, uint32_t>> edge_of;
+  // Per halfedge, its non-manifold edge (kNoId: none).
+  std::vector<uint32_t> edge_of(3 * faces.size(), kNoId);
   for (uint32_t e = 0; e + 1 < offsets.size(); ++e)
-    for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i) edge_of.emplace_back(edges[i], e);
-  std::sort(edge_of.begin(), edge_of.end());
-  const auto edge_at = [&](uint32_t h) {
-    const auto it = std::lower_bound(edge_of.begin(), edge_of.end(), std::pair{h, 0u});
-    return it != edge_of.end() && it->first == h ? it->second : kNoId;
-  };
+    for (uint32_t i = offsets[e]; i < offsets[e + 1]; ++i)
+      if (edge_of[edges[i]] == kNoId) edge_of[edges[i]] = e;
+  const auto edge_at = [&](uint32_t h) { return edge_of[h]; };
 
   for (uint32_t e = 0; e + 1 < offsets.size(); ++e) {
     uint32_t single[3], count = 0;
