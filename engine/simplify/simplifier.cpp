@@ -260,10 +260,11 @@ bool Simplifier::pair_seam(uint32_t from, uint32_t into) {
   for (VertexId copy : groups_->of(from)) {
     if (!mesh_.vertex_alive(copy)) continue;
     if (seam_pairs_.size() == kMaxSeamCopies) return false;
-    mesh_.neighbors(copy, seam_ring_);
+    // The smallest neighbour in `into`, read off the faces around the copy.
     VertexId partner = kNoId;
-    for (VertexId n : seam_ring_)
-      if (groups_->group[n] == into) partner = std::min(partner, n);
+    for (FaceId f : mesh_.faces_of(copy))
+      for (VertexId n : mesh_.face(f))
+        if (n != copy && groups_->group[n] == into) partner = std::min(partner, n);
     if (partner == kNoId) return false;
     seam_pairs_.push_back({partner, copy});
   }
