@@ -18,6 +18,9 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 [[ $# -ge 1 ]] || { echo "usage: $0 MESH..." >&2; exit 2; }
+# shellcheck source=bench/common.sh
+source "$root/bench/common.sh"
+check_repeats "${REPEATS:-1}"
 p="${P:-2}"
 metric="${METRIC:-energy}"
 workers="${WORKERS:-2}"
@@ -36,7 +39,6 @@ for _ in $(seq 100); do [[ -s "$out/data/coordinator.port" ]] && break; sleep 0.
 sleep 1  # the workers register
 server=(--server "127.0.0.1:$port")
 printf "mesh\tp\tinprocess_s\tservice_s\tupload_s\twait_s\tdownload_s\tread_s\tencode_s\tcall_overhead_s\tstore_s\tjob_MB\tresult_MB\tbytes_per_face\ttransport_share\tservice_over_inprocess\tidentical\n"
-median() { sort -g | awk '{v[NR] = $1} END {print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2)}'; }
 for mesh in "$@"; do
   name="$(basename "$mesh")"; name="${name%%.*}"
   rows=""
