@@ -10,12 +10,14 @@
 
 #include <spdlog/spdlog.h>
 
+#include "parallel/held_quadrics.h"
 #include "parallel/job_codec.h"
 #include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
 #include "parapm.grpc.pb.h"
 #include "rpc_security.h"
 #include "rpc_status.h"
+#include "storage/ids.h"
 #include "util/clock.h"
 #include "util/error.h"
 #include "util/job_pool.h"
@@ -39,6 +41,13 @@ struct Flight {
   size_t index = 0;
   WorkerSlot slot;  // worker_id empty: in-process
   uint32_t attempt = 1;
+  // Set when the request made for the job leaves out quadrics another worker holds: this
+  // flight sends the job whole, encoded on its own thread.
+  std::optional<parapm::v1::SubsetRequest> whole;
+  uint64_t job_bytes = 0;      // what the call sent
+  uint64_t held_quadrics = 0;  // quadrics it left out
+  // With a build key: what the worker keeps at the job's end (global vertex, fingerprint).
+  std::vector<std::pair<VertexId, uint64_t>> kept;
   std::chrono::steady_clock::time_point start;
   grpc::ClientContext context;
   std::thread thread;
@@ -59,11 +68,14 @@ double transfer_seconds(const Flight& f) {
 
 // Reads the worker's stream into flight.result; the status says how it ended. A worker that
 // sends what does not decode is treated like one that failed (its subset goes elsewhere).
-// `on_begun` runs when the worker says the subset holds a slot.
+// `on_sent` runs once the request is sent (while the worker works; it must not throw),
+// `on_begun` when the worker says the subset holds a slot.
 void call_worker(Flight& flight, parapm::v1::WorkerService::Stub& stub,
-                 const parapm::v1::SubsetRequest& request, const std::function<void()>& on_begun) {
+                 const parapm::v1::SubsetRequest& request, const std::function<void()>& on_sent,
+                 const std::function<void()>& on_begun) {
   const auto start = std::chrono::steady_clock::now();
   auto reader = stub.SimplifySubset(&flight.context, request);
+  on_sent();
   parapm::v1::SubsetProgress message;
   bool summary = false;
   std::string broken;
@@ -106,7 +118,26 @@ RemoteRunner::RemoteRunner(WorkerRegistry& registry, WorkerChannels& channels,
     : registry_(registry),
       channels_(channels),
       options_(std::move(options)),
-      on_event_(std::move(on_event)) {}
+      on_event_(std::move(on_event)) {
+  if (options_.held_quadrics) build_key_ = options_.job_id + "/" + new_id("build-");
+}
+
+namespace {
+
+// What the worker of a quadric job keeps at its end (held_quadrics.h), as fingerprints: the
+// job's initial free quadrics (initial_free_quadrics) followed through its records, the
+// arithmetic of the worker's module. Error(kInvalidInput) when a record names a vertex that is
+// not a free one of the job.
+std::vector<std::pair<VertexId, uint64_t>> kept_fingerprints(QuadricState quadrics,
+                                                             const SubsetResult& result) {
+  follow_records(quadrics, result.records);
+  std::vector<std::pair<VertexId, uint64_t>> kept(quadrics.vertices.size());
+  for (size_t i = 0; i < kept.size(); ++i)
+    kept[i] = {quadrics.vertices[i], quadric_fingerprint(quadrics.quadrics[i])};
+  return kept;
+}
+
+}  // namespace
 
 // One run(): a round's subsets from their requests to their results. Its flights' threads
 // write only their own Flight; everything else is the dispatching thread's.
@@ -118,7 +149,8 @@ class RemoteRunner::Dispatch {
         cancel_(cancel),
         results_(jobs.size()),
         attempts_(jobs.size(), 0),
-        last_worker_(jobs.size()) {}
+        last_worker_(jobs.size()),
+        holder_(jobs.size()) {}
 
   std::vector<SubsetResult> run() {
     encode_requests();
@@ -139,18 +171,51 @@ class RemoteRunner::Dispatch {
   }
 
  private:
-  // Side by side, one job per hardware thread (each request is its own).
+  bool keeps_quadrics(const SubsetJob& job) const {
+    return !runner_.build_key_.empty() && job.options.metric == "quadric";
+  }
+
+  // The request of subset i as any worker takes it: the job whole.
+  parapm::v1::SubsetRequest whole_request(size_t i) const {
+    parapm::v1::SubsetRequest request;
+    request.set_job_id(runner_.options_.job_id);
+    request.set_round(jobs_[i].round);
+    request.set_subset(jobs_[i].subset);
+    if (keeps_quadrics(jobs_[i])) request.set_build_key(runner_.build_key_);
+    request.set_job(encode_subset_job(jobs_[i]));
+    return request;
+  }
+
+  // Side by side, one job per hardware thread (each request is its own). A quadric job goes
+  // without the quadrics its planned worker holds (holder_[i]; HeldQuadricsLedger::plan_round).
   void encode_requests() {
     const auto encode_start = std::chrono::steady_clock::now();
+    std::map<std::string, uint32_t> slots = runner_.registry_.live_slots_by_worker();
+    for (const std::string& id : runner_.distrusted_) slots.erase(id);
+    std::vector<HeldQuadricsLedger::Plan> plans;
+    if (!runner_.build_key_.empty()) plans = runner_.held_.plan_round(jobs_, slots);
     requests_.resize(jobs_.size());
+    held_count_.assign(jobs_.size(), 0);
     run_jobs(jobs_.size(), 0, [&](size_t i) {
-      requests_[i].set_job_id(runner_.options_.job_id);
-      requests_[i].set_round(jobs_[i].round);
-      requests_[i].set_subset(jobs_[i].subset);
-      requests_[i].set_job(encode_subset_job(jobs_[i]));
+      const SubsetJob& job = jobs_[i];
+      const HeldQuadricsLedger::Plan plan = plans.empty() ? HeldQuadricsLedger::Plan{} : plans[i];
+      if (plan.count == 0 || !keeps_quadrics(job)) {
+        requests_[i] = whole_request(i);
+        return;
+      }
+      parapm::v1::SubsetRequest& request = requests_[i];
+      request.set_job_id(runner_.options_.job_id);
+      request.set_round(job.round);
+      request.set_subset(job.subset);
+      request.set_build_key(runner_.build_key_);
+      MetricState state = job.state;
+      const HeldOut out = take_out_held(state.quadric, plan.held);
+      request.set_held_vertices(encode_increasing_ids(out.vertices));
+      request.set_held_fingerprint(out.fingerprint);
+      request.set_job(encode_subset_job(job, state));
+      holder_[i] = plan.worker;
+      held_count_[i] = out.vertices.size();
     });
-    for (const parapm::v1::SubsetRequest& request : requests_)
-      runner_.transport_.job_bytes += request.job().size();
     runner_.transport_.encode_seconds += seconds_since(encode_start);
   }
 
@@ -190,7 +255,8 @@ class RemoteRunner::Dispatch {
     flights_.clear();
   }
 
-  // Subset i on `slot`'s worker, or in-process without one, on a thread of its own.
+  // Subset i on `slot`'s worker, or in-process without one, on a thread of its own. A job
+  // whose request leaves out quadrics goes whole to another worker than their holder.
   void launch(size_t i, std::optional<WorkerSlot> slot) {
     auto flight = std::make_unique<Flight>();
     Flight& f = *flight;
@@ -206,10 +272,33 @@ class RemoteRunner::Dispatch {
     };
     if (slot) {
       f.slot = *slot;
+      const bool whole = !requests_[i].held_vertices().empty() && holder_[i] != slot->worker_id;
       rpc::attach_token(f.context, runner_.options_.token);
       auto stub = parapm::v1::WorkerService::NewStub(runner_.channels_.get(slot->address));
-      f.thread = std::thread([&f, request = &requests_[i], stub = std::move(stub), mark] {
-        call_worker(f, *stub, *request, [&] { mark(f.begun); });
+      f.thread = std::thread([this, &f, i, whole, stub = std::move(stub), mark] {
+        try {
+          if (whole) f.whole = whole_request(i);
+          const parapm::v1::SubsetRequest& request = f.whole ? *f.whole : requests_[i];
+          f.job_bytes = request.job().size() + request.held_vertices().size();
+          if (!f.whole) f.held_quadrics = held_count_[i];
+          // What the worker will keep starts from these, found while it works.
+          const bool keeps = !request.build_key().empty();
+          QuadricState initial;
+          std::string failed;
+          auto find_initial = [&] {
+            if (!keeps) return;
+            try {
+              initial = initial_free_quadrics(jobs_[i]);
+            } catch (const std::exception& e) {
+              failed = e.what();
+            }
+          };
+          call_worker(f, *stub, request, find_initial, [&] { mark(f.begun); });
+          if (!failed.empty()) throw Error(ErrorCode::kInternal, failed);
+          if (f.status.ok() && keeps) f.kept = kept_fingerprints(std::move(initial), f.result);
+        } catch (const std::exception& e) {
+          f.status = {grpc::StatusCode::DATA_LOSS, e.what()};
+        }
         mark(f.finished);
       });
     } else {
@@ -260,6 +349,7 @@ class RemoteRunner::Dispatch {
   // A finished flight: its result, or a retry elsewhere, or the job's failure (Error).
   void take_outcome(Flight& f) {
     const SubsetJob& job = jobs_[f.index];
+    if (!f.slot.worker_id.empty()) runner_.transport_.job_bytes += f.job_bytes;
     if (f.status.ok() && !f.slot.worker_id.empty() &&
         f.result.state.metric != returned_state_metric(job))
       f.status = {grpc::StatusCode::DATA_LOSS, "the worker returned a state of metric '" +
@@ -271,7 +361,10 @@ class RemoteRunner::Dispatch {
         transport.call_overhead_seconds += transfer_seconds(f);
         transport.result_bytes += f.result_bytes;
         ++transport.calls;
+        transport.held_quadrics += f.held_quadrics;
+        transport.sent_quadrics += job.state.quadric.vertices.size() - f.held_quadrics;
       }
+      if (!f.kept.empty()) runner_.held_.record(f.slot.worker_id, f.kept);
       event(SubsetEvent::Kind::kDone, f);
       results_[f.index] = std::move(f.result);
       ++done_;
@@ -282,6 +375,19 @@ class RemoteRunner::Dispatch {
     if (f.slot.worker_id.empty() || f.status.error_code() == grpc::StatusCode::INVALID_ARGUMENT)
       throw Error(rpc::error_code_of(f.status.error_code()),
                   "subset " + std::to_string(job.subset) + ": " + f.status.error_message());
+    if (f.status.error_code() == grpc::StatusCode::FAILED_PRECONDITION &&
+        holder_[f.index] == f.slot.worker_id) {
+      // The worker no longer holds what the job left out: the job goes whole, and no job of
+      // this build leaves anything out for that worker again. Not the subset's failure.
+      spdlog::info("job {}: worker {} lacks the quadrics subset {} of round {} left out: {}",
+                   runner_.options_.job_id, f.slot.name, job.subset, job.round,
+                   f.status.error_message());
+      runner_.distrusted_.insert(f.slot.worker_id);
+      holder_[f.index].clear();
+      --attempts_[f.index];
+      pending_.push_front(f.index);
+      return;
+    }
     spdlog::warn("job {}: subset {} of round {} failed on worker {} (attempt {}): {}",
                  runner_.options_.job_id, job.subset, job.round, f.slot.name, f.attempt,
                  f.status.error_message());
@@ -296,12 +402,30 @@ class RemoteRunner::Dispatch {
     pending_.push_front(f.index);
   }
 
-  // Launches what waits on the free workers (another than the one it failed on, where
-  // possible), or in-process when no worker is registered and the options allow it.
+  // The first waiting subset whose quadrics' holder can take it now, launched there.
+  bool dispatch_to_holders() {
+    WorkerRegistry& registry = runner_.registry_;
+    const bool queue_ahead = pending_.size() > registry.live_slots();
+    for (auto it = pending_.begin(); it != pending_.end(); ++it) {
+      const size_t i = *it;
+      if (holder_[i].empty() || holder_[i] == last_worker_[i]) continue;
+      if (std::optional<WorkerSlot> slot = registry.acquire_on(holder_[i], queue_ahead)) {
+        pending_.erase(it);
+        launch(i, slot);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // Launches what waits on the free workers: first each on the worker holding its quadrics,
+  // then on any (another than the one it failed on, where possible), or in-process when no
+  // worker is registered and the options allow it.
   void dispatch_pending() {
     const RemoteOptions& options = runner_.options_;
     WorkerRegistry& registry = runner_.registry_;
     while (!pending_.empty()) {
+      if (dispatch_to_holders()) continue;
       const size_t i = pending_.front();
       std::optional<WorkerSlot> slot = registry.acquire({last_worker_[i]});
       if (!slot) slot = registry.acquire();
@@ -351,6 +475,10 @@ class RemoteRunner::Dispatch {
   std::deque<size_t> pending_;            // subsets waiting for a worker, retries first
   std::vector<uint32_t> attempts_;        // per subset
   std::vector<std::string> last_worker_;  // per subset: the worker it last failed on
+  // Per subset: the worker its request was made for (it leaves out the quadrics that worker
+  // holds); empty: none, or that worker lost them (the job goes whole).
+  std::vector<std::string> holder_;
+  std::vector<uint64_t> held_count_;  // per subset: the quadrics its request leaves out
   std::vector<std::unique_ptr<Flight>> flights_;
   std::mutex mutex_;  // guards the flights' `finished` with changed_
   std::condition_variable changed_;

@@ -9,10 +9,12 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 
 #include <grpcpp/grpcpp.h>
 
+#include "held_quadrics_ledger.h"
 #include "parallel/parallel_build.h"
 #include "worker_registry.h"
 
@@ -50,18 +52,25 @@ struct RemoteOptions {
   // When no worker is registered, the coordinator runs subsets itself on this many threads
   // (0: it waits for a worker instead).
   unsigned local_threads = 0;
+  // A quadric build's workers keep their jobs' quadrics between rounds, and a later job goes
+  // to the worker holding most of its quadrics, without them (held_quadrics.h). Off: every
+  // job carries its whole state, to any worker.
+  bool held_quadrics = true;
 };
 
 // What moving the jobs cost, summed over every subset call of the runner's life.
 struct TransportStats {
-  double encode_seconds = 0;  // subset jobs to bytes, in the coordinator
+  double encode_seconds = 0;  // subset jobs to bytes, in the coordinator (before dispatch)
   // Per call: its wall time at the coordinator minus the worker's own time for the subset and
   // its wait for a slot there when queued ahead (left: sending the job, decoding it,
   // streaming and decoding the records), summed.
   double call_overhead_seconds = 0;
-  uint64_t job_bytes = 0;
+  uint64_t job_bytes = 0;     // of every call sent, retries included
   uint64_t result_bytes = 0;  // record batches and summaries
   uint64_t calls = 0;
+  // Quadrics left out of the jobs done (their workers held them), and those sent.
+  uint64_t held_quadrics = 0;
+  uint64_t sent_quadrics = 0;
 };
 
 class RemoteRunner : public SubsetRunner {
@@ -74,6 +83,10 @@ class RemoteRunner : public SubsetRunner {
  private:
   class Dispatch;  // one run's state (remote_runner.cpp)
   TransportStats transport_;
+  std::string build_key_;    // the workers keep this build's quadrics under it
+  HeldQuadricsLedger held_;  // what they keep
+  // Workers that lost quadrics this build had left with them: none is left out for them again.
+  std::set<std::string> distrusted_;
   WorkerRegistry& registry_;
   WorkerChannels& channels_;
   RemoteOptions options_;

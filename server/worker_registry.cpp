@@ -68,6 +68,15 @@ size_t WorkerRegistry::live_count() {
   return workers_.size();
 }
 
+std::map<std::string, uint32_t> WorkerRegistry::live_slots_by_worker() {
+  std::lock_guard lock(mutex_);
+  expire();
+  std::map<std::string, uint32_t> slots;
+  for (const auto& [id, entry] : workers_)
+    if (!entry.suspected) slots[id] = entry.description.threads;
+  return slots;
+}
+
 size_t WorkerRegistry::live_slots() {
   std::lock_guard lock(mutex_);
   expire();
@@ -96,6 +105,19 @@ std::optional<WorkerSlot> WorkerRegistry::acquire(const std::set<std::string>& a
   if (!best) return std::nullopt;
   ++best->busy;
   return WorkerSlot{best_id, best->description.address, best->description.name};
+}
+
+std::optional<WorkerSlot> WorkerRegistry::acquire_on(const std::string& worker_id,
+                                                     bool queue_ahead) {
+  std::lock_guard lock(mutex_);
+  expire();
+  const auto it = workers_.find(worker_id);
+  if (it == workers_.end()) return std::nullopt;
+  Entry& entry = it->second;
+  if (entry.suspected || entry.busy >= entry.description.threads * (queue_ahead ? 2 : 1))
+    return std::nullopt;
+  ++entry.busy;
+  return WorkerSlot{worker_id, entry.description.address, entry.description.name};
 }
 
 void WorkerRegistry::release(const std::string& worker_id) {

@@ -43,6 +43,8 @@ class WorkerRegistry {
   bool beat(const std::string& worker_id, uint32_t running_subsets);
   bool alive(const std::string& worker_id);
   size_t live_count();
+  // The live workers' ids and slots (not suspected ones).
+  std::map<std::string, uint32_t> live_slots_by_worker();
 
   // A slot on the least loaded live worker not in `avoid`, if any has a free one. With
   // `queue_ahead`, a worker whose slots are all busy takes up to one call more per slot: the
@@ -50,6 +52,9 @@ class WorkerRegistry {
   // frees there.
   std::optional<WorkerSlot> acquire(const std::set<std::string>& avoid = {},
                                     bool queue_ahead = false);
+  // A slot on that worker, if it is live, not suspected, and has a free one (with
+  // `queue_ahead`, as acquire()).
+  std::optional<WorkerSlot> acquire_on(const std::string& worker_id, bool queue_ahead = false);
   // The slots of the live workers, summed.
   size_t live_slots();
   void release(const std::string& worker_id);

@@ -11,6 +11,7 @@
 
 #include "coordinator_link.h"
 #include "daemon.h"
+#include "held_quadrics_cache.h"
 #include "metrics.h"
 #include "rpc_server.h"
 #include "subset_service.h"
@@ -30,6 +31,7 @@ struct WorkerArgs {
   parapm::rpc::TlsFiles tls;
   bool coordinator_tls = false;
   std::string metrics_listen;  // "" : no metrics endpoint
+  uint64_t held_quadrics_mb = 1024;
   std::string log_level = "info";
   std::string log_format = "text";
 };
@@ -40,13 +42,18 @@ int run(const WorkerArgs& args) {
   const std::string token = rpc::token_for_listening(args.token_file, args.listen);
   const unsigned threads = args.threads ? args.threads : std::thread::hardware_concurrency();
   worker::WorkerMetrics metrics(threads);
-  worker::SubsetService service(rpc::TokenCheck(token), threads, metrics);
+  // A build's held quadrics go unused between its rounds for seconds; ten minutes unused, the
+  // build is over or gone.
+  worker::HeldQuadricsCache held(args.held_quadrics_mb << 20, std::chrono::minutes(10));
+  worker::SubsetService service(rpc::TokenCheck(token), threads, metrics, held);
   // The metrics endpoint's options are checked before anything listens.
   std::optional<rpc::MetricsServer> metrics_server;
   if (!args.metrics_listen.empty())
     metrics_server.emplace(metrics.registry,
-                           rpc::MetricsEndpoint{args.metrics_listen, token, args.tls},
-                           [&] { metrics.running.Set(double(service.running())); });
+                           rpc::MetricsEndpoint{args.metrics_listen, token, args.tls}, [&] {
+                             metrics.running.Set(double(service.running()));
+                             metrics.held_quadrics_bytes.Set(double(held.bytes()));
+                           });
   rpc::ServerSetup setup;
   setup.listen = args.listen;
   setup.tls = args.tls;
@@ -101,6 +108,12 @@ int main(int argc, char** argv) {
                  "relative speed of this machine; the coordinator gives faster workers more work")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--held-quadrics-mb", args.held_quadrics_mb,
+                 "memory for the quadrics kept between a build's rounds, so that later jobs "
+                 "need not carry them (about 128 bytes a vertex; the builds used longest ago "
+                 "are dropped past it, and their next jobs come whole)")
+      ->capture_default_str()
+      ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 20));
   app.add_option("--name", args.name, "name in the coordinator's events and logs");
   app.add_option("--token-file", args.token_file,
                  "bearer token for every call, both ways (else PARAPM_TOKEN; required when "

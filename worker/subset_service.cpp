@@ -7,6 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "parallel/held_quadrics.h"
 #include "parallel/job_codec.h"
 #include "parallel/simplify_subset.h"
 #include "rpc_server.h"
@@ -23,6 +24,7 @@ namespace {
 constexpr size_t kRecordsPerBatch = 16384;
 constexpr auto kProgressInterval = std::chrono::milliseconds(250);
 constexpr auto kCancelPoll = std::chrono::milliseconds(20);
+constexpr size_t kMaxBuildKey = 256;  // the coordinator's are a job id and a random id
 
 // Passes the call's cancellation (the coordinator cancelled the job, or went away) to the
 // engine within kCancelPoll, whatever the engine is doing; stops at once when destroyed (the
@@ -60,8 +62,29 @@ class CancelWatcher {
 
 }  // namespace
 
-SubsetService::SubsetService(rpc::TokenCheck auth, unsigned slots, WorkerMetrics& metrics)
-    : auth_(std::move(auth)), slots_(std::max(1u, slots)), metrics_(metrics) {}
+SubsetService::SubsetService(rpc::TokenCheck auth, unsigned slots, WorkerMetrics& metrics,
+                             HeldQuadricsCache& held)
+    : auth_(std::move(auth)), slots_(std::max(1u, slots)), metrics_(metrics), held_(held) {}
+
+grpc::Status SubsetService::restore_held_quadrics(const parapm::v1::SubsetRequest& request,
+                                                  SubsetJob& job) {
+  if (request.held_vertices().empty()) return grpc::Status::OK;
+  if (request.build_key().empty() || job.state.metric != "quadric")
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            "held quadrics named without a build key or for a job without a quadric state"};
+  const std::vector<VertexId> local = decode_increasing_ids(
+      request.held_vertices(), job.global_vertex.size(), "held quadrics' vertices");
+  std::vector<VertexId> global(local.size());
+  for (size_t i = 0; i < local.size(); ++i) global[i] = job.global_vertex[local[i]];
+  std::vector<Quadric> quadrics;
+  if (!held_.find(request.build_key(), global, quadrics) ||
+      quadrics_fingerprint(quadrics) != request.held_fingerprint())
+    return {grpc::StatusCode::FAILED_PRECONDITION,
+            "this worker does not hold the " + std::to_string(local.size()) +
+                " quadrics the job leaves out (it was restarted or dropped them): send them"};
+  put_back_held(job.state.quadric, local, quadrics);
+  return grpc::Status::OK;
+}
 
 void SubsetService::record_outcome(const grpc::Status& status, double seconds,
                                    uint64_t bytes_sent) {
@@ -103,7 +126,11 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
   uint64_t bytes_sent = 0;
   const grpc::Status status = rpc::serve(auth_, context, [&]() -> grpc::Status {
     metrics_.job_bytes.Increment(double(request->job().size()));
+    if (request->build_key().size() > kMaxBuildKey)
+      return {grpc::StatusCode::INVALID_ARGUMENT,
+              "build key over " + std::to_string(kMaxBuildKey) + " bytes"};
     SubsetJob job = decode_subset_job(request->job());
+    if (grpc::Status held = restore_held_quadrics(*request, job); !held.ok()) return held;
     const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +
                              " subset " + std::to_string(job.subset);
     const auto decoded = std::chrono::steady_clock::now();
@@ -143,9 +170,12 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
       if (!writer->Write(message)) peer_gone = true;
     };
     spdlog::info("{}: started, {} faces", name, job.mesh.face_count());
+    // A quadric job of a build keeps its free vertices' quadrics at its end (held_quadrics.h).
+    const bool keeps = !request->build_key().empty();
+    QuadricState kept;
     SubsetResult result;
     try {
-      result = simplify_subset(std::move(job), progress, &cancel);
+      result = simplify_subset(std::move(job), progress, &cancel, keeps ? &kept : nullptr);
     } catch (const Error& e) {
       if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded)
         spdlog::info("{}: stopped ({}) after {:.3f} s", name, e.what(), seconds_since(start));
@@ -153,6 +183,9 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
         spdlog::warn("{}: failed: {}", name, e.what());
       throw;
     }
+
+    if (keeps) held_.keep(request->build_key(), kept);
+    kept = QuadricState{};
 
     // The records, then the summary; a failed write means the coordinator is gone.
     parapm::v1::SubsetProgress message;

@@ -34,7 +34,13 @@ WorkerMetrics::WorkerMetrics(unsigned slot_count)
                   .Name("parapm_worker_subsets_running")
                   .Help("Subsets running now")
                   .Register(*registry)
-                  .Add({})) {
+                  .Add({})),
+      held_quadrics_bytes(prometheus::BuildGauge()
+                              .Name("parapm_worker_held_quadrics_bytes")
+                              .Help("Bytes of quadrics kept between builds' rounds "
+                                    "(--held-quadrics-mb bounds them)")
+                              .Register(*registry)
+                              .Add({})) {
   for (const char* outcome : {"done", "failed", "cancelled"}) subsets.Add({{"outcome", outcome}});
   slots.Set(double(slot_count));
 }

@@ -620,7 +620,7 @@ void read_deferred(ByteReader& in, uint64_t bound, std::vector<DeferredEdge>& de
              [&](DeferredEdge& d) { d.key = in.f32(); });
 }
 
-void write_job(ByteWriter& out, const SubsetJob& job) {
+void write_job(ByteWriter& out, const SubsetJob& job, const MetricState& state) {
   const Mesh& m = job.mesh;
   const size_t floats = size_t(m.layout.floats_per_wedge());
   if (job.global_vertex.size() != m.vertex_count() || job.owned.size() != m.vertex_count() ||
@@ -666,7 +666,7 @@ void write_job(ByteWriter& out, const SubsetJob& job) {
     for (WedgeId id : w) write_near(out, id, previous);
   write_increasing(out, job.global_wedge, "global wedge");
   out.varint(job.owned_faces);
-  write_state(out, job.state);
+  write_state(out, state);
   write_keys(out, job.keys);
   write_deferred(out, job.deferred);
 }
@@ -853,8 +853,35 @@ void read_summary(ByteReader& in, SubsetResult& r) {
 std::string encode_subset_job(const SubsetJob& job) {
   std::ostringstream stream;
   ByteWriter out(&stream);
-  write_job(out, job);
+  write_job(out, job, job.state);
   return finish(out, stream);
+}
+
+std::string encode_subset_job(const SubsetJob& job, const MetricState& state) {
+  std::ostringstream stream;
+  ByteWriter out(&stream);
+  write_job(out, job, state);
+  return finish(out, stream);
+}
+
+std::string encode_increasing_ids(const std::vector<uint32_t>& ids) {
+  std::ostringstream stream;
+  ByteWriter out(&stream);
+  out.varint(ids.size());
+  write_increasing(out, ids, "listed");
+  return finish(out, stream);
+}
+
+std::vector<uint32_t> decode_increasing_ids(std::string_view bytes, uint64_t bound,
+                                            const char* what) {
+  ViewReader reader(bytes, what);
+  ByteReader& in = reader.in;
+  in.set_context("ids");
+  const uint64_t n = read_count(in, 1, "ids");
+  std::vector<uint32_t> ids;
+  read_increasing(in, n, bound, ids);
+  expect_end(in);
+  return ids;
 }
 
 SubsetJob decode_subset_job(std::string_view bytes) {

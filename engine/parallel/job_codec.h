@@ -77,9 +77,18 @@
 namespace parapm {
 
 std::string encode_subset_job(const SubsetJob& job);
+// The job with `state` in place of its own (its quadric state less the quadrics its worker
+// holds: held_quadrics.h).
+std::string encode_subset_job(const SubsetJob& job, const MetricState& state);
 // Also runs validate_subset_job and checks the state against the job's mesh (ids in range,
 // the attribute state E_scalar will need), so that simplify_subset can import it safely.
 SubsetJob decode_subset_job(std::string_view bytes);
+
+// A list of strictly increasing ids (n v, ids+), and back: Error(kInvalidInput) "`what`: byte N
+// ..." for ids not below `bound`, trailing bytes or a short list.
+std::string encode_increasing_ids(const std::vector<uint32_t>& ids);
+std::vector<uint32_t> decode_increasing_ids(std::string_view bytes, uint64_t bound,
+                                            const char* what);
 
 // One batch of records (a worker streams several); ids are the whole mesh's, checked by
 // replay_collapses (collapse_merge.h) against the coordinator's mesh, which completes them.

@@ -8,6 +8,7 @@
 
 #include "parallel/job_state.h"
 #include "parallel/subset_rule.h"
+#include "simplify/quadric_priority.h"
 #include "simplify/simplify.h"
 #include "util/clock.h"
 
@@ -61,7 +62,7 @@ namespace {
 // `release` (null, or `job` itself when the caller gives it up): its mesh, state and keys are
 // released once the working mesh, the module and the memo hold them.
 SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCallback& progress,
-                      const CancelToken* cancel) {
+                      const CancelToken* cancel, QuadricState* free_quadrics) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
   validate_subset_job(job);
@@ -74,6 +75,12 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
   result.owned_faces = job.owned_faces;
   std::vector<uint8_t> free_vertex = free_vertices(job.mesh, job.owned);
   for (uint8_t f : free_vertex) result.free_vertices += f;
+  if (free_quadrics) {
+    *free_quadrics = QuadricState{};
+    if (job.options.metric == "quadric")
+      for (VertexId v = 0; v < free_vertex.size(); ++v)
+        if (free_vertex[v]) free_quadrics->vertices.push_back(v);
+  }
 
   CollapseMesh working(job.mesh);
   std::unique_ptr<PriorityModule> metric = job_module(job, working);
@@ -126,6 +133,14 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
   memo.reset();
   metric->release_caches();
   if (had_state) result.state = export_result_state(*metric, working, job, result.records);
+  if (free_quadrics && !free_quadrics->vertices.empty()) {
+    const auto& quadrics = dynamic_cast<const QuadricPriority&>(*metric);
+    free_quadrics->quadrics.reserve(free_quadrics->vertices.size());
+    for (VertexId& v : free_quadrics->vertices) {
+      free_quadrics->quadrics.push_back(quadrics.quadric(v));
+      v = job.global_vertex[v];
+    }
+  }
   for (CollapseRecord& r : result.records) globalise(r, job);
   result.costings = metric->costings();
   result.wall_seconds = seconds_since(start);
@@ -144,13 +159,13 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
 }  // namespace
 
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress,
-                             const CancelToken* cancel) {
-  return simplify(job, nullptr, progress, cancel);
+                             const CancelToken* cancel, QuadricState* free_quadrics) {
+  return simplify(job, nullptr, progress, cancel, free_quadrics);
 }
 
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress,
-                             const CancelToken* cancel) {
-  return simplify(job, &job, progress, cancel);
+                             const CancelToken* cancel, QuadricState* free_quadrics) {
+  return simplify(job, &job, progress, cancel, free_quadrics);
 }
 
 }  // namespace parapm

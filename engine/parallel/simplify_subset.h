@@ -42,14 +42,18 @@ struct SubsetResult {
 };
 
 // Throws Error(kInvalidInput) for an invalid job or options, Error(kCancelled /
-// kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing.
+// kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing. With
+// `free_quadrics` and a quadric job: its free vertices' quadrics at its end, in global ids
+// (what a worker keeps between rounds: held_quadrics.h); left empty otherwise.
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress = {},
-                             const CancelToken* cancel = nullptr);
+                             const CancelToken* cancel = nullptr,
+                             QuadricState* free_quadrics = nullptr);
 // The same, releasing the job's mesh, state and keys as soon as its working mesh and metric
 // hold them (a job's peak memory holds them once, not twice); `job` keeps its ids, owned and
 // locked flags and options.
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress = {},
-                             const CancelToken* cancel = nullptr);
+                             const CancelToken* cancel = nullptr,
+                             QuadricState* free_quadrics = nullptr);
 
 // The options a job's metric is made with (Error(kInvalidInput) for invalid ones).
 SimplifyOptions simplify_options_of(const SubsetOptions& subset);

@@ -1,6 +1,6 @@
 // The coordinator's registry of workers, as its dispatcher uses it: a slot on the least
-// loaded live worker, one call more per slot only when queueing ahead, none on a suspected
-// worker, and the live slots counted.
+// loaded live worker or on a named one, one call more per slot only when queueing ahead, none
+// on a suspected worker, and the live slots counted.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -55,6 +55,25 @@ TEST(WorkerRegistry, QueueingAheadTakesOneCallMorePerSlot) {
   const std::optional<WorkerSlot> again = registry.acquire({two}, true);
   ASSERT_TRUE(again);
   EXPECT_EQ(again->worker_id, one);
+}
+
+// A slot on one named worker (the holder of a job's quadrics), under the same bounds.
+TEST(WorkerRegistry, ASlotOnANamedWorker) {
+  WorkerRegistry registry(milliseconds(60000));
+  const std::string one = registry.add(worker("one", 1));
+  const std::string two = registry.add(worker("two", 1));
+  ASSERT_TRUE(registry.acquire_on(two));
+  EXPECT_FALSE(registry.acquire_on(two)) << "its one slot is busy";
+  ASSERT_TRUE(registry.acquire_on(two, true)) << "one call queued ahead";
+  EXPECT_FALSE(registry.acquire_on(two, true));
+  EXPECT_FALSE(registry.acquire_on("worker-unknown"));
+  EXPECT_EQ(registry.live_slots_by_worker(),
+            (std::map<std::string, uint32_t>{{one, 1u}, {two, 1u}}));
+  registry.suspect(one);
+  EXPECT_FALSE(registry.acquire_on(one)) << "a suspect takes nothing";
+  EXPECT_EQ(registry.live_slots_by_worker(), (std::map<std::string, uint32_t>{{two, 1u}}));
+  registry.release(two);
+  EXPECT_TRUE(registry.acquire_on(two, true));
 }
 
 TEST(WorkerRegistry, AQueuedCallGoesToTheLeastLoadedAndNeverToASuspect) {

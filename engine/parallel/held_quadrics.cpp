@@ -1,0 +1,126 @@
+#include "parallel/held_quadrics.h"
+
+#include <algorithm>
+#include <bit>
+#include <string>
+
+#include "parallel/simplify_subset.h"
+#include "parallel/subset_rule.h"
+#include "simplify/quadric_priority.h"
+#include "util/error.h"
+
+namespace parapm {
+namespace {
+
+// splitmix64's finaliser: every input bit reaches every output bit.
+uint64_t mix(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+uint64_t quadric_fingerprint(const Quadric& q) {
+  uint64_t h = 0x51ad41c5ULL;
+  for (double x : {q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.b0, q.b1, q.b2, q.c, q.weight})
+    h = mix(h ^ std::bit_cast<uint64_t>(x));
+  return h;
+}
+
+uint64_t quadrics_fingerprint(const std::vector<Quadric>& quadrics) {
+  uint64_t h = mix(quadrics.size());
+  for (const Quadric& q : quadrics) h = mix(h ^ quadric_fingerprint(q));
+  return h;
+}
+
+QuadricState initial_free_quadrics(const SubsetJob& job) {
+  QuadricState out;
+  if (job.options.metric != "quadric") return out;
+  if (!job.state.empty()) {
+    out = job.state.quadric;
+  } else {
+    // What the job's simplifier does first: initialise its module on its working mesh.
+    const CollapseMesh working(job.mesh);
+    const std::unique_ptr<PriorityModule> module = job_module(job, working);
+    module->initialize(working);
+    const auto* quadrics = dynamic_cast<const QuadricPriority*>(module.get());
+    if (!quadrics) throw_internal("initial_free_quadrics: the quadric job's module is another");
+    const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+    for (VertexId v = 0; v < free.size(); ++v)
+      if (free[v]) {
+        out.vertices.push_back(v);
+        out.quadrics.push_back(quadrics->quadric(v));
+      }
+  }
+  for (VertexId& v : out.vertices) {
+    if (v >= job.global_vertex.size())
+      throw_invalid("quadric state: vertex " + std::to_string(v) + " out of the job's range");
+    v = job.global_vertex[v];
+  }
+  return out;
+}
+
+void follow_records(QuadricState& quadrics, const std::vector<CollapseRecord>& records) {
+  const std::vector<VertexId>& ids = quadrics.vertices;
+  auto index_of = [&](VertexId v, size_t record) {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), v);
+    if (it == ids.end() || *it != v)
+      throw_invalid("collapse " + std::to_string(record) + ": vertex " + std::to_string(v) +
+                    " is not a free vertex of its job");
+    return size_t(it - ids.begin());
+  };
+  for (size_t i = 0; i < records.size(); ++i) {
+    const size_t s = index_of(records[i].vs, i), t = index_of(records[i].vt, i);
+    quadrics.quadrics[s] += quadrics.quadrics[t];
+  }
+}
+
+HeldOut take_out_held(QuadricState& state, const std::vector<uint8_t>& held) {
+  if (held.size() != state.vertices.size())
+    throw_internal("take_out_held: one flag per quadric expected");
+  HeldOut out;
+  std::vector<Quadric> held_quadrics;
+  size_t kept = 0;
+  for (size_t i = 0; i < held.size(); ++i) {
+    if (held[i]) {
+      out.vertices.push_back(state.vertices[i]);
+      held_quadrics.push_back(state.quadrics[i]);
+    } else {
+      state.vertices[kept] = state.vertices[i];
+      state.quadrics[kept] = state.quadrics[i];
+      ++kept;
+    }
+  }
+  state.vertices.resize(kept);
+  state.quadrics.resize(kept);
+  out.fingerprint = quadrics_fingerprint(held_quadrics);
+  return out;
+}
+
+void put_back_held(QuadricState& state, const std::vector<VertexId>& vertices,
+                   const std::vector<Quadric>& quadrics) {
+  if (vertices.size() != quadrics.size())
+    throw_invalid("held quadrics: " + std::to_string(vertices.size()) + " vertices, " +
+                  std::to_string(quadrics.size()) + " quadrics");
+  QuadricState merged;
+  merged.vertices.reserve(state.vertices.size() + vertices.size());
+  merged.quadrics.reserve(merged.vertices.capacity());
+  size_t i = 0, j = 0;
+  while (i < state.vertices.size() || j < vertices.size()) {
+    const bool from_held =
+        i == state.vertices.size() || (j < vertices.size() && vertices[j] < state.vertices[i]);
+    const VertexId v = from_held ? vertices[j] : state.vertices[i];
+    if (!merged.vertices.empty() && v <= merged.vertices.back())
+      throw_invalid("held quadrics: vertex " + std::to_string(v) +
+                    (v == merged.vertices.back() ? " is in the job's state too"
+                                                 : " out of increasing order"));
+    merged.vertices.push_back(v);
+    merged.quadrics.push_back(from_held ? quadrics[j++] : state.quadrics[i++]);
+  }
+  state = std::move(merged);
+}
+
+}  // namespace parapm

@@ -1,0 +1,135 @@
+// What a worker keeps of a quadric job (held_quadrics.h), its module's quadrics at the end, is
+// what the coordinator computes from the job and its records and what the master holds after
+// following them: its free vertices' quadrics, bit for bit, with or without a state (round 0's
+// jobs initialise their own); a state less its held quadrics, put back, is the state again.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstring>
+
+#include "parallel/held_quadrics.h"
+#include "parallel/job_codec.h"
+#include "parallel/simplify_subset.h"
+#include "parallel_test_support.h"
+#include "simplify/quadric_priority.h"
+#include "util/error.h"
+
+namespace parapm {
+namespace {
+
+bool same_bits(const Quadric& a, const Quadric& b) {
+  return std::memcmp(&a, &b, sizeof(Quadric)) == 0;
+}
+
+// For each job, with its state and without (round 0): the quadrics its worker keeps are those
+// the master has once it followed every job's records.
+TEST(HeldQuadrics, AWorkerKeepsWhatTheMasterHoldsAfterTheRound) {
+  for (const char* name : {"stratocaster-9k.ply", "cad-cycloidal-43k.ply"}) {
+    testing::RoundZero round(name, SimplifyOptions{}, 4);
+    auto& master = dynamic_cast<QuadricPriority&>(*round.master);
+    std::vector<QuadricState> kept;
+    for (SubsetJob& job : round.jobs) {
+      job.options.target_faces = job.mesh.face_count() / 3;
+      SubsetJob without = job;
+      without.state = MetricState{};
+      const QuadricState from_state = initial_free_quadrics(job);
+      const QuadricState initialised = initial_free_quadrics(without);
+      ASSERT_EQ(from_state.vertices, initialised.vertices) << name;
+      ASSERT_FALSE(from_state.vertices.empty());
+      for (size_t i = 0; i < from_state.vertices.size(); ++i) {
+        ASSERT_TRUE(same_bits(from_state.quadrics[i], initialised.quadrics[i]))
+            << name << " vertex " << from_state.vertices[i];
+        ASSERT_TRUE(same_bits(initialised.quadrics[i], master.quadric(initialised.vertices[i])));
+      }
+      QuadricState state = initialised;
+      QuadricState at_end;
+      const SubsetResult result = simplify_subset(without, {}, nullptr, &at_end);
+      ASSERT_FALSE(result.records.empty());
+      follow_records(state, result.records);
+      // The job's own quadrics at its end, as a worker keeps them, are the followed ones.
+      ASSERT_EQ(at_end.vertices, state.vertices);
+      for (size_t i = 0; i < state.vertices.size(); ++i)
+        ASSERT_TRUE(same_bits(at_end.quadrics[i], state.quadrics[i])) << name;
+      master.follow_records(result.records);
+      kept.push_back(std::move(state));
+    }
+    size_t compared = 0;
+    for (const QuadricState& state : kept)
+      for (size_t i = 0; i < state.vertices.size(); ++i, ++compared)
+        ASSERT_TRUE(same_bits(state.quadrics[i], master.quadric(state.vertices[i])))
+            << name << " vertex " << state.vertices[i];
+    EXPECT_GT(compared, round.whole.live_vertices() / 2) << name;
+  }
+}
+
+TEST(HeldQuadrics, ARecordOfAVertexNotFreeIsRefused) {
+  testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
+  const SubsetJob& job = round.jobs[0];
+  QuadricState state = initial_free_quadrics(job);
+  CollapseRecord r;
+  r.vs = state.vertices[0];
+  r.vt = round.jobs[1].global_vertex[0];  // the other subset's
+  ASSERT_FALSE(std::binary_search(state.vertices.begin(), state.vertices.end(), r.vt));
+  EXPECT_THROW(follow_records(state, {r}), Error);
+}
+
+TEST(HeldQuadrics, TakenOutAndPutBackTheStateIsTheSame) {
+  testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
+  const QuadricState whole = round.jobs[0].state.quadric;
+  ASSERT_GT(whole.vertices.size(), 10u);
+  std::vector<uint8_t> held(whole.vertices.size(), 0);
+  for (size_t i = 0; i < held.size(); i += 3) held[i] = 1;
+  QuadricState state = whole;
+  const HeldOut out = take_out_held(state, held);
+  EXPECT_EQ(out.vertices.size() + state.vertices.size(), whole.vertices.size());
+  std::vector<Quadric> quadrics;
+  for (size_t i = 0; i < held.size(); ++i)
+    if (held[i]) quadrics.push_back(whole.quadrics[i]);
+  EXPECT_EQ(out.fingerprint, quadrics_fingerprint(quadrics));
+  // The ids travel as the request's list.
+  EXPECT_EQ(
+      decode_increasing_ids(encode_increasing_ids(out.vertices), whole.vertices.back() + 1, "held"),
+      out.vertices);
+
+  QuadricState doubled = state;
+  std::vector<VertexId> twice = out.vertices;
+  twice[1] = state.vertices[0];  // a vertex the state holds already
+  std::sort(twice.begin(), twice.end());
+  EXPECT_THROW(put_back_held(doubled, twice, quadrics), Error);
+  std::vector<VertexId> unsorted = out.vertices;
+  std::swap(unsorted[0], unsorted[1]);
+  QuadricState shuffled = state;
+  EXPECT_THROW(put_back_held(shuffled, unsorted, quadrics), Error);
+  EXPECT_THROW(put_back_held(shuffled, out.vertices, {}), Error);
+
+  put_back_held(state, out.vertices, quadrics);
+  ASSERT_EQ(state.vertices, whole.vertices);
+  for (size_t i = 0; i < whole.quadrics.size(); ++i)
+    ASSERT_TRUE(same_bits(state.quadrics[i], whole.quadrics[i]));
+}
+
+TEST(HeldQuadrics, FingerprintsSeeEveryBit) {
+  Quadric q = Quadric::from_plane({0, 0, 1}, -1, 2);
+  const uint64_t f = quadric_fingerprint(q);
+  Quadric signed_zero = q;
+  signed_zero.a01 = -0.0;  // equal as a double, not as bits
+  EXPECT_NE(quadric_fingerprint(signed_zero), f);
+  Quadric nudged = q;
+  nudged.weight = std::nextafter(q.weight, 3.0);
+  EXPECT_NE(quadric_fingerprint(nudged), f);
+  EXPECT_NE(quadrics_fingerprint({q, nudged}), quadrics_fingerprint({nudged, q}));
+  EXPECT_NE(quadrics_fingerprint({q}), quadrics_fingerprint({q, q}));
+}
+
+TEST(HeldQuadrics, AHostileIdListIsRefused) {
+  const std::string ids = encode_increasing_ids({3, 7, 9});
+  EXPECT_EQ(decode_increasing_ids(ids, 10, "held"), (std::vector<uint32_t>{3, 7, 9}));
+  EXPECT_THROW(decode_increasing_ids(ids, 9, "held"), Error);                // 9 out of range
+  EXPECT_THROW(decode_increasing_ids(ids + "x", 10, "held"), Error);         // trailing bytes
+  EXPECT_THROW(decode_increasing_ids(ids.substr(0, 2), 10, "held"), Error);  // cut short
+  EXPECT_THROW(decode_increasing_ids("\xff\xff\xff\xff\x0f", 10, "held"), Error);
+  EXPECT_THROW(encode_increasing_ids({3, 3}), Error);
+}
+
+}  // namespace
+}  // namespace parapm
