@@ -11,8 +11,8 @@
 # summed over calls, storing the PM), the MB of jobs and of results moved between coordinator
 # and workers and their sum per input face (bytes), transport / service wall, service /
 # in-process wall, whether both .pm files are byte-identical (they must be), and the share of
-# the quadrics the jobs left out, their workers holding them from a round before (the
-# quadric's; 0 for the energy). With REPEATS
+# the state the jobs left out, their workers holding it from a round before (quadrics, or the
+# energy's points' positions). With REPEATS
 # (default 1) above 1, each mesh is run that many times, in turn, and a last line ("# ...")
 # gives the medians of both wall clocks and of their ratio.
 # Environment: P (default 2), METRIC (default energy), WORKERS, WORKER_THREADS, REPEATS, PORT
@@ -40,7 +40,7 @@ trap 'kill -INT $up_pid 2> /dev/null; wait $up_pid 2> /dev/null || true' EXIT
 for _ in $(seq 100); do [[ -s "$out/data/coordinator.port" ]] && break; sleep 0.1; done
 sleep 1  # the workers register
 server=(--server "127.0.0.1:$port")
-printf "mesh\tp\tinprocess_s\tservice_s\tupload_s\twait_s\tdownload_s\tread_s\tencode_s\tcall_overhead_s\tstore_s\tjob_MB\tresult_MB\tbytes_per_face\ttransport_share\tservice_over_inprocess\tidentical\theld_quadrics_share\n"
+printf "mesh\tp\tinprocess_s\tservice_s\tupload_s\twait_s\tdownload_s\tread_s\tencode_s\tcall_overhead_s\tstore_s\tjob_MB\tresult_MB\tbytes_per_face\ttransport_share\tservice_over_inprocess\tidentical\theld_share\n"
 for mesh in "$@"; do
   name="$(basename "$mesh")"; name="${name%%.*}"
   rows=""
@@ -72,7 +72,7 @@ for mesh in "$@"; do
           | round),
          ($moved / .client.total_seconds * 1000 | round / 1000),
          (.client.total_seconds / ($local | tonumber) * 1000 | round / 1000), $same,
-         ((($t.held_quadrics // "0") | tonumber) as $h | (($t.sent_quadrics // "0") | tonumber) as $s
+         ((($t.held_items // "0") | tonumber) as $h | (($t.sent_items // "0") | tonumber) as $s
           | if $h + $s > 0 then ($h / ($h + $s) * 1000 | round / 1000) else 0 end)] | @tsv' <<< "$svc"
     )"
     printf "%s\n" "$row"

@@ -672,14 +672,14 @@ void Coordinator::execute(JobRecord& record, Running& running,
   transport.set_job_bytes(moved.job_bytes);
   transport.set_result_bytes(moved.result_bytes);
   transport.set_calls(moved.calls);
-  transport.set_held_quadrics(moved.held_quadrics);
-  transport.set_sent_quadrics(moved.sent_quadrics);
+  transport.set_held_items(moved.held_items);
+  transport.set_sent_items(moved.sent_items);
   spdlog::info(
-      "job {} transport: {} calls, jobs {:.1f} MB encoded in {:.3f} s ({} quadrics left out, "
+      "job {} transport: {} calls, jobs {:.1f} MB encoded in {:.3f} s ({} items of state left out, "
       "held by their workers; {} sent), results {:.1f} MB, call overhead {:.3f} s in all; read "
       "{:.3f} s, store {:.3f} s",
-      job_id, moved.calls, double(moved.job_bytes) / 1e6, moved.encode_seconds, moved.held_quadrics,
-      moved.sent_quadrics, double(moved.result_bytes) / 1e6, moved.call_overhead_seconds,
+      job_id, moved.calls, double(moved.job_bytes) / 1e6, moved.encode_seconds, moved.held_items,
+      moved.sent_items, double(moved.result_bytes) / 1e6, moved.call_overhead_seconds,
       transport.read_seconds(), transport.store_seconds());
 }
 

@@ -10,7 +10,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "parallel/held_quadrics.h"
+#include "parallel/held_state.h"
 #include "parallel/job_codec.h"
 #include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
@@ -44,10 +44,10 @@ struct Flight {
   // Set when the request made for the job leaves out quadrics another worker holds: this
   // flight sends the job whole, encoded on its own thread.
   std::optional<parapm::v1::SubsetRequest> whole;
-  uint64_t job_bytes = 0;      // what the call sent
-  uint64_t held_quadrics = 0;  // quadrics it left out
-  // With a build key: what the worker keeps at the job's end (global vertex, fingerprint).
-  std::vector<std::pair<VertexId, uint64_t>> kept;
+  uint64_t job_bytes = 0;   // what the call sent
+  uint64_t held_items = 0;  // quadrics or points it left out
+  // With a build key: what the worker holds after the job (holdable items: id, fingerprint).
+  std::vector<std::pair<uint32_t, uint64_t>> kept;
   std::chrono::steady_clock::time_point start;
   grpc::ClientContext context;
   std::thread thread;
@@ -119,22 +119,30 @@ RemoteRunner::RemoteRunner(WorkerRegistry& registry, WorkerChannels& channels,
       channels_(channels),
       options_(std::move(options)),
       on_event_(std::move(on_event)) {
-  if (options_.held_quadrics) build_key_ = options_.job_id + "/" + new_id("build-");
+  if (options_.held_state) build_key_ = options_.job_id + "/" + new_id("build-");
 }
 
 namespace {
 
-// What the worker of a quadric job keeps at its end (held_quadrics.h), as fingerprints: the
+// What the worker of a quadric job keeps at its end (held_state.h), as fingerprints: the
 // job's initial free quadrics (initial_free_quadrics) followed through its records, the
 // arithmetic of the worker's module. Error(kInvalidInput) when a record names a vertex that is
 // not a free one of the job.
-std::vector<std::pair<VertexId, uint64_t>> kept_fingerprints(QuadricState quadrics,
+std::vector<std::pair<uint32_t, uint64_t>> kept_fingerprints(QuadricState quadrics,
                                                              const SubsetResult& result) {
   follow_records(quadrics, result.records);
-  std::vector<std::pair<VertexId, uint64_t>> kept(quadrics.vertices.size());
+  std::vector<std::pair<uint32_t, uint64_t>> kept(quadrics.vertices.size());
   for (size_t i = 0; i < kept.size(); ++i)
     kept[i] = {quadrics.vertices[i], quadric_fingerprint(quadrics.quadrics[i])};
   return kept;
+}
+
+// The items of the job's state that a worker may hold (holdable_items), counted.
+size_t holdable_count(const SubsetJob& job) {
+  if (job.state.metric == "quadric") return job.state.quadric.vertices.size();
+  if (job.state.metric == "energy" && job.state.energy.positions)
+    return job.state.energy.points.size();
+  return 0;
 }
 
 }  // namespace
@@ -171,8 +179,9 @@ class RemoteRunner::Dispatch {
   }
 
  private:
-  bool keeps_quadrics(const SubsetJob& job) const {
-    return !runner_.build_key_.empty() && job.options.metric == "quadric";
+  bool keeps_state(const SubsetJob& job) const {
+    return !runner_.build_key_.empty() &&
+           (job.options.metric == "quadric" || job.options.metric == "energy");
   }
 
   // The request of subset i as any worker takes it: the job whole.
@@ -181,25 +190,32 @@ class RemoteRunner::Dispatch {
     request.set_job_id(runner_.options_.job_id);
     request.set_round(jobs_[i].round);
     request.set_subset(jobs_[i].subset);
-    if (keeps_quadrics(jobs_[i])) request.set_build_key(runner_.build_key_);
+    if (keeps_state(jobs_[i])) request.set_build_key(runner_.build_key_);
     request.set_job(encode_subset_job(jobs_[i]));
     return request;
   }
 
-  // Side by side, one job per hardware thread (each request is its own). A quadric job goes
-  // without the quadrics its planned worker holds (holder_[i]; HeldQuadricsLedger::plan_round).
+  // Side by side, one job per hardware thread (each request is its own). A job goes without
+  // what its planned worker holds (holder_[i]; HeldStateLedger::plan_round): a quadric job
+  // without those quadrics, an energy job without those points' positions and values.
   void encode_requests() {
     const auto encode_start = std::chrono::steady_clock::now();
     std::map<std::string, uint32_t> slots = runner_.registry_.live_slots_by_worker();
     for (const std::string& id : runner_.distrusted_) slots.erase(id);
-    std::vector<HeldQuadricsLedger::Plan> plans;
-    if (!runner_.build_key_.empty()) plans = runner_.held_.plan_round(jobs_, slots);
+    items_.assign(jobs_.size(), {});
+    std::vector<HeldStateLedger::Plan> plans;
+    if (!runner_.build_key_.empty()) {
+      run_jobs(jobs_.size(), 0, [&](size_t i) {
+        if (keeps_state(jobs_[i])) items_[i] = holdable_items(jobs_[i]);
+      });
+      plans = runner_.held_.plan_round(items_, slots);
+    }
     requests_.resize(jobs_.size());
     held_count_.assign(jobs_.size(), 0);
     run_jobs(jobs_.size(), 0, [&](size_t i) {
       const SubsetJob& job = jobs_[i];
-      const HeldQuadricsLedger::Plan plan = plans.empty() ? HeldQuadricsLedger::Plan{} : plans[i];
-      if (plan.count == 0 || !keeps_quadrics(job)) {
+      const HeldStateLedger::Plan plan = plans.empty() ? HeldStateLedger::Plan{} : plans[i];
+      if (plan.count == 0 || !keeps_state(job)) {
         requests_[i] = whole_request(i);
         return;
       }
@@ -208,13 +224,27 @@ class RemoteRunner::Dispatch {
       request.set_round(job.round);
       request.set_subset(job.subset);
       request.set_build_key(runner_.build_key_);
-      MetricState state = job.state;
-      const HeldOut out = take_out_held(state.quadric, plan.held);
-      request.set_held_vertices(encode_increasing_ids(out.vertices));
-      request.set_held_fingerprint(out.fingerprint);
-      request.set_job(encode_subset_job(job, state));
+      if (job.state.metric == "quadric") {
+        MetricState state = job.state;
+        const HeldOut out = take_out_held(state.quadric, plan.held);
+        request.set_held_ids(encode_increasing_ids(out.vertices));
+        request.set_held_fingerprint(out.fingerprint);
+        request.set_job(encode_subset_job(job, state));
+      } else {
+        // The points' positions and values, by their indices in the state's points.
+        std::vector<uint32_t> indices;
+        std::vector<uint64_t> fingerprints;
+        for (uint32_t k = 0; k < plan.held.size(); ++k)
+          if (plan.held[k]) {
+            indices.push_back(k);
+            fingerprints.push_back(items_[i][k].second);
+          }
+        request.set_held_ids(encode_increasing_ids(indices));
+        request.set_held_fingerprint(fingerprints_fingerprint(fingerprints));
+        request.set_job(encode_subset_job(job, job.state, indices));
+      }
       holder_[i] = plan.worker;
-      held_count_[i] = out.vertices.size();
+      held_count_[i] = plan.count;
     });
     runner_.transport_.encode_seconds += seconds_since(encode_start);
   }
@@ -256,7 +286,7 @@ class RemoteRunner::Dispatch {
   }
 
   // Subset i on `slot`'s worker, or in-process without one, on a thread of its own. A job
-  // whose request leaves out quadrics goes whole to another worker than their holder.
+  // whose request leaves out state goes whole to another worker than its holder.
   void launch(size_t i, std::optional<WorkerSlot> slot) {
     auto flight = std::make_unique<Flight>();
     Flight& f = *flight;
@@ -272,30 +302,37 @@ class RemoteRunner::Dispatch {
     };
     if (slot) {
       f.slot = *slot;
-      const bool whole = !requests_[i].held_vertices().empty() && holder_[i] != slot->worker_id;
+      const bool whole = !requests_[i].held_ids().empty() && holder_[i] != slot->worker_id;
       rpc::attach_token(f.context, runner_.options_.token);
       auto stub = parapm::v1::WorkerService::NewStub(runner_.channels_.get(slot->address));
       f.thread = std::thread([this, &f, i, whole, stub = std::move(stub), mark] {
         try {
           if (whole) f.whole = whole_request(i);
           const parapm::v1::SubsetRequest& request = f.whole ? *f.whole : requests_[i];
-          f.job_bytes = request.job().size() + request.held_vertices().size();
-          if (!f.whole) f.held_quadrics = held_count_[i];
-          // What the worker will keep starts from these, found while it works.
+          f.job_bytes = request.job().size() + request.held_ids().size();
+          if (!f.whole) f.held_items = held_count_[i];
+          // What the worker will keep (an energy job's points as sent; a quadric job's
+          // quadrics from these, followed through its records), found while it works.
           const bool keeps = !request.build_key().empty();
+          const bool quadric = jobs_[i].options.metric == "quadric";
           QuadricState initial;
           std::string failed;
-          auto find_initial = [&] {
+          auto find_kept = [&] {
             if (!keeps) return;
             try {
-              initial = initial_free_quadrics(jobs_[i]);
+              if (quadric)
+                initial = initial_free_quadrics(jobs_[i]);
+              else
+                f.kept = items_[i];
             } catch (const std::exception& e) {
               failed = e.what();
             }
           };
-          call_worker(f, *stub, request, find_initial, [&] { mark(f.begun); });
+          call_worker(f, *stub, request, find_kept, [&] { mark(f.begun); });
           if (!failed.empty()) throw Error(ErrorCode::kInternal, failed);
-          if (f.status.ok() && keeps) f.kept = kept_fingerprints(std::move(initial), f.result);
+          if (f.status.ok() && keeps && quadric)
+            f.kept = kept_fingerprints(std::move(initial), f.result);
+          if (!f.status.ok()) f.kept.clear();
         } catch (const std::exception& e) {
           f.status = {grpc::StatusCode::DATA_LOSS, e.what()};
         }
@@ -361,8 +398,8 @@ class RemoteRunner::Dispatch {
         transport.call_overhead_seconds += transfer_seconds(f);
         transport.result_bytes += f.result_bytes;
         ++transport.calls;
-        transport.held_quadrics += f.held_quadrics;
-        transport.sent_quadrics += job.state.quadric.vertices.size() - f.held_quadrics;
+        transport.held_items += f.held_items;
+        transport.sent_items += holdable_count(job) - f.held_items;
       }
       if (!f.kept.empty()) runner_.held_.record(f.slot.worker_id, f.kept);
       event(SubsetEvent::Kind::kDone, f);
@@ -379,7 +416,7 @@ class RemoteRunner::Dispatch {
         holder_[f.index] == f.slot.worker_id) {
       // The worker no longer holds what the job left out: the job goes whole, and no job of
       // this build leaves anything out for that worker again. Not the subset's failure.
-      spdlog::info("job {}: worker {} lacks the quadrics subset {} of round {} left out: {}",
+      spdlog::info("job {}: worker {} lacks the state subset {} of round {} left out: {}",
                    runner_.options_.job_id, f.slot.name, job.subset, job.round,
                    f.status.error_message());
       runner_.distrusted_.insert(f.slot.worker_id);
@@ -478,7 +515,9 @@ class RemoteRunner::Dispatch {
   // Per subset: the worker its request was made for (it leaves out the quadrics that worker
   // holds); empty: none, or that worker lost them (the job goes whole).
   std::vector<std::string> holder_;
-  std::vector<uint64_t> held_count_;  // per subset: the quadrics its request leaves out
+  std::vector<uint64_t> held_count_;  // per subset: the items its request leaves out
+  // Per subset, with a build key: its holdable items (holdable_items), found once.
+  std::vector<std::vector<std::pair<uint32_t, uint64_t>>> items_;
   std::vector<std::unique_ptr<Flight>> flights_;
   std::mutex mutex_;  // guards the flights' `finished` with changed_
   std::condition_variable changed_;

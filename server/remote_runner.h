@@ -14,7 +14,7 @@
 
 #include <grpcpp/grpcpp.h>
 
-#include "held_quadrics_ledger.h"
+#include "held_state_ledger.h"
 #include "parallel/parallel_build.h"
 #include "worker_registry.h"
 
@@ -52,10 +52,10 @@ struct RemoteOptions {
   // When no worker is registered, the coordinator runs subsets itself on this many threads
   // (0: it waits for a worker instead).
   unsigned local_threads = 0;
-  // A quadric build's workers keep their jobs' quadrics between rounds, and a later job goes
-  // to the worker holding most of its quadrics, without them (held_quadrics.h). Off: every
-  // job carries its whole state, to any worker.
-  bool held_quadrics = true;
+  // The workers keep a build's state between rounds (a quadric job's quadrics, an energy
+  // job's points' positions), and a later job goes to the worker holding most of it, without
+  // it (held_state.h). Off: every job carries its whole state, to any worker.
+  bool held_state = true;
 };
 
 // What moving the jobs cost, summed over every subset call of the runner's life.
@@ -68,9 +68,10 @@ struct TransportStats {
   uint64_t job_bytes = 0;     // of every call sent, retries included
   uint64_t result_bytes = 0;  // record batches and summaries
   uint64_t calls = 0;
-  // Quadrics left out of the jobs done (their workers held them), and those sent.
-  uint64_t held_quadrics = 0;
-  uint64_t sent_quadrics = 0;
+  // Items of state left out of the jobs done, their workers holding them (quadrics or
+  // points: held_state.h), and those the jobs carried.
+  uint64_t held_items = 0;
+  uint64_t sent_items = 0;
 };
 
 class RemoteRunner : public SubsetRunner {
@@ -83,8 +84,8 @@ class RemoteRunner : public SubsetRunner {
  private:
   class Dispatch;  // one run's state (remote_runner.cpp)
   TransportStats transport_;
-  std::string build_key_;    // the workers keep this build's quadrics under it
-  HeldQuadricsLedger held_;  // what they keep
+  std::string build_key_;  // the workers keep this build's state under it
+  HeldStateLedger held_;   // what they keep
   // Workers that lost quadrics this build had left with them: none is left out for them again.
   std::set<std::string> distrusted_;
   WorkerRegistry& registry_;

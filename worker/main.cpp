@@ -11,7 +11,7 @@
 
 #include "coordinator_link.h"
 #include "daemon.h"
-#include "held_quadrics_cache.h"
+#include "held_state_cache.h"
 #include "metrics.h"
 #include "rpc_server.h"
 #include "subset_service.h"
@@ -31,7 +31,7 @@ struct WorkerArgs {
   parapm::rpc::TlsFiles tls;
   bool coordinator_tls = false;
   std::string metrics_listen;  // "" : no metrics endpoint
-  uint64_t held_quadrics_mb = 1024;
+  uint64_t held_state_mb = 1024;
   std::string log_level = "info";
   std::string log_format = "text";
 };
@@ -42,9 +42,9 @@ int run(const WorkerArgs& args) {
   const std::string token = rpc::token_for_listening(args.token_file, args.listen);
   const unsigned threads = args.threads ? args.threads : std::thread::hardware_concurrency();
   worker::WorkerMetrics metrics(threads);
-  // A build's held quadrics go unused between its rounds for seconds; ten minutes unused, the
+  // A build's held state goes unused between its rounds for seconds; ten minutes unused, the
   // build is over or gone.
-  worker::HeldQuadricsCache held(args.held_quadrics_mb << 20, std::chrono::minutes(10));
+  worker::HeldStateCache held(args.held_state_mb << 20, std::chrono::minutes(10));
   worker::SubsetService service(rpc::TokenCheck(token), threads, metrics, held);
   // The metrics endpoint's options are checked before anything listens.
   std::optional<rpc::MetricsServer> metrics_server;
@@ -52,7 +52,7 @@ int run(const WorkerArgs& args) {
     metrics_server.emplace(metrics.registry,
                            rpc::MetricsEndpoint{args.metrics_listen, token, args.tls}, [&] {
                              metrics.running.Set(double(service.running()));
-                             metrics.held_quadrics_bytes.Set(double(held.bytes()));
+                             metrics.held_state_bytes.Set(double(held.bytes()));
                            });
   rpc::ServerSetup setup;
   setup.listen = args.listen;
@@ -108,9 +108,10 @@ int main(int argc, char** argv) {
                  "relative speed of this machine; the coordinator gives faster workers more work")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--held-quadrics-mb", args.held_quadrics_mb,
-                 "memory for the quadrics kept between a build's rounds, so that later jobs "
-                 "need not carry them (about 128 bytes a vertex; the builds used longest ago "
+  app.add_option("--held-state-mb", args.held_state_mb,
+                 "memory for the state kept between a build's rounds, so that later jobs need "
+                 "not carry it (a quadric build's quadrics, about 128 bytes a vertex; an energy "
+                 "build's points' positions, about 25 bytes a point; the builds used longest ago "
                  "are dropped past it, and their next jobs come whole)")
       ->capture_default_str()
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 20));

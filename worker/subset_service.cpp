@@ -7,7 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "parallel/held_quadrics.h"
+#include "parallel/held_state.h"
 #include "parallel/job_codec.h"
 #include "parallel/simplify_subset.h"
 #include "rpc_server.h"
@@ -63,27 +63,55 @@ class CancelWatcher {
 }  // namespace
 
 SubsetService::SubsetService(rpc::TokenCheck auth, unsigned slots, WorkerMetrics& metrics,
-                             HeldQuadricsCache& held)
+                             HeldStateCache& held)
     : auth_(std::move(auth)), slots_(std::max(1u, slots)), metrics_(metrics), held_(held) {}
 
-grpc::Status SubsetService::restore_held_quadrics(const parapm::v1::SubsetRequest& request,
-                                                  SubsetJob& job) {
-  if (request.held_vertices().empty()) return grpc::Status::OK;
-  if (request.build_key().empty() || job.state.metric != "quadric")
-    return {grpc::StatusCode::INVALID_ARGUMENT,
-            "held quadrics named without a build key or for a job without a quadric state"};
-  const std::vector<VertexId> local = decode_increasing_ids(
-      request.held_vertices(), job.global_vertex.size(), "held quadrics' vertices");
-  std::vector<VertexId> global(local.size());
-  for (size_t i = 0; i < local.size(); ++i) global[i] = job.global_vertex[local[i]];
-  std::vector<Quadric> quadrics;
-  if (!held_.find(request.build_key(), global, quadrics) ||
-      quadrics_fingerprint(quadrics) != request.held_fingerprint())
-    return {grpc::StatusCode::FAILED_PRECONDITION,
-            "this worker does not hold the " + std::to_string(local.size()) +
-                " quadrics the job leaves out (it was restarted or dropped them): send them"};
-  put_back_held(job.state.quadric, local, quadrics);
-  return grpc::Status::OK;
+grpc::Status SubsetService::restore_held_state(const parapm::v1::SubsetRequest& request,
+                                               const std::vector<uint32_t>& held, SubsetJob& job) {
+  if (held.empty()) return grpc::Status::OK;
+  const std::string& build = request.build_key();
+  auto not_held = [&] {
+    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
+                        "this worker does not hold the state of the " +
+                            std::to_string(held.size()) +
+                            " items the job leaves out (it was restarted or dropped them): "
+                            "send them");
+  };
+  if (!build.empty() && job.state.metric == "quadric") {
+    std::vector<VertexId> global(held.size());
+    for (size_t i = 0; i < held.size(); ++i) {
+      if (held[i] >= job.global_vertex.size())
+        return {grpc::StatusCode::INVALID_ARGUMENT, "held quadric of a vertex out of the job"};
+      global[i] = job.global_vertex[held[i]];
+    }
+    std::vector<Quadric> quadrics;
+    if (!held_.find(build, global, quadrics) ||
+        quadrics_fingerprint(quadrics) != request.held_fingerprint())
+      return not_held();
+    put_back_held(job.state.quadric, held, quadrics);
+    return grpc::Status::OK;
+  }
+  if (!build.empty() && job.state.metric == "energy" && job.state.energy.positions) {
+    EnergyState& state = job.state.energy;
+    const size_t k = state.points.empty() ? 0 : state.point_values.size() / state.points.size();
+    std::vector<uint32_t> ids(held.size());
+    for (size_t i = 0; i < held.size(); ++i) {
+      if (held[i] >= state.points.size())
+        return {grpc::StatusCode::INVALID_ARGUMENT, "held point past the job's points"};
+      ids[i] = state.points[held[i]].id;
+    }
+    std::vector<Vec3> positions;
+    std::vector<float> values;
+    if (!held_.find_points(build, ids, k, positions, values)) return not_held();
+    std::vector<uint64_t> fingerprints(held.size());
+    for (size_t i = 0; i < held.size(); ++i)
+      fingerprints[i] = point_fingerprint(positions[i], values.data() + i * k, k);
+    if (fingerprints_fingerprint(fingerprints) != request.held_fingerprint()) return not_held();
+    put_back_held_points(state, held, positions, values);
+    return grpc::Status::OK;
+  }
+  return {grpc::StatusCode::INVALID_ARGUMENT,
+          "held state named without a build key or for a job without a state to hold"};
 }
 
 void SubsetService::record_outcome(const grpc::Status& status, double seconds,
@@ -125,12 +153,16 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
   const auto start = std::chrono::steady_clock::now();
   uint64_t bytes_sent = 0;
   const grpc::Status status = rpc::serve(auth_, context, [&]() -> grpc::Status {
-    metrics_.job_bytes.Increment(double(request->job().size()));
+    metrics_.job_bytes.Increment(double(request->job().size() + request->held_ids().size()));
     if (request->build_key().size() > kMaxBuildKey)
       return {grpc::StatusCode::INVALID_ARGUMENT,
               "build key over " + std::to_string(kMaxBuildKey) + " bytes"};
-    SubsetJob job = decode_subset_job(request->job());
-    if (grpc::Status held = restore_held_quadrics(*request, job); !held.ok()) return held;
+    const std::vector<uint32_t> held_ids =
+        request->held_ids().empty()
+            ? std::vector<uint32_t>{}
+            : decode_increasing_ids(request->held_ids(), kNoId, "held state's ids");
+    SubsetJob job = decode_subset_job(request->job(), held_ids);
+    if (grpc::Status held = restore_held_state(*request, held_ids, job); !held.ok()) return held;
     const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +
                              " subset " + std::to_string(job.subset);
     const auto decoded = std::chrono::steady_clock::now();
@@ -170,8 +202,10 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
       if (!writer->Write(message)) peer_gone = true;
     };
     spdlog::info("{}: started, {} faces", name, job.mesh.face_count());
-    // A quadric job of a build keeps its free vertices' quadrics at its end (held_quadrics.h).
+    // A job of a build keeps its points' positions and values (an energy job's, which never
+    // change), or its free vertices' quadrics at its end (a quadric job's): held_state.h.
     const bool keeps = !request->build_key().empty();
+    if (keeps) held_.keep_points(request->build_key(), job.state.energy);
     QuadricState kept;
     SubsetResult result;
     try {

@@ -35,12 +35,12 @@ WorkerMetrics::WorkerMetrics(unsigned slot_count)
                   .Help("Subsets running now")
                   .Register(*registry)
                   .Add({})),
-      held_quadrics_bytes(prometheus::BuildGauge()
-                              .Name("parapm_worker_held_quadrics_bytes")
-                              .Help("Bytes of quadrics kept between builds' rounds "
-                                    "(--held-quadrics-mb bounds them)")
-                              .Register(*registry)
-                              .Add({})) {
+      held_state_bytes(prometheus::BuildGauge()
+                           .Name("parapm_worker_held_state_bytes")
+                           .Help("Bytes of state kept between builds' rounds "
+                                 "(--held-state-mb bounds them)")
+                           .Register(*registry)
+                           .Add({})) {
   for (const char* outcome : {"done", "failed", "cancelled"}) subsets.Add({{"outcome", outcome}});
   slots.Set(double(slot_count));
 }

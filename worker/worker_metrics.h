@@ -23,7 +23,7 @@ struct WorkerMetrics {
   prometheus::Counter& result_bytes;                 // records and summaries sent
   prometheus::Gauge& slots;                          // --threads
   prometheus::Gauge& running;                        // subsets running now
-  prometheus::Gauge& held_quadrics_bytes;            // HeldQuadricsCache::bytes()
+  prometheus::Gauge& held_state_bytes;               // HeldStateCache::bytes()
 };
 
 }  // namespace parapm::worker

@@ -218,6 +218,22 @@ uint8_t metric_code(const std::string& metric) {
 
 // ---- Metric state ------------------------------------------------------------------------
 
+// The points whose positions and values a job leaves out (its worker holds them): their
+// indices in the state's point order, increasing; `next`, the first not yet passed.
+struct HeldPoints {
+  const std::vector<uint32_t>& indices;
+  size_t next = 0;
+  // Whether point `index` (the points are visited in order) is held.
+  bool take(size_t index) {
+    if (next < indices.size() && indices[next] == index) {
+      ++next;
+      return true;
+    }
+    return false;
+  }
+};
+const std::vector<uint32_t> kNoHeldPoints;
+
 // What a state's ids may reach: the job's local mesh, or (a summary, global ids) anything.
 struct StateBounds {
   uint64_t vertices = kNoId;
@@ -272,13 +288,14 @@ int energy_floats(const EnergyState& s) {
 }
 
 void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool residuals,
-                 bool as_f32, uint32_t& previous_id) {
+                 bool as_f32, HeldPoints& held, uint32_t& previous_id) {
   const EnergyState::Point& p = s.points[i];
   write_near(out, p.id, previous_id);
-  if (s.positions) write_position(out, p.position, as_f32);
+  const bool positions = s.positions && !held.take(i);
+  if (positions) write_position(out, p.position, as_f32);
   out.f64(p.distance_sq);
   if (residuals) out.f64(p.residual);
-  if (s.positions)
+  if (positions)
     for (int j = 0; j < k; ++j) out.f32(s.point_values[i * size_t(k) + size_t(j)]);
 }
 
@@ -291,13 +308,17 @@ void check_spans(const std::vector<uint32_t>& begin, size_t vertices, size_t lis
     if (begin[i] > begin[i + 1]) cannot_encode(std::string("energy state ") + what + " spans");
 }
 
-void write_energy(ByteWriter& out, const EnergyState& s) {
+void write_energy(ByteWriter& out, const EnergyState& s, const std::vector<uint32_t>& held_points) {
   const int k = energy_floats(s);
+  if (!held_points.empty() && (!s.positions || held_points.back() >= s.points.size()))
+    cannot_encode("held points beyond the state's");
   bool residuals = false, points_f32 = s.positions, samples_f32 = s.positions;
-  for (const EnergyState::Point& p : s.points) {
-    residuals |= std::bit_cast<uint64_t>(p.residual) != 0;
-    points_f32 = points_f32 && is_float(p.position);
+  HeldPoints scan{held_points};
+  for (size_t i = 0; i < s.points.size(); ++i) {
+    residuals |= std::bit_cast<uint64_t>(s.points[i].residual) != 0;
+    points_f32 = points_f32 && (scan.take(i) || is_float(s.points[i].position));
   }
+  HeldPoints held{held_points};
   for (const EnergyState::CurveSample& c : s.samples)
     samples_f32 = samples_f32 && is_float(c.position);
   out.varint(s.faces.size());
@@ -314,7 +335,8 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
     size_t end = next;
     while (end < s.points.size() && s.points[end].face == f && s.points[end].vertex == kNoId) ++end;
     out.varint(end - next);
-    for (; next < end; ++next) write_point(out, s, next, k, residuals, points_f32, previous_id);
+    for (; next < end; ++next)
+      write_point(out, s, next, k, residuals, points_f32, held, previous_id);
   }
   const size_t face_points = next;
   for (VertexId v : s.vertices)
@@ -338,7 +360,7 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
   for (size_t i = 0; i < s.vertices.size(); ++i) {
     const bool parked = next < s.points.size() && s.points[next].vertex == s.vertices[i];
     out.u8(parked ? 1 : 0);
-    if (parked) write_point(out, s, next++, k, residuals, points_f32, previous_id);
+    if (parked) write_point(out, s, next++, k, residuals, points_f32, held, previous_id);
     out.varint(s.sharp_begin[i + 1] - s.sharp_begin[i]);
     for (uint32_t j = s.sharp_begin[i]; j < s.sharp_begin[i + 1]; ++j)
       out.varint(s.sharp_neighbors[j]);
@@ -360,22 +382,27 @@ void write_energy(ByteWriter& out, const EnergyState& s) {
   }
 }
 
+// A held point's position and values are left at zero (its worker fills them in).
 void read_point(ByteReader& in, int k, bool residuals, bool as_f32, FaceId face, VertexId vertex,
-                uint32_t& previous_id, EnergyState& s) {
+                HeldPoints& held, uint32_t& previous_id, EnergyState& s) {
   EnergyState::Point p;
   p.id = read_near(in, kAnyId, previous_id, "point id");
   p.face = face;
   p.vertex = vertex;
-  if (s.positions) p.position = read_position(in, as_f32);
+  const bool positions = s.positions && !held.take(s.points.size());
+  if (positions) p.position = read_position(in, as_f32);
   p.distance_sq = in.f64();
   p.residual = residuals ? in.f64() : 0.0;
   if (s.positions)
-    for (int j = 0; j < k; ++j) s.point_values.push_back(in.f32());
+    for (int j = 0; j < k; ++j) s.point_values.push_back(positions ? in.f32() : 0.0f);
   s.points.push_back(p);
 }
 
-// A job's state carries positions, a returned one does not (EnergyState::positions).
-void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, EnergyState& s) {
+// A job's state carries positions (but of `held` points), a returned one does not
+// (EnergyState::positions).
+void read_energy(ByteReader& in, const StateBounds& bounds, bool positions,
+                 const std::vector<uint32_t>& held_points, EnergyState& s) {
+  HeldPoints held{held_points};
   in.set_context("energy state");
   read_increasing(in, read_count(in, 2, "energy faces"), bounds.faces, s.faces);
   read_increasing(in, read_count(in, 4, "energy vertices"), bounds.vertices, s.vertices);
@@ -392,14 +419,15 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, Ener
   const bool points_f32 = flags & kPointsF32, samples_f32 = flags & kSamplesF32;
   if ((points_f32 || samples_f32) && !positions) in.fail("float positions flagged, none present");
   const uint64_t point_bytes =
-      1 + 8 + (residuals ? 8 : 0) + (positions ? (points_f32 ? 12 : 24) + 4 * uint64_t(k) : 0);
+      1 + 8 + (residuals ? 8 : 0) +
+      (positions && held_points.empty() ? (points_f32 ? 12 : 24) + 4 * uint64_t(k) : 0);
   uint32_t previous_id = 0, previous_sample = 0;  // (near: in the order written)
 
   for (size_t i = 0; i < s.faces.size(); ++i) {
     in.set_context("energy face", i);
     const uint64_t n = read_count(in, point_bytes, "points");
     for (uint64_t j = 0; j < n; ++j)
-      read_point(in, k, residuals, points_f32, s.faces[i], kNoId, previous_id, s);
+      read_point(in, k, residuals, points_f32, s.faces[i], kNoId, held, previous_id, s);
   }
   in.set_context("curve samples");
   s.samples.resize(read_count(in,
@@ -421,7 +449,7 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, Ener
     const VertexId v = s.vertices[i];
     const uint8_t parked = in.u8();
     if (parked > 1) in.fail("bad parked flag");
-    if (parked) read_point(in, k, residuals, points_f32, kNoId, v, previous_id, s);
+    if (parked) read_point(in, k, residuals, points_f32, kNoId, v, held, previous_id, s);
     const uint64_t sharp = read_count(in, 1, "sharp neighbours");
     for (uint64_t j = 0; j < sharp; ++j) {
       const VertexId x = read_id(in, bounds.vertices, "sharp neighbour");
@@ -436,6 +464,7 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, Ener
   }
   in.set_context("energy state");
   s.curve_samples_total = in.varint64();
+  if (held.next != held_points.size()) in.fail("held points beyond the state's");
 
   // Distinct point ids: the master links each point into its face's list by id.
   std::vector<uint32_t> ids(s.points.size());
@@ -457,24 +486,26 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions, Ener
   }
 }
 
-void write_state(ByteWriter& out, const MetricState& s) {
+void write_state(ByteWriter& out, const MetricState& s,
+                 const std::vector<uint32_t>& held = kNoHeldPoints) {
   const uint8_t code = metric_code(s.metric);
   out.u8(code);
   if ((code != 1 && !is_empty(s.quadric)) || (code != 2 && !is_empty(s.energy)))
     cannot_encode("a state holds another metric's part");
   if (code == 1) write_quadric(out, s.quadric);
-  if (code == 2) write_energy(out, s.energy);
+  if (code == 2) write_energy(out, s.energy, held);
 }
 
 // A job's state (`job`), or a returned one: without positions, and never the quadric's
 // (job_state.h, returns_state).
-void read_state(ByteReader& in, const StateBounds& bounds, bool job, MetricState& s) {
+void read_state(ByteReader& in, const StateBounds& bounds, bool job, MetricState& s,
+                const std::vector<uint32_t>& held = kNoHeldPoints) {
   in.set_context("state");
   s = MetricState{};
   s.metric = read_metric(in);
   if (s.metric == "quadric" && !job) in.fail("a returned quadric state (quadric jobs return none)");
   if (s.metric == "quadric") read_quadric(in, bounds, s.quadric);
-  if (s.metric == "energy") read_energy(in, bounds, job, s.energy);
+  if (s.metric == "energy") read_energy(in, bounds, job, held, s.energy);
 }
 
 // ---- Job --------------------------------------------------------------------------------
@@ -620,7 +651,8 @@ void read_deferred(ByteReader& in, uint64_t bound, std::vector<DeferredEdge>& de
              [&](DeferredEdge& d) { d.key = in.f32(); });
 }
 
-void write_job(ByteWriter& out, const SubsetJob& job, const MetricState& state) {
+void write_job(ByteWriter& out, const SubsetJob& job, const MetricState& state,
+               const std::vector<uint32_t>& held) {
   const Mesh& m = job.mesh;
   const size_t floats = size_t(m.layout.floats_per_wedge());
   if (job.global_vertex.size() != m.vertex_count() || job.owned.size() != m.vertex_count() ||
@@ -666,12 +698,12 @@ void write_job(ByteWriter& out, const SubsetJob& job, const MetricState& state) 
     for (WedgeId id : w) write_near(out, id, previous);
   write_increasing(out, job.global_wedge, "global wedge");
   out.varint(job.owned_faces);
-  write_state(out, state);
+  write_state(out, state, held);
   write_keys(out, job.keys);
   write_deferred(out, job.deferred);
 }
 
-void read_job(ByteReader& in, SubsetJob& job) {
+void read_job(ByteReader& in, SubsetJob& job, const std::vector<uint32_t>& held) {
   read_magic(in, kJobMagic, "subset job");
   job.round = in.varint32();
   job.subset = in.varint32();
@@ -753,7 +785,7 @@ void read_job(ByteReader& in, SubsetJob& job) {
   job.owned_faces = in.varint64();
   if (job.owned_faces > faces) in.fail("more owned faces than faces");
 
-  read_state(in, StateBounds{vertices, faces, wedges}, /*job=*/true, job.state);
+  read_state(in, StateBounds{vertices, faces, wedges}, /*job=*/true, job.state, held);
   in.set_context("state");
   check_job_state(in, job);
   read_keys(in, vertices, job.keys);
@@ -853,14 +885,18 @@ void read_summary(ByteReader& in, SubsetResult& r) {
 std::string encode_subset_job(const SubsetJob& job) {
   std::ostringstream stream;
   ByteWriter out(&stream);
-  write_job(out, job, job.state);
+  write_job(out, job, job.state, kNoHeldPoints);
   return finish(out, stream);
 }
 
-std::string encode_subset_job(const SubsetJob& job, const MetricState& state) {
+std::string encode_subset_job(const SubsetJob& job, const MetricState& state,
+                              const std::vector<uint32_t>& held_points) {
+  if (std::adjacent_find(held_points.begin(), held_points.end(), std::greater_equal<>()) !=
+      held_points.end())
+    cannot_encode("held point indices not increasing");
   std::ostringstream stream;
   ByteWriter out(&stream);
-  write_job(out, job, state);
+  write_job(out, job, state, held_points);
   return finish(out, stream);
 }
 
@@ -884,10 +920,13 @@ std::vector<uint32_t> decode_increasing_ids(std::string_view bytes, uint64_t bou
   return ids;
 }
 
-SubsetJob decode_subset_job(std::string_view bytes) {
+SubsetJob decode_subset_job(std::string_view bytes, const std::vector<uint32_t>& held_points) {
+  if (std::adjacent_find(held_points.begin(), held_points.end(), std::greater_equal<>()) !=
+      held_points.end())
+    throw_invalid("subset job: held point indices not increasing");
   ViewReader reader(bytes, "subset job");
   SubsetJob job;
-  read_job(reader.in, job);
+  read_job(reader.in, job, held_points);
   validate_subset_job(job);
   return job;
 }

@@ -44,7 +44,7 @@ struct SubsetResult {
 // Throws Error(kInvalidInput) for an invalid job or options, Error(kCancelled /
 // kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing. With
 // `free_quadrics` and a quadric job: its free vertices' quadrics at its end, in global ids
-// (what a worker keeps between rounds: held_quadrics.h); left empty otherwise.
+// (what a worker keeps between rounds: held_state.h); left empty otherwise.
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr,
                              QuadricState* free_quadrics = nullptr);

@@ -121,6 +121,8 @@ TEST_F(Metrics, ScrapedDuringAndAfterARealJobTheyCountWhatHappened) {
   EXPECT_GE(w["parapm_worker_result_bytes_total"], c["parapm_subset_result_bytes_total"]);
   EXPECT_EQ(w["parapm_worker_slots"], 1);
   EXPECT_EQ(w["parapm_worker_subsets_running"], 0);
+  // The energy job's points' positions, kept for the build's later jobs.
+  EXPECT_GT(w["parapm_worker_held_state_bytes"], 0);
 }
 
 // A job cancelled before it started ended too: counted like one cancelled while it ran.

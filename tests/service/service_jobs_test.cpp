@@ -166,31 +166,36 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   EXPECT_EQ(first.content_sha256(), again.content_sha256());
 }
 
-// A quadric build's workers keep their jobs' quadrics between rounds, and later jobs go to
-// them without those (held_quadrics.h): the PM stays the in-process build's. w2 keeps none
-// (--held-quadrics-mb 0), as after a restart or an eviction: the jobs left for it come back
-// refused and go whole, and no job of the build leaves quadrics out for it again.
-TEST_F(ServiceJobs, WorkersKeepTheirQuadricsBetweenRounds) {
+// A build's workers keep state between rounds (a quadric job's quadrics, an energy job's
+// points' positions: held_state.h), and later jobs go to them without it: the PM stays the
+// in-process build's. w2 keeps none (--held-state-mb 0), as after a restart or an eviction:
+// the jobs left for it come back refused and go whole, and no job of the build leaves state
+// out for it again.
+TEST_F(ServiceJobs, WorkersKeepTheirStateBetweenRounds) {
   service().start_coordinator({});
   service().start_worker("w1", 1);
-  service().start_worker("w2", 1, {"--held-quadrics-mb", "0"});
+  service().start_worker("w2", 1, {"--held-state-mb", "0"});
   service().wait_for_workers(2);
-  parapm::v1::JobOptions options = ServiceTest::options(4, parapm::v1::METRIC_QUADRIC, 0.01);
-  options.set_min_subset_faces(0);
-  WatchResult watched;
-  build_and_compare("gmsh-aneurysm-20k.stl.gz", options, {"w1", "w2"}, &watched);
-  ASSERT_TRUE(watched.finished());
-  const auto& transport = watched.events.back().finished().transport();
-  EXPECT_GT(transport.held_quadrics(), 0u);
-  EXPECT_GT(transport.sent_quadrics(), 0u);
-  const std::string log = service().coordinator().log();
-  EXPECT_NE(log.find("lacks the quadrics"), std::string::npos);
-  // Refused once, w2 is left nothing out again: one refusal at most per round after the first.
-  size_t refusals = 0;
-  for (size_t at = log.find("lacks the quadrics"); at != std::string::npos;
-       at = log.find("lacks the quadrics", at + 1))
-    ++refusals;
-  EXPECT_LE(refusals, 2u) << log;
+  size_t refusals_before = 0;
+  for (const auto metric : {parapm::v1::METRIC_QUADRIC, parapm::v1::METRIC_ENERGY}) {
+    parapm::v1::JobOptions options = ServiceTest::options(4, metric, 0.01);
+    options.set_min_subset_faces(0);
+    WatchResult watched;
+    build_and_compare("gmsh-aneurysm-20k.stl.gz", options, {"w1", "w2"}, &watched);
+    ASSERT_TRUE(watched.finished());
+    const auto& transport = watched.events.back().finished().transport();
+    EXPECT_GT(transport.held_items(), 0u) << metric;
+    EXPECT_GT(transport.sent_items(), 0u) << metric;
+    const std::string log = service().coordinator().log();
+    size_t refusals = 0;
+    for (size_t at = log.find("lacks the state"); at != std::string::npos;
+         at = log.find("lacks the state", at + 1))
+      ++refusals;
+    // Refused once, w2 is left nothing out again: at most its two calls in flight refused.
+    EXPECT_GT(refusals, refusals_before) << metric << log;
+    EXPECT_LE(refusals, refusals_before + 2) << metric << log;
+    refusals_before = refusals;
+  }
 }
 
 // Eight clients at once, each uploading and submitting from its own thread (two per mesh,

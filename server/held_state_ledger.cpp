@@ -1,32 +1,26 @@
-#include "held_quadrics_ledger.h"
+#include "held_state_ledger.h"
 
 #include <algorithm>
 #include <tuple>
 
-#include "parallel/held_quadrics.h"
 #include "util/job_pool.h"
 
 namespace parapm::service {
 
-void HeldQuadricsLedger::holders(const SubsetJob& job, std::vector<uint32_t>& holder,
-                                 std::vector<size_t>& count) const {
-  const QuadricState& state = job.state.quadric;
-  holder.assign(state.vertices.size(), 0);
+void HeldStateLedger::holders(const Items& items, std::vector<uint32_t>& holder,
+                              std::vector<size_t>& count) const {
+  holder.assign(items.size(), 0);
   count.assign(workers_.size() + 1, 0);
-  if (job.state.metric != "quadric") return;
-  for (size_t k = 0; k < state.vertices.size(); ++k) {
-    const VertexId local = state.vertices[k];
-    if (local >= job.global_vertex.size()) continue;
-    const VertexId v = job.global_vertex[local];
-    if (v >= holder_.size() || holder_[v] == 0) continue;
-    if (fingerprint_[v] != quadric_fingerprint(state.quadrics[k])) continue;
-    holder[k] = holder_[v];
-    ++count[holder_[v]];
+  for (size_t k = 0; k < items.size(); ++k) {
+    const auto [id, fingerprint] = items[k];
+    if (id >= holder_.size() || holder_[id] == 0 || fingerprint_[id] != fingerprint) continue;
+    holder[k] = holder_[id];
+    ++count[holder_[id]];
   }
 }
 
-std::vector<HeldQuadricsLedger::Plan> HeldQuadricsLedger::plan_round(
-    const std::vector<SubsetJob>& jobs, const std::map<std::string, uint32_t>& slots) const {
+std::vector<HeldStateLedger::Plan> HeldStateLedger::plan_round(
+    const std::vector<Items>& jobs, const std::map<std::string, uint32_t>& slots) const {
   std::vector<Plan> plans(jobs.size());
   if (holder_.empty() || slots.empty()) return plans;
   std::vector<std::vector<uint32_t>> holder(jobs.size());
@@ -61,15 +55,15 @@ std::vector<HeldQuadricsLedger::Plan> HeldQuadricsLedger::plan_round(
   return plans;
 }
 
-uint32_t HeldQuadricsLedger::index_of(const std::string& worker) {
+uint32_t HeldStateLedger::index_of(const std::string& worker) {
   const auto it = std::find(workers_.begin(), workers_.end(), worker);
   if (it != workers_.end()) return uint32_t(it - workers_.begin()) + 1;
   workers_.push_back(worker);
   return uint32_t(workers_.size());
 }
 
-void HeldQuadricsLedger::record(const std::string& worker,
-                                const std::vector<std::pair<VertexId, uint64_t>>& kept) {
+void HeldStateLedger::record(const std::string& worker,
+                             const std::vector<std::pair<uint32_t, uint64_t>>& kept) {
   const uint32_t w = index_of(worker);
   for (const auto& [v, fingerprint] : kept) {
     if (v >= holder_.size()) {

@@ -1,11 +1,11 @@
-// The worker's cache of held quadrics (worker/held_quadrics_cache.h): what it kept comes back
-// by build and vertex, a vertex it lacks is reported, and its bounds drop whole builds, the
+// The worker's cache of held state (worker/held_state_cache.h): what it kept comes back by
+// build and vertex or point, one it lacks is reported, and its bounds drop whole builds, the
 // longest unused first, or those unused too long.
 #include <gtest/gtest.h>
 
 #include <thread>
 
-#include "held_quadrics_cache.h"
+#include "held_state_cache.h"
 
 namespace parapm::worker {
 namespace {
@@ -19,8 +19,8 @@ QuadricState quadrics_of(std::vector<VertexId> vertices, double weight) {
   return s;
 }
 
-TEST(HeldQuadricsCache, KeepsByBuildAndVertex) {
-  HeldQuadricsCache cache(1 << 20, std::chrono::minutes(10));
+TEST(HeldStateCache, KeepsByBuildAndVertex) {
+  HeldStateCache cache(1 << 20, std::chrono::minutes(10));
   cache.keep("a", quadrics_of({1, 5, 9}, 1));
   cache.keep("b", quadrics_of({5}, 2));
   std::vector<Quadric> out;
@@ -37,11 +37,39 @@ TEST(HeldQuadricsCache, KeepsByBuildAndVertex) {
   cache.keep("a", quadrics_of({5}, 3));
   ASSERT_TRUE(cache.find("a", {5, 9}, out));
   EXPECT_EQ(out[0].weight, 3);
-  EXPECT_EQ(cache.bytes(), 4 * HeldQuadricsCache::kEntryBytes);
+  EXPECT_EQ(cache.bytes(), 4 * HeldStateCache::kQuadricBytes);
 }
 
-TEST(HeldQuadricsCache, PastItsBoundTheLongestUnusedBuildGoes) {
-  HeldQuadricsCache cache(10 * HeldQuadricsCache::kEntryBytes, std::chrono::minutes(10));
+TEST(HeldStateCache, KeepsPointsById) {
+  HeldStateCache cache(1 << 20, std::chrono::minutes(10));
+  EnergyState state;
+  for (uint32_t id : {7u, 2u, 40u}) {
+    EnergyState::Point p;
+    p.id = id;
+    p.position = {double(id), 1, 2};
+    state.points.push_back(p);
+    state.point_values.insert(state.point_values.end(), {float(id), 0.5f});
+  }
+  cache.keep_points("a", state);
+  std::vector<Vec3> positions;
+  std::vector<float> values;
+  ASSERT_TRUE(cache.find_points("a", {40, 7}, 2, positions, values));
+  EXPECT_EQ(positions, (std::vector<Vec3>{{40, 1, 2}, {7, 1, 2}}));
+  EXPECT_EQ(values, (std::vector<float>{40, 0.5f, 7, 0.5f}));
+  EXPECT_FALSE(cache.find_points("a", {3}, 2, positions, values));   // never kept
+  EXPECT_FALSE(cache.find_points("a", {41}, 2, positions, values));  // past them all
+  EXPECT_FALSE(cache.find_points("a", {7}, 3, positions, values));   // kept with 2 values
+  EXPECT_FALSE(cache.find_points("b", {7}, 2, positions, values));
+  EXPECT_EQ(cache.bytes(), 41 * (HeldStateCache::kPointBytes + 8));
+  // Points beyond what the whole cache could hold are not kept.
+  HeldStateCache small(100 * HeldStateCache::kPointBytes, std::chrono::minutes(10));
+  state.points[2].id = 1000;
+  small.keep_points("a", state);
+  EXPECT_FALSE(small.find_points("a", {7}, 2, positions, values));
+}
+
+TEST(HeldStateCache, PastItsBoundTheLongestUnusedBuildGoes) {
+  HeldStateCache cache(10 * HeldStateCache::kQuadricBytes, std::chrono::minutes(10));
   std::vector<Quadric> out;
   cache.keep("old", quadrics_of({1, 2, 3, 4}, 1));
   std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -57,16 +85,16 @@ TEST(HeldQuadricsCache, PastItsBoundTheLongestUnusedBuildGoes) {
   // A build alone over the bound is not kept at all.
   cache.keep("huge", quadrics_of({1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}, 1));
   EXPECT_FALSE(cache.find("huge", {1}, out));
-  EXPECT_LE(cache.bytes(), 10 * HeldQuadricsCache::kEntryBytes);
+  EXPECT_LE(cache.bytes(), 10 * HeldStateCache::kQuadricBytes);
   // Nothing at all with no memory.
-  HeldQuadricsCache none(0, std::chrono::minutes(10));
+  HeldStateCache none(0, std::chrono::minutes(10));
   none.keep("a", quadrics_of({1}, 1));
   EXPECT_FALSE(none.find("a", {1}, out));
   EXPECT_EQ(none.builds(), 0u);
 }
 
-TEST(HeldQuadricsCache, ABuildUnusedTooLongIsDropped) {
-  HeldQuadricsCache cache(1 << 20, std::chrono::seconds(1));
+TEST(HeldStateCache, ABuildUnusedTooLongIsDropped) {
+  HeldStateCache cache(1 << 20, std::chrono::seconds(1));
   std::vector<Quadric> out;
   cache.keep("idle", quadrics_of({1}, 1));
   cache.keep("busy", quadrics_of({1}, 1));

@@ -1,4 +1,4 @@
-#include "parallel/held_quadrics.h"
+#include "parallel/held_state.h"
 
 #include <algorithm>
 #include <bit>
@@ -121,6 +121,57 @@ void put_back_held(QuadricState& state, const std::vector<VertexId>& vertices,
     merged.quadrics.push_back(from_held ? quadrics[j++] : state.quadrics[i++]);
   }
   state = std::move(merged);
+}
+
+std::vector<std::pair<uint32_t, uint64_t>> holdable_items(const SubsetJob& job) {
+  std::vector<std::pair<uint32_t, uint64_t>> items;
+  if (job.state.metric == "quadric") {
+    const QuadricState& q = job.state.quadric;
+    items.reserve(q.vertices.size());
+    for (size_t k = 0; k < q.vertices.size(); ++k)
+      if (q.vertices[k] < job.global_vertex.size())
+        items.emplace_back(job.global_vertex[q.vertices[k]], quadric_fingerprint(q.quadrics[k]));
+  } else if (job.state.metric == "energy" && job.state.energy.positions) {
+    const EnergyState& e = job.state.energy;
+    items.reserve(e.points.size());
+    for (size_t i = 0; i < e.points.size(); ++i)
+      items.emplace_back(e.points[i].id, point_fingerprint(e, i));
+  }
+  return items;
+}
+
+uint64_t point_fingerprint(const Vec3& position, const float* values, size_t k) {
+  uint64_t h = 0x9017e5ULL;
+  for (double c : position) h = mix(h ^ std::bit_cast<uint64_t>(c));
+  for (size_t j = 0; j < k; ++j) h = mix(h ^ std::bit_cast<uint32_t>(values[j]));
+  return h;
+}
+
+uint64_t point_fingerprint(const EnergyState& state, size_t i) {
+  const size_t k = state.points.empty() ? 0 : state.point_values.size() / state.points.size();
+  return point_fingerprint(state.points[i].position, state.point_values.data() + i * k, k);
+}
+
+uint64_t fingerprints_fingerprint(const std::vector<uint64_t>& fingerprints) {
+  uint64_t h = mix(fingerprints.size());
+  for (uint64_t f : fingerprints) h = mix(h ^ f);
+  return h;
+}
+
+void put_back_held_points(EnergyState& state, const std::vector<uint32_t>& held,
+                          const std::vector<Vec3>& positions, const std::vector<float>& values) {
+  const size_t k = state.points.empty() ? 0 : state.point_values.size() / state.points.size();
+  if (positions.size() != held.size() || values.size() != held.size() * k)
+    throw_invalid("held points: " + std::to_string(held.size()) + " indices, " +
+                  std::to_string(positions.size()) + " positions");
+  for (size_t j = 0; j < held.size(); ++j) {
+    const size_t i = held[j];
+    if (i >= state.points.size())
+      throw_invalid("held point " + std::to_string(i) + " past the job's points");
+    state.points[i].position = positions[j];
+    std::copy_n(values.begin() + ptrdiff_t(j * k), k,
+                state.point_values.begin() + ptrdiff_t(i * k));
+  }
 }
 
 }  // namespace parapm

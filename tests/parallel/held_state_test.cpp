@@ -1,13 +1,14 @@
-// What a worker keeps of a quadric job (held_quadrics.h), its module's quadrics at the end, is
+// What a worker keeps of a quadric job (held_state.h), its module's quadrics at the end, is
 // what the coordinator computes from the job and its records and what the master holds after
 // following them: its free vertices' quadrics, bit for bit, with or without a state (round 0's
-// jobs initialise their own); a state less its held quadrics, put back, is the state again.
+// jobs initialise their own); a state less its held quadrics, or an energy job less its held
+// points' positions, put back, is the state again.
 #include <gtest/gtest.h>
 
 #include <bit>
 #include <cstring>
 
-#include "parallel/held_quadrics.h"
+#include "parallel/held_state.h"
 #include "parallel/job_codec.h"
 #include "parallel/simplify_subset.h"
 #include "parallel_test_support.h"
@@ -23,7 +24,7 @@ bool same_bits(const Quadric& a, const Quadric& b) {
 
 // For each job, with its state and without (round 0): the quadrics its worker keeps are those
 // the master has once it followed every job's records.
-TEST(HeldQuadrics, AWorkerKeepsWhatTheMasterHoldsAfterTheRound) {
+TEST(HeldState, AWorkerKeepsWhatTheMasterHoldsAfterTheRound) {
   for (const char* name : {"stratocaster-9k.ply", "cad-cycloidal-43k.ply"}) {
     testing::RoundZero round(name, SimplifyOptions{}, 4);
     auto& master = dynamic_cast<QuadricPriority&>(*round.master);
@@ -62,7 +63,7 @@ TEST(HeldQuadrics, AWorkerKeepsWhatTheMasterHoldsAfterTheRound) {
   }
 }
 
-TEST(HeldQuadrics, ARecordOfAVertexNotFreeIsRefused) {
+TEST(HeldState, ARecordOfAVertexNotFreeIsRefused) {
   testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
   const SubsetJob& job = round.jobs[0];
   QuadricState state = initial_free_quadrics(job);
@@ -73,7 +74,7 @@ TEST(HeldQuadrics, ARecordOfAVertexNotFreeIsRefused) {
   EXPECT_THROW(follow_records(state, {r}), Error);
 }
 
-TEST(HeldQuadrics, TakenOutAndPutBackTheStateIsTheSame) {
+TEST(HeldState, TakenOutAndPutBackTheStateIsTheSame) {
   testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
   const QuadricState whole = round.jobs[0].state.quadric;
   ASSERT_GT(whole.vertices.size(), 10u);
@@ -108,7 +109,7 @@ TEST(HeldQuadrics, TakenOutAndPutBackTheStateIsTheSame) {
     ASSERT_TRUE(same_bits(state.quadrics[i], whole.quadrics[i]));
 }
 
-TEST(HeldQuadrics, FingerprintsSeeEveryBit) {
+TEST(HeldState, FingerprintsSeeEveryBit) {
   Quadric q = Quadric::from_plane({0, 0, 1}, -1, 2);
   const uint64_t f = quadric_fingerprint(q);
   Quadric signed_zero = q;
@@ -121,7 +122,7 @@ TEST(HeldQuadrics, FingerprintsSeeEveryBit) {
   EXPECT_NE(quadrics_fingerprint({q}), quadrics_fingerprint({q, q}));
 }
 
-TEST(HeldQuadrics, AHostileIdListIsRefused) {
+TEST(HeldState, AHostileIdListIsRefused) {
   const std::string ids = encode_increasing_ids({3, 7, 9});
   EXPECT_EQ(decode_increasing_ids(ids, 10, "held"), (std::vector<uint32_t>{3, 7, 9}));
   EXPECT_THROW(decode_increasing_ids(ids, 9, "held"), Error);                // 9 out of range
@@ -129,6 +130,61 @@ TEST(HeldQuadrics, AHostileIdListIsRefused) {
   EXPECT_THROW(decode_increasing_ids(ids.substr(0, 2), 10, "held"), Error);  // cut short
   EXPECT_THROW(decode_increasing_ids("\xff\xff\xff\xff\x0f", 10, "held"), Error);
   EXPECT_THROW(encode_increasing_ids({3, 3}), Error);
+}
+
+// An energy job's points travel without the positions and values of the points its worker
+// holds, by their indices in the state's order; put back, the state is the job's again.
+TEST(HeldState, AnEnergyJobLeavesOutThePointsItsWorkerHolds) {
+  SimplifyOptions options;
+  options.metric = "energy";
+  testing::RoundZero round("pymeshlab-colored-airplane-11k.ply", options, 2);
+  const SubsetJob& job = round.jobs[0];
+  const EnergyState& whole = job.state.energy;
+  ASSERT_TRUE(whole.positions);
+  ASSERT_GT(whole.points.size(), 100u);
+  const size_t k = whole.point_values.size() / whole.points.size();
+  ASSERT_GT(k, 0u);  // the airplane's colours
+  const auto items = holdable_items(job);
+  ASSERT_EQ(items.size(), whole.points.size());
+  std::vector<uint32_t> held;
+  for (uint32_t i = 0; i < whole.points.size(); i += 2) held.push_back(i);
+  const std::string all = encode_subset_job(job);
+  const std::string bytes = encode_subset_job(job, job.state, held);
+  EXPECT_LT(bytes.size(), all.size() - held.size() * (12 + 4 * k) / 2);
+
+  SubsetJob decoded = decode_subset_job(bytes, held);
+  EnergyState& state = decoded.state.energy;
+  ASSERT_EQ(state.points.size(), whole.points.size());
+  EXPECT_EQ(state.points[0].position, (Vec3{0, 0, 0}));
+  std::vector<Vec3> positions;
+  std::vector<float> values;
+  std::vector<uint64_t> fingerprints;
+  for (uint32_t i : held) {
+    positions.push_back(whole.points[i].position);
+    values.insert(values.end(), whole.point_values.begin() + i * k,
+                  whole.point_values.begin() + (i + 1) * k);
+    fingerprints.push_back(items[i].second);
+    EXPECT_EQ(point_fingerprint(positions.back(), values.data() + values.size() - k, k),
+              items[i].second);
+  }
+  put_back_held_points(state, held, positions, values);
+  for (size_t i = 0; i < whole.points.size(); ++i) {
+    ASSERT_EQ(state.points[i].id, whole.points[i].id);
+    ASSERT_EQ(state.points[i].position, whole.points[i].position) << i;
+    ASSERT_EQ(state.points[i].distance_sq, whole.points[i].distance_sq);
+  }
+  EXPECT_EQ(state.point_values, whole.point_values);
+  EXPECT_NE(fingerprints_fingerprint(fingerprints),
+            fingerprints_fingerprint(
+                std::vector<uint64_t>(fingerprints.begin() + 1, fingerprints.end())));
+
+  // Indices past the points, or not increasing, are refused on both sides.
+  const std::vector<uint32_t> past = {uint32_t(whole.points.size())};
+  EXPECT_THROW(encode_subset_job(job, job.state, past), Error);
+  EXPECT_THROW(decode_subset_job(all, past), Error);
+  EXPECT_THROW(decode_subset_job(bytes, {1, 0}), Error);
+  EXPECT_THROW(put_back_held_points(state, past, {Vec3{}}, std::vector<float>(k)), Error);
+  EXPECT_THROW(put_back_held_points(state, held, positions, {}), Error);
 }
 
 }  // namespace

@@ -1,11 +1,15 @@
-// Quadrics a worker holds between the rounds of one build. A quadric job's free vertices end
-// their round with quadrics both sides can compute alike, bit for bit, from the job and its
-// records: the worker keeps them, and the coordinator, knowing what it keeps, leaves out of a
-// later job of that worker the quadrics it holds unchanged (88 bytes each), sending their ids
-// and one fingerprint of them instead. Plain data and arithmetic: the service layer moves it.
+// State a worker holds between the rounds of one build, so that later jobs of that worker
+// need not carry it: the coordinator, knowing what the worker keeps, leaves it out of the job,
+// sending ids and one fingerprint of what it left out instead. Two kinds, by the metric:
+//  - the quadric's: a quadric job's free vertices end their round with quadrics both sides can
+//    compute alike, bit for bit, from the job and its records (88 bytes each);
+//  - the energy's: its sample points' positions and attribute values, which never change (24
+//    bytes each for a drawn point, 12 for a vertex's, plus 4 per attribute float).
+// Plain data and arithmetic: the service layer moves it.
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "parallel/subset_job.h"
@@ -44,5 +48,24 @@ HeldOut take_out_held(QuadricState& state, const std::vector<uint8_t>& held);
 // size, are not increasing, or name a vertex `state` lists.
 void put_back_held(QuadricState& state, const std::vector<VertexId>& vertices,
                    const std::vector<Quadric>& quadrics);
+
+// What a job's state holds that its worker may hold already, as (id, fingerprint) pairs in
+// the state's order: a quadric job's (global vertex, quadric_fingerprint) per state entry; an
+// energy job's (point id, point_fingerprint) per point. Empty for a job without a state.
+std::vector<std::pair<uint32_t, uint64_t>> holdable_items(const SubsetJob& job);
+
+// The fingerprint of point i of an energy state with positions: its position's and attribute
+// values' bits.
+uint64_t point_fingerprint(const EnergyState& state, size_t i);
+// The fingerprint of points given by position and values (k floats each), in order, and of a
+// list of item fingerprints in order.
+uint64_t point_fingerprint(const Vec3& position, const float* values, size_t k);
+uint64_t fingerprints_fingerprint(const std::vector<uint64_t>& fingerprints);
+
+// The energy state's points at `held` (indices in its point order, increasing) get
+// `positions` and `values` (k floats each, in `held`'s order). Error(kInvalidInput) when an
+// index is past the points or the sizes disagree.
+void put_back_held_points(EnergyState& state, const std::vector<uint32_t>& held,
+                          const std::vector<Vec3>& positions, const std::vector<float>& values);
 
 }  // namespace parapm
