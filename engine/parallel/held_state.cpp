@@ -128,9 +128,12 @@ std::vector<std::pair<uint32_t, uint64_t>> holdable_items(const SubsetJob& job) 
   if (job.state.metric == "quadric") {
     const QuadricState& q = job.state.quadric;
     items.reserve(q.vertices.size());
-    for (size_t k = 0; k < q.vertices.size(); ++k)
-      if (q.vertices[k] < job.global_vertex.size())
-        items.emplace_back(job.global_vertex[q.vertices[k]], quadric_fingerprint(q.quadrics[k]));
+    for (size_t k = 0; k < q.vertices.size(); ++k) {
+      if (q.vertices[k] >= job.global_vertex.size())
+        throw_invalid("quadric state: vertex " + std::to_string(q.vertices[k]) +
+                      " out of the job's range");
+      items.emplace_back(job.global_vertex[q.vertices[k]], quadric_fingerprint(q.quadrics[k]));
+    }
   } else if (job.state.metric == "energy" && job.state.energy.positions) {
     const EnergyState& e = job.state.energy;
     items.reserve(e.points.size());

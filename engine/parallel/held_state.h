@@ -52,13 +52,14 @@ void put_back_held(QuadricState& state, const std::vector<VertexId>& vertices,
 // What a job's state holds that its worker may hold already, as (id, fingerprint) pairs in
 // the state's order: a quadric job's (global vertex, quadric_fingerprint) per state entry; an
 // energy job's (point id, point_fingerprint) per point. Empty for a job without a state.
+// Error(kInvalidInput) for a quadric state naming a vertex out of the job.
 std::vector<std::pair<uint32_t, uint64_t>> holdable_items(const SubsetJob& job);
 
 // The fingerprint of point i of an energy state with positions: its position's and attribute
 // values' bits.
 uint64_t point_fingerprint(const EnergyState& state, size_t i);
-// The fingerprint of points given by position and values (k floats each), in order, and of a
-// list of item fingerprints in order.
+// The fingerprint of a point given by its position and values (k floats), and of a list of
+// item fingerprints in order.
 uint64_t point_fingerprint(const Vec3& position, const float* values, size_t k);
 uint64_t fingerprints_fingerprint(const std::vector<uint64_t>& fingerprints);
 
