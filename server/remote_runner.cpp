@@ -119,7 +119,7 @@ RemoteRunner::RemoteRunner(WorkerRegistry& registry, WorkerChannels& channels,
       channels_(channels),
       options_(std::move(options)),
       on_event_(std::move(on_event)) {
-  if (options_.held_state) build_key_ = options_.job_id + "/" + new_id("build-");
+  build_key_ = options_.job_id + "/" + new_id("build-");
 }
 
 namespace {
@@ -180,8 +180,7 @@ class RemoteRunner::Dispatch {
 
  private:
   bool keeps_state(const SubsetJob& job) const {
-    return !runner_.build_key_.empty() &&
-           (job.options.metric == "quadric" || job.options.metric == "energy");
+    return job.options.metric == "quadric" || job.options.metric == "energy";
   }
 
   // The request of subset i as any worker takes it: the job whole.
@@ -203,18 +202,15 @@ class RemoteRunner::Dispatch {
     std::map<std::string, uint32_t> slots = runner_.registry_.live_slots_by_worker();
     for (const std::string& id : runner_.distrusted_) slots.erase(id);
     items_.assign(jobs_.size(), {});
-    std::vector<HeldStateLedger::Plan> plans;
-    if (!runner_.build_key_.empty()) {
-      run_jobs(jobs_.size(), 0, [&](size_t i) {
-        if (keeps_state(jobs_[i])) items_[i] = holdable_items(jobs_[i]);
-      });
-      plans = runner_.held_.plan_round(items_, slots);
-    }
+    run_jobs(jobs_.size(), 0, [&](size_t i) {
+      if (keeps_state(jobs_[i])) items_[i] = holdable_items(jobs_[i]);
+    });
+    const std::vector<HeldStateLedger::Plan> plans = runner_.held_.plan_round(items_, slots);
     requests_.resize(jobs_.size());
     held_count_.assign(jobs_.size(), 0);
     run_jobs(jobs_.size(), 0, [&](size_t i) {
       const SubsetJob& job = jobs_[i];
-      const HeldStateLedger::Plan plan = plans.empty() ? HeldStateLedger::Plan{} : plans[i];
+      const HeldStateLedger::Plan& plan = plans[i];
       if (plan.count == 0 || !keeps_state(job)) {
         requests_[i] = whole_request(i);
         return;
@@ -516,7 +512,7 @@ class RemoteRunner::Dispatch {
   // holds); empty: none, or that worker lost them (the job goes whole).
   std::vector<std::string> holder_;
   std::vector<uint64_t> held_count_;  // per subset: the items its request leaves out
-  // Per subset, with a build key: its holdable items (holdable_items), found once.
+  // Per subset: its holdable items (holdable_items), found once.
   std::vector<std::vector<std::pair<uint32_t, uint64_t>>> items_;
   std::vector<std::unique_ptr<Flight>> flights_;
   std::mutex mutex_;  // guards the flights' `finished` with changed_

@@ -52,10 +52,6 @@ struct RemoteOptions {
   // When no worker is registered, the coordinator runs subsets itself on this many threads
   // (0: it waits for a worker instead).
   unsigned local_threads = 0;
-  // The workers keep a build's state between rounds (a quadric job's quadrics, an energy
-  // job's points' positions), and a later job goes to the worker holding most of it, without
-  // it (held_state.h). Off: every job carries its whole state, to any worker.
-  bool held_state = true;
 };
 
 // What moving the jobs cost, summed over every subset call of the runner's life.
@@ -84,9 +80,11 @@ class RemoteRunner : public SubsetRunner {
  private:
   class Dispatch;  // one run's state (remote_runner.cpp)
   TransportStats transport_;
-  std::string build_key_;  // the workers keep this build's state under it
-  HeldStateLedger held_;   // what they keep
-  // Workers that lost quadrics this build had left with them: none is left out for them again.
+  // The workers keep this build's state under it (held_state.h), and a later job goes to the
+  // worker holding most of its own, without it.
+  std::string build_key_;
+  HeldStateLedger held_;  // what they keep
+  // Workers that lost state this build had left with them: none is left out for them again.
   std::set<std::string> distrusted_;
   WorkerRegistry& registry_;
   WorkerChannels& channels_;
