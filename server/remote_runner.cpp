@@ -196,7 +196,7 @@ class RemoteRunner::Dispatch {
 
   // Side by side, one job per hardware thread (each request is its own). A job goes without
   // what its planned worker holds (holder_[i]; HeldStateLedger::plan_round): a quadric job
-  // without those quadrics, an energy job without those points' positions and values.
+  // without those quadrics, an energy job with those points as their ids alone.
   void encode_requests() {
     const auto encode_start = std::chrono::steady_clock::now();
     std::map<std::string, uint32_t> slots = runner_.registry_.live_slots_by_worker();
@@ -227,7 +227,7 @@ class RemoteRunner::Dispatch {
         request.set_held_fingerprint(out.fingerprint);
         request.set_job(encode_subset_job(job, state));
       } else {
-        // The points' positions and values, by their indices in the state's points.
+        // The points, by their indices in the state's points.
         std::vector<uint32_t> indices;
         std::vector<uint64_t> fingerprints;
         for (uint32_t k = 0; k < plan.held.size(); ++k)
@@ -307,8 +307,9 @@ class RemoteRunner::Dispatch {
           const parapm::v1::SubsetRequest& request = f.whole ? *f.whole : requests_[i];
           f.job_bytes = request.job().size() + request.held_ids().size();
           if (!f.whole) f.held_items = held_count_[i];
-          // What the worker will keep (an energy job's points as sent; a quadric job's
-          // quadrics from these, followed through its records), found while it works.
+          // What the worker will keep: a quadric job's quadrics from these (found while it
+          // works), followed through its records; an energy job's points as sent, with the
+          // distances its result returns.
           const bool keeps = !request.build_key().empty();
           const bool quadric = jobs_[i].options.metric == "quadric";
           QuadricState initial;
@@ -316,19 +317,16 @@ class RemoteRunner::Dispatch {
           auto find_kept = [&] {
             if (!keeps) return;
             try {
-              if (quadric)
-                initial = initial_free_quadrics(jobs_[i]);
-              else
-                f.kept = items_[i];
+              if (quadric) initial = initial_free_quadrics(jobs_[i]);
             } catch (const std::exception& e) {
               failed = e.what();
             }
           };
           call_worker(f, *stub, request, find_kept, [&] { mark(f.begun); });
           if (!failed.empty()) throw Error(ErrorCode::kInternal, failed);
-          if (f.status.ok() && keeps && quadric)
-            f.kept = kept_fingerprints(std::move(initial), f.result);
-          if (!f.status.ok()) f.kept.clear();
+          if (f.status.ok() && keeps)
+            f.kept = quadric ? kept_fingerprints(std::move(initial), f.result)
+                             : held_items_after(jobs_[i], f.result.state.energy);
         } catch (const std::exception& e) {
           f.status = {grpc::StatusCode::DATA_LOSS, e.what()};
         }

@@ -41,7 +41,7 @@ void HeldStateCache::keep(const std::string& build, const QuadricState& quadrics
 }
 
 bool HeldStateCache::find_points(const std::string& build, const std::vector<uint32_t>& ids,
-                                 size_t k, std::vector<Vec3>& positions,
+                                 size_t k, std::vector<HeldPoint>& points,
                                  std::vector<float>& values) {
   std::lock_guard lock(mutex_);
   trim(build);
@@ -50,13 +50,13 @@ bool HeldStateCache::find_points(const std::string& build, const std::vector<uin
   Build& held = it->second;
   held.last_use = std::chrono::steady_clock::now();
   if (!ids.empty() && held.k != k) return false;
-  positions.clear();
+  points.clear();
   values.clear();
-  positions.reserve(ids.size());
+  points.reserve(ids.size());
   values.reserve(ids.size() * k);
   for (uint32_t id : ids) {
     if (id >= held.have.size() || !held.have[id]) return false;
-    positions.push_back(held.positions[id]);
+    points.push_back(held.points[id]);
     values.insert(values.end(), held.values.begin() + ptrdiff_t(id * k),
                   held.values.begin() + ptrdiff_t((id + 1) * k));
   }
@@ -75,24 +75,37 @@ void HeldStateCache::keep_points(const std::string& build, const EnergyState& st
   const uint64_t size = uint64_t(largest) + 1;
   if (held.k != k || size * (kPointBytes + 4 * k) > max_bytes_) {
     // Points of another kind, or more than the whole cache could hold: none kept.
-    held.positions = {};
+    held.points = {};
     held.values = {};
     held.have = {};
   } else {
     if (size > held.have.size()) {
-      held.positions.resize(size);
+      held.points.resize(size);
       held.values.resize(size * k);
       held.have.resize(size, 0);
     }
     for (size_t i = 0; i < state.points.size(); ++i) {
-      const uint32_t id = state.points[i].id;
-      held.positions[id] = state.points[i].position;
+      const EnergyState::Point& p = state.points[i];
+      held.points[p.id] = {p.position, p.distance_sq, p.residual};
       std::copy_n(state.point_values.begin() + ptrdiff_t(i * k), k,
-                  held.values.begin() + ptrdiff_t(size_t(id) * k));
-      held.have[id] = 1;
+                  held.values.begin() + ptrdiff_t(size_t(p.id) * k));
+      held.have[p.id] = 1;
     }
   }
   trim(build);
+}
+
+void HeldStateCache::update_points(const std::string& build, const EnergyState& returned) {
+  if (build.empty() || returned.points.empty()) return;
+  std::lock_guard lock(mutex_);
+  const auto it = builds_.find(build);
+  if (it == builds_.end()) return;
+  Build& held = it->second;
+  for (const EnergyState::Point& p : returned.points) {
+    if (p.id >= held.have.size() || !held.have[p.id]) continue;
+    held.points[p.id].distance_sq = p.distance_sq;
+    held.points[p.id].residual = p.residual;
+  }
 }
 
 uint64_t HeldStateCache::bytes_locked() const {

@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
   app.add_option("--held-state-mb", args.held_state_mb,
                  "memory for the state kept between a build's rounds, so that later jobs need "
                  "not carry it (a quadric build's quadrics, about 128 bytes a vertex; an energy "
-                 "build's points' positions, about 25 bytes a point; the builds used longest ago "
+                 "build's sample points, about 41 bytes a point; the builds used longest ago "
                  "are dropped past it, and their next jobs come whole)")
       ->capture_default_str()
       ->check(CLI::Range(uint64_t{0}, uint64_t{1} << 20));

@@ -100,14 +100,14 @@ grpc::Status SubsetService::restore_held_state(const parapm::v1::SubsetRequest& 
         return {grpc::StatusCode::INVALID_ARGUMENT, "held point past the job's points"};
       ids[i] = state.points[held[i]].id;
     }
-    std::vector<Vec3> positions;
+    std::vector<HeldPoint> points;
     std::vector<float> values;
-    if (!held_.find_points(build, ids, k, positions, values)) return not_held();
+    if (!held_.find_points(build, ids, k, points, values)) return not_held();
     std::vector<uint64_t> fingerprints(held.size());
     for (size_t i = 0; i < held.size(); ++i)
-      fingerprints[i] = point_fingerprint(positions[i], values.data() + i * k, k);
+      fingerprints[i] = point_fingerprint(points[i], values.data() + i * k, k);
     if (fingerprints_fingerprint(fingerprints) != request.held_fingerprint()) return not_held();
-    put_back_held_points(state, held, positions, values);
+    put_back_held_points(state, held, points, values);
     return grpc::Status::OK;
   }
   return {grpc::StatusCode::INVALID_ARGUMENT,
@@ -202,8 +202,9 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
       if (!writer->Write(message)) peer_gone = true;
     };
     spdlog::info("{}: started, {} faces", name, job.mesh.face_count());
-    // A job of a build keeps its points' positions and values (an energy job's, which never
-    // change), or its free vertices' quadrics at its end (a quadric job's): held_state.h.
+    // A job of a build keeps its points (an energy job's: their positions and values, which
+    // never change, and their distances at its end), or its free vertices' quadrics at its end
+    // (a quadric job's): held_state.h.
     const bool keeps = !request->build_key().empty();
     if (keeps) held_.keep_points(request->build_key(), job.state.energy);
     QuadricState kept;
@@ -218,7 +219,10 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
       throw;
     }
 
-    if (keeps) held_.keep(request->build_key(), kept);
+    if (keeps) {
+      held_.keep(request->build_key(), kept);
+      held_.update_points(request->build_key(), result.state.energy);
+    }
     kept = QuadricState{};
 
     // The records, then the summary; a failed write means the coordinator is gone.

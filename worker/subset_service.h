@@ -3,8 +3,8 @@
 // runs, then the collapse records in batches, then the summary (state, stats, times). The
 // call's deadline and cancellation reach the engine through a CancelToken. A job of a build
 // keeps state (HeldStateCache: a quadric job's free vertices' quadrics at its end, an energy
-// job's points' positions and values) for the build's later jobs, whose requests leave out
-// what it holds (engine/parallel/held_state.h).
+// job's sample points) for the build's later jobs, whose requests leave out what it holds
+// (engine/parallel/held_state.h).
 #pragma once
 
 #include <atomic>
@@ -36,8 +36,8 @@ class SubsetService final : public parapm::v1::WorkerService::Service {
   // The call's outcome in the metrics.
   void record_outcome(const grpc::Status& status, double seconds, uint64_t bytes_sent);
   // Puts back into the job's state what its request left out (`held`, its held_ids: a
-  // quadric job's quadrics, an energy job's points' positions and values); a status other than
-  // OK when this worker does not hold them.
+  // quadric job's quadrics, an energy job's sample points); a status other than OK when this
+  // worker does not hold them.
   grpc::Status restore_held_state(const parapm::v1::SubsetRequest& request,
                                   const std::vector<uint32_t>& held, SubsetJob& job);
   // Waits for a free slot; false when the call was cancelled meanwhile.

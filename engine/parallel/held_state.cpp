@@ -143,16 +143,20 @@ std::vector<std::pair<uint32_t, uint64_t>> holdable_items(const SubsetJob& job) 
   return items;
 }
 
-uint64_t point_fingerprint(const Vec3& position, const float* values, size_t k) {
+uint64_t point_fingerprint(const HeldPoint& point, const float* values, size_t k) {
   uint64_t h = 0x9017e5ULL;
-  for (double c : position) h = mix(h ^ std::bit_cast<uint64_t>(c));
+  for (double c : point.position) h = mix(h ^ std::bit_cast<uint64_t>(c));
+  h = mix(h ^ std::bit_cast<uint64_t>(point.distance_sq));
+  h = mix(h ^ std::bit_cast<uint64_t>(point.residual));
   for (size_t j = 0; j < k; ++j) h = mix(h ^ std::bit_cast<uint32_t>(values[j]));
   return h;
 }
 
 uint64_t point_fingerprint(const EnergyState& state, size_t i) {
   const size_t k = state.points.empty() ? 0 : state.point_values.size() / state.points.size();
-  return point_fingerprint(state.points[i].position, state.point_values.data() + i * k, k);
+  const EnergyState::Point& p = state.points[i];
+  return point_fingerprint({p.position, p.distance_sq, p.residual},
+                           state.point_values.data() + i * k, k);
 }
 
 uint64_t fingerprints_fingerprint(const std::vector<uint64_t>& fingerprints) {
@@ -161,17 +165,42 @@ uint64_t fingerprints_fingerprint(const std::vector<uint64_t>& fingerprints) {
   return h;
 }
 
+std::vector<std::pair<uint32_t, uint64_t>> held_items_after(const SubsetJob& job,
+                                                            const EnergyState& returned) {
+  const EnergyState& sent = job.state.energy;
+  if (job.state.metric != "energy" || !sent.positions) return {};
+  // The returned points' distances and residuals, by id.
+  std::vector<std::pair<uint32_t, uint32_t>> by_id(returned.points.size());
+  for (uint32_t i = 0; i < by_id.size(); ++i) by_id[i] = {returned.points[i].id, i};
+  std::sort(by_id.begin(), by_id.end());
+  const size_t k = sent.points.empty() ? 0 : sent.point_values.size() / sent.points.size();
+  std::vector<std::pair<uint32_t, uint64_t>> items(sent.points.size());
+  for (size_t i = 0; i < sent.points.size(); ++i) {
+    const EnergyState::Point& p = sent.points[i];
+    HeldPoint held{p.position, p.distance_sq, p.residual};
+    const auto it = std::lower_bound(by_id.begin(), by_id.end(), std::pair{p.id, 0u});
+    if (it != by_id.end() && it->first == p.id) {
+      held.distance_sq = returned.points[it->second].distance_sq;
+      held.residual = returned.points[it->second].residual;
+    }
+    items[i] = {p.id, point_fingerprint(held, sent.point_values.data() + i * k, k)};
+  }
+  return items;
+}
+
 void put_back_held_points(EnergyState& state, const std::vector<uint32_t>& held,
-                          const std::vector<Vec3>& positions, const std::vector<float>& values) {
+                          const std::vector<HeldPoint>& points, const std::vector<float>& values) {
   const size_t k = state.points.empty() ? 0 : state.point_values.size() / state.points.size();
-  if (positions.size() != held.size() || values.size() != held.size() * k)
+  if (points.size() != held.size() || values.size() != held.size() * k)
     throw_invalid("held points: " + std::to_string(held.size()) + " indices, " +
-                  std::to_string(positions.size()) + " positions");
+                  std::to_string(points.size()) + " points");
   for (size_t j = 0; j < held.size(); ++j) {
     const size_t i = held[j];
     if (i >= state.points.size())
       throw_invalid("held point " + std::to_string(i) + " past the job's points");
-    state.points[i].position = positions[j];
+    state.points[i].position = points[j].position;
+    state.points[i].distance_sq = points[j].distance_sq;
+    state.points[i].residual = points[j].residual;
     std::copy_n(values.begin() + ptrdiff_t(j * k), k,
                 state.point_values.begin() + ptrdiff_t(i * k));
   }

@@ -4,7 +4,8 @@
 //  - the quadric's: a quadric job's free vertices end their round with quadrics both sides can
 //    compute alike, bit for bit, from the job and its records (88 bytes each);
 //  - the energy's: its sample points' positions and attribute values, which never change (24
-//    bytes each for a drawn point, 12 for a vertex's, plus 4 per attribute float).
+//    bytes each for a drawn point, 12 for a vertex's, plus 4 per attribute float), and their
+//    distances (and attribute residuals) as the worker's job left them.
 // Plain data and arithmetic: the service layer moves it.
 #pragma once
 
@@ -55,18 +56,27 @@ void put_back_held(QuadricState& state, const std::vector<VertexId>& vertices,
 // Error(kInvalidInput) for a quadric state naming a vertex out of the job.
 std::vector<std::pair<uint32_t, uint64_t>> holdable_items(const SubsetJob& job);
 
-// The fingerprint of point i of an energy state with positions: its position's and attribute
-// values' bits.
+// What a worker holds of a point besides its attribute values.
+struct HeldPoint {
+  Vec3 position{};
+  double distance_sq = 0;
+  double residual = 0;
+};
+// The fingerprint of a point (its position's, distance's, residual's and k attribute values'
+// bits); of point i of an energy state with positions; of a list of fingerprints in order.
+uint64_t point_fingerprint(const HeldPoint& point, const float* values, size_t k);
 uint64_t point_fingerprint(const EnergyState& state, size_t i);
-// The fingerprint of a point given by its position and values (k floats), and of a list of
-// item fingerprints in order.
-uint64_t point_fingerprint(const Vec3& position, const float* values, size_t k);
 uint64_t fingerprints_fingerprint(const std::vector<uint64_t>& fingerprints);
 
-// The energy state's points at `held` (indices in its point order, increasing) get
-// `positions` and `values` (k floats each, in `held`'s order). Error(kInvalidInput) when an
-// index is past the points or the sizes disagree.
+// An energy job's items as its worker holds them after the job (holdable_items of its state
+// with the distances and residuals of the points `returned`, its result's state, instead).
+std::vector<std::pair<uint32_t, uint64_t>> held_items_after(const SubsetJob& job,
+                                                            const EnergyState& returned);
+
+// The energy state's points at `held` (indices in its point order, increasing) get `points`
+// and `values` (k floats each, in `held`'s order). Error(kInvalidInput) when an index is past
+// the points or the sizes disagree.
 void put_back_held_points(EnergyState& state, const std::vector<uint32_t>& held,
-                          const std::vector<Vec3>& positions, const std::vector<float>& values);
+                          const std::vector<HeldPoint>& points, const std::vector<float>& values);
 
 }  // namespace parapm

@@ -291,7 +291,8 @@ void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool re
                  bool as_f32, HeldPoints& held, uint32_t& previous_id) {
   const EnergyState::Point& p = s.points[i];
   write_near(out, p.id, previous_id);
-  const bool positions = s.positions && !held.take(i);
+  if (s.positions && held.take(i)) return;  // its worker holds the rest
+  const bool positions = s.positions;
   if (positions) write_position(out, p.position, as_f32);
   out.f64(p.distance_sq);
   if (residuals) out.f64(p.residual);
@@ -382,19 +383,24 @@ void write_energy(ByteWriter& out, const EnergyState& s, const std::vector<uint3
   }
 }
 
-// A held point's position and values are left at zero (its worker fills them in).
+// A held point is its id alone: its position, distance, residual and values are left at zero
+// (its worker fills them in).
 void read_point(ByteReader& in, int k, bool residuals, bool as_f32, FaceId face, VertexId vertex,
                 HeldPoints& held, uint32_t& previous_id, EnergyState& s) {
   EnergyState::Point p;
   p.id = read_near(in, kAnyId, previous_id, "point id");
   p.face = face;
   p.vertex = vertex;
-  const bool positions = s.positions && !held.take(s.points.size());
-  if (positions) p.position = read_position(in, as_f32);
+  if (s.positions && held.take(s.points.size())) {
+    s.point_values.resize(s.point_values.size() + size_t(k), 0.0f);
+    s.points.push_back(p);
+    return;
+  }
+  if (s.positions) p.position = read_position(in, as_f32);
   p.distance_sq = in.f64();
   p.residual = residuals ? in.f64() : 0.0;
   if (s.positions)
-    for (int j = 0; j < k; ++j) s.point_values.push_back(positions ? in.f32() : 0.0f);
+    for (int j = 0; j < k; ++j) s.point_values.push_back(in.f32());
   s.points.push_back(p);
 }
 
@@ -419,8 +425,9 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions,
   const bool points_f32 = flags & kPointsF32, samples_f32 = flags & kSamplesF32;
   if ((points_f32 || samples_f32) && !positions) in.fail("float positions flagged, none present");
   const uint64_t point_bytes =
-      1 + 8 + (residuals ? 8 : 0) +
-      (positions && held_points.empty() ? (points_f32 ? 12 : 24) + 4 * uint64_t(k) : 0);
+      held_points.empty()
+          ? 1 + 8 + (residuals ? 8 : 0) + (positions ? (points_f32 ? 12 : 24) + 4 * uint64_t(k) : 0)
+          : 1;
   uint32_t previous_id = 0, previous_sample = 0;  // (near: in the order written)
 
   for (size_t i = 0; i < s.faces.size(); ++i) {

@@ -38,10 +38,9 @@
 //           n x k f32 values, per wedge (its index - the index of its class's wedge) v. A
 //           point: id near, [position 3 f64], distance_sq f64, [residual f64], [k f32 (with
 //           positions)]; its face or vertex is the one it is written under (export order);
-//           its id is near the point written before it, across faces and vertices. A job
-//           may leave out the position and values of points its worker holds (their indices
-//           in the state's point order travel beside the job: encode_subset_job's
-//           held_points).
+//           its id is near the point written before it, across faces and vertices. A point
+//           its worker holds is its id alone (their indices in the state's point order
+//           travel beside the job: encode_subset_job's held_points).
 //   keys    n v, then per key (sorted by (a, b), a < b: edge_keys.h) a minus the previous
 //           key's a v, b - a - 1 v, cost f64 (NaN: the edge cannot be placed).
 //   deferred n v, then per edge (sorted by (a, b), a < b: simplifier.h, DeferredEdge) as a
@@ -81,15 +80,15 @@ namespace parapm {
 
 std::string encode_subset_job(const SubsetJob& job);
 // The job with `state` in place of its own (its quadric state less the quadrics its worker
-// holds: held_state.h), and without the positions and attribute values of the energy state's
-// points at `held_points` (indices in its point order, increasing: its worker holds them).
+// holds: held_state.h), and with the energy state's points at `held_points` (indices in its
+// point order, increasing: its worker holds them) as their ids alone.
 std::string encode_subset_job(const SubsetJob& job, const MetricState& state,
                               const std::vector<uint32_t>& held_points = {});
 // Also runs validate_subset_job and checks the state against the job's mesh (ids in range,
 // the attribute state E_scalar will need), so that simplify_subset can import it safely. The
-// points at `held_points` (indices in the state's point order, increasing) were encoded
-// without positions and values: they are left at zero, for the caller to put back
-// (put_back_held_points).
+// points at `held_points` (indices in the state's point order, increasing) were encoded as
+// their ids alone: their positions, distances, residuals and values are left at zero, for the
+// caller to put back (put_back_held_points).
 SubsetJob decode_subset_job(std::string_view bytes, const std::vector<uint32_t>& held_points = {});
 
 // A list of strictly increasing ids (n v, ids+), and back: Error(kInvalidInput) "`what`: byte N

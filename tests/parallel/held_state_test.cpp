@@ -132,8 +132,8 @@ TEST(HeldState, AHostileIdListIsRefused) {
   EXPECT_THROW(encode_increasing_ids({3, 3}), Error);
 }
 
-// An energy job's points travel without the positions and values of the points its worker
-// holds, by their indices in the state's order; put back, the state is the job's again.
+// An energy job's points its worker holds travel as their ids alone, named by their indices in
+// the state's order; put back, the state is the job's again.
 TEST(HeldState, AnEnergyJobLeavesOutThePointsItsWorkerHolds) {
   SimplifyOptions options;
   options.metric = "energy";
@@ -150,28 +150,31 @@ TEST(HeldState, AnEnergyJobLeavesOutThePointsItsWorkerHolds) {
   for (uint32_t i = 0; i < whole.points.size(); i += 2) held.push_back(i);
   const std::string all = encode_subset_job(job);
   const std::string bytes = encode_subset_job(job, job.state, held);
-  EXPECT_LT(bytes.size(), all.size() - held.size() * (12 + 4 * k) / 2);
+  EXPECT_LT(bytes.size(), all.size() - held.size() * (12 + 8 + 4 * k) / 2);
 
   SubsetJob decoded = decode_subset_job(bytes, held);
   EnergyState& state = decoded.state.energy;
   ASSERT_EQ(state.points.size(), whole.points.size());
   EXPECT_EQ(state.points[0].position, (Vec3{0, 0, 0}));
-  std::vector<Vec3> positions;
+  EXPECT_EQ(state.points[0].distance_sq, 0);
+  std::vector<HeldPoint> points;
   std::vector<float> values;
   std::vector<uint64_t> fingerprints;
   for (uint32_t i : held) {
-    positions.push_back(whole.points[i].position);
+    const EnergyState::Point& p = whole.points[i];
+    points.push_back({p.position, p.distance_sq, p.residual});
     values.insert(values.end(), whole.point_values.begin() + i * k,
                   whole.point_values.begin() + (i + 1) * k);
     fingerprints.push_back(items[i].second);
-    EXPECT_EQ(point_fingerprint(positions.back(), values.data() + values.size() - k, k),
+    EXPECT_EQ(point_fingerprint(points.back(), values.data() + values.size() - k, k),
               items[i].second);
   }
-  put_back_held_points(state, held, positions, values);
+  put_back_held_points(state, held, points, values);
   for (size_t i = 0; i < whole.points.size(); ++i) {
     ASSERT_EQ(state.points[i].id, whole.points[i].id);
     ASSERT_EQ(state.points[i].position, whole.points[i].position) << i;
     ASSERT_EQ(state.points[i].distance_sq, whole.points[i].distance_sq);
+    ASSERT_EQ(state.points[i].residual, whole.points[i].residual);
   }
   EXPECT_EQ(state.point_values, whole.point_values);
   EXPECT_NE(fingerprints_fingerprint(fingerprints),
@@ -183,8 +186,21 @@ TEST(HeldState, AnEnergyJobLeavesOutThePointsItsWorkerHolds) {
   EXPECT_THROW(encode_subset_job(job, job.state, past), Error);
   EXPECT_THROW(decode_subset_job(all, past), Error);
   EXPECT_THROW(decode_subset_job(bytes, {1, 0}), Error);
-  EXPECT_THROW(put_back_held_points(state, past, {Vec3{}}, std::vector<float>(k)), Error);
-  EXPECT_THROW(put_back_held_points(state, held, positions, {}), Error);
+  EXPECT_THROW(put_back_held_points(state, past, {HeldPoint{}}, std::vector<float>(k)), Error);
+  EXPECT_THROW(put_back_held_points(state, held, points, {}), Error);
+
+  // After a job, its worker holds the distances its result returns.
+  EnergyState returned;
+  returned.positions = false;
+  EnergyState::Point moved = whole.points[1];
+  moved.distance_sq += 1;
+  returned.points.push_back(moved);
+  const auto after = held_items_after(job, returned);
+  ASSERT_EQ(after.size(), items.size());
+  EXPECT_EQ(after[0], items[0]);
+  EXPECT_NE(after[1], items[1]);
+  EXPECT_EQ(after[1].second, point_fingerprint({moved.position, moved.distance_sq, moved.residual},
+                                               whole.point_values.data() + k, k));
 }
 
 }  // namespace

@@ -47,19 +47,34 @@ TEST(HeldStateCache, KeepsPointsById) {
     EnergyState::Point p;
     p.id = id;
     p.position = {double(id), 1, 2};
+    p.distance_sq = id / 10.0;
     state.points.push_back(p);
     state.point_values.insert(state.point_values.end(), {float(id), 0.5f});
   }
   cache.keep_points("a", state);
-  std::vector<Vec3> positions;
+  std::vector<HeldPoint> positions;
   std::vector<float> values;
   ASSERT_TRUE(cache.find_points("a", {40, 7}, 2, positions, values));
-  EXPECT_EQ(positions, (std::vector<Vec3>{{40, 1, 2}, {7, 1, 2}}));
+  ASSERT_EQ(positions.size(), 2u);
+  EXPECT_EQ(positions[0].position, (Vec3{40, 1, 2}));
+  EXPECT_EQ(positions[1].position, (Vec3{7, 1, 2}));
+  EXPECT_EQ(positions[1].distance_sq, 0.7);
   EXPECT_EQ(values, (std::vector<float>{40, 0.5f, 7, 0.5f}));
+  // A job's returned distances replace the kept ones (a point never kept is not added).
+  EnergyState returned;
+  returned.positions = false;
+  returned.points = {state.points[0], state.points[0]};
+  returned.points[0].distance_sq = 9;
+  returned.points[1].id = 5;
+  cache.update_points("a", returned);
+  ASSERT_TRUE(cache.find_points("a", {7}, 2, positions, values));
+  EXPECT_EQ(positions[0].distance_sq, 9);
+  EXPECT_EQ(positions[0].position, (Vec3{7, 1, 2}));
   EXPECT_FALSE(cache.find_points("a", {3}, 2, positions, values));   // never kept
   EXPECT_FALSE(cache.find_points("a", {41}, 2, positions, values));  // past them all
   EXPECT_FALSE(cache.find_points("a", {7}, 3, positions, values));   // kept with 2 values
   EXPECT_FALSE(cache.find_points("b", {7}, 2, positions, values));
+  EXPECT_FALSE(cache.find_points("a", {5}, 2, positions, values));
   EXPECT_EQ(cache.bytes(), 41 * (HeldStateCache::kPointBytes + 8));
   // Points beyond what the whole cache could hold are not kept.
   HeldStateCache small(100 * HeldStateCache::kPointBytes, std::chrono::minutes(10));
