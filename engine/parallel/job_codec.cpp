@@ -218,7 +218,7 @@ uint8_t metric_code(const std::string& metric) {
 
 // ---- Metric state ------------------------------------------------------------------------
 
-// The points whose positions and values a job leaves out (its worker holds them): their
+// The points a job writes as their ids alone (its worker holds the rest of them): their
 // indices in the state's point order, increasing; `next`, the first not yet passed.
 struct HeldPoints {
   const std::vector<uint32_t>& indices;
@@ -292,11 +292,10 @@ void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool re
   const EnergyState::Point& p = s.points[i];
   write_near(out, p.id, previous_id);
   if (s.positions && held.take(i)) return;  // its worker holds the rest
-  const bool positions = s.positions;
-  if (positions) write_position(out, p.position, as_f32);
+  if (s.positions) write_position(out, p.position, as_f32);
   out.f64(p.distance_sq);
   if (residuals) out.f64(p.residual);
-  if (positions)
+  if (s.positions)
     for (int j = 0; j < k; ++j) out.f32(s.point_values[i * size_t(k) + size_t(j)]);
 }
 
@@ -404,7 +403,7 @@ void read_point(ByteReader& in, int k, bool residuals, bool as_f32, FaceId face,
   s.points.push_back(p);
 }
 
-// A job's state carries positions (but of `held` points), a returned one does not
+// A job's state carries positions (its held points are ids alone), a returned one does not
 // (EnergyState::positions).
 void read_energy(ByteReader& in, const StateBounds& bounds, bool positions,
                  const std::vector<uint32_t>& held_points, EnergyState& s) {
