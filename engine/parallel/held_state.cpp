@@ -31,9 +31,9 @@ uint64_t quadric_fingerprint(const Quadric& q) {
 }
 
 uint64_t quadrics_fingerprint(const std::vector<Quadric>& quadrics) {
-  uint64_t h = mix(quadrics.size());
-  for (const Quadric& q : quadrics) h = mix(h ^ quadric_fingerprint(q));
-  return h;
+  std::vector<uint64_t> fingerprints(quadrics.size());
+  for (size_t i = 0; i < quadrics.size(); ++i) fingerprints[i] = quadric_fingerprint(quadrics[i]);
+  return fingerprints_fingerprint(fingerprints);
 }
 
 QuadricState initial_free_quadrics(const SubsetJob& job) {
