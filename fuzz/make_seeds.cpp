@@ -1,6 +1,6 @@
 // parapm-fuzz-seeds DIR: writes the binary seeds of the fuzz corpus from the engine's own
 // encoders, on a drawn 10 x 10 grid (200 faces, with texture coordinates): DIR/pm/grid.pm,
-// DIR/job_codec/{job,records,summary}-{quadric,energy} and DIR/mesh/grid.{obj,ply}, each
+// DIR/job_codec/{job,records,summary,held}-{quadric,energy} and DIR/mesh/grid.{obj,ply}, each
 // prefixed by the byte that selects its decoder or name in fuzz_job_codec / fuzz_mesh_reader.
 #include <cstdio>
 #include <filesystem>
@@ -55,6 +55,19 @@ void write(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
 
+// `job` leaving out every other item of its state that a worker may hold (as the coordinator
+// sends it: held_state.h), prefixed as fuzz_job_codec reads it: the held ids' length (2 bytes,
+// little-endian), the ids, the job.
+std::string held_job(const SubsetJob& job) {
+  const size_t items = job.state.metric == "quadric" ? job.state.quadric.vertices.size()
+                                                     : job.state.energy.points.size();
+  std::vector<uint32_t> held;
+  for (uint32_t i = 0; i < items; i += 2) held.push_back(i);
+  const std::string ids = encode_increasing_ids(held);
+  return std::string{char(ids.size() & 0xff), char(ids.size() >> 8)} + ids +
+         encode_subset_job(job, job.state, held);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -104,6 +117,7 @@ int main(int argc, char** argv) {
               encode_collapse_records(result.records.data(), result.records.size()));
     write(dir / "job_codec" / (std::string("summary-") + metric),
           std::string(1, '\2') + encode_subset_summary(result));
+    write(dir / "job_codec" / (std::string("held-") + metric), '\3' + held_job(job));
   }
   return 0;
 }

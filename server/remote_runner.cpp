@@ -195,8 +195,8 @@ class RemoteRunner::Dispatch {
   }
 
   // Side by side, one job per hardware thread (each request is its own). A job goes without
-  // what its planned worker holds (holder_[i]; HeldStateLedger::plan_round): a quadric job
-  // without those quadrics, an energy job with those points as their ids alone.
+  // what its planned worker holds (holder_[i]; HeldStateLedger::plan_round): those quadrics or
+  // points as their ids alone.
   void encode_requests() {
     const auto encode_start = std::chrono::steady_clock::now();
     std::map<std::string, uint32_t> slots = runner_.registry_.live_slots_by_worker();
@@ -220,25 +220,17 @@ class RemoteRunner::Dispatch {
       request.set_round(job.round);
       request.set_subset(job.subset);
       request.set_build_key(runner_.build_key_);
-      if (job.state.metric == "quadric") {
-        MetricState state = job.state;
-        const HeldOut out = take_out_held(state.quadric, plan.held);
-        request.set_held_ids(encode_increasing_ids(out.vertices));
-        request.set_held_fingerprint(out.fingerprint);
-        request.set_job(encode_subset_job(job, state));
-      } else {
-        // The points, by their indices in the state's points.
-        std::vector<uint32_t> indices;
-        std::vector<uint64_t> fingerprints;
-        for (uint32_t k = 0; k < plan.held.size(); ++k)
-          if (plan.held[k]) {
-            indices.push_back(k);
-            fingerprints.push_back(items_[i][k].second);
-          }
-        request.set_held_ids(encode_increasing_ids(indices));
-        request.set_held_fingerprint(fingerprints_fingerprint(fingerprints));
-        request.set_job(encode_subset_job(job, job.state, indices));
-      }
+      // The held items, by their indices in the state's order.
+      std::vector<uint32_t> indices;
+      std::vector<uint64_t> fingerprints;
+      for (uint32_t k = 0; k < plan.held.size(); ++k)
+        if (plan.held[k]) {
+          indices.push_back(k);
+          fingerprints.push_back(items_[i][k].second);
+        }
+      request.set_held_ids(encode_increasing_ids(indices));
+      request.set_held_fingerprint(fingerprints_fingerprint(fingerprints));
+      request.set_job(encode_subset_job(job, job.state, indices));
       holder_[i] = plan.worker;
       held_count_[i] = plan.count;
     });

@@ -124,6 +124,12 @@ size_t HeldStateCache::builds() const {
   return builds_.size();
 }
 
+size_t HeldStateCache::item_bound(const std::string& build) const {
+  std::lock_guard lock(mutex_);
+  const auto it = builds_.find(build);
+  return it == builds_.end() ? 0 : it->second.quadrics.size() + it->second.points.size();
+}
+
 void HeldStateCache::trim(const std::string& keep_build) {
   const auto now = std::chrono::steady_clock::now();
   for (auto it = builds_.begin(); it != builds_.end();) {

@@ -43,6 +43,9 @@ class HeldStateCache {
 
   uint64_t bytes() const;
   size_t builds() const;
+  // At least as many as the items `build` holds (its quadrics, and its points' ids up to the
+  // largest): a job naming more held items than that is refused before it is decoded.
+  size_t item_bound(const std::string& build) const;
 
   // What one kept quadric costs, with its key and the hash table's share; a kept point its
   // position, distance, residual, flag and 4 bytes per value, for every id up to the largest.

@@ -66,29 +66,30 @@ SubsetService::SubsetService(rpc::TokenCheck auth, unsigned slots, WorkerMetrics
                              HeldStateCache& held)
     : auth_(std::move(auth)), slots_(std::max(1u, slots)), metrics_(metrics), held_(held) {}
 
+namespace {
+
+grpc::Status not_held(size_t items) {
+  return {grpc::StatusCode::FAILED_PRECONDITION,
+          "this worker does not hold the state of the " + std::to_string(items) +
+              " items the job leaves out (it was restarted or dropped them): send them"};
+}
+
+}  // namespace
+
 grpc::Status SubsetService::restore_held_state(const parapm::v1::SubsetRequest& request,
                                                const std::vector<uint32_t>& held, SubsetJob& job) {
   if (held.empty()) return grpc::Status::OK;
   const std::string& build = request.build_key();
-  auto not_held = [&] {
-    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
-                        "this worker does not hold the state of the " +
-                            std::to_string(held.size()) +
-                            " items the job leaves out (it was restarted or dropped them): "
-                            "send them");
-  };
   if (!build.empty() && job.state.metric == "quadric") {
+    // (the decoder checked the indices against the state, and the state's vertices against the job)
+    const QuadricState& state = job.state.quadric;
     std::vector<VertexId> global(held.size());
-    for (size_t i = 0; i < held.size(); ++i) {
-      if (held[i] >= job.global_vertex.size())
-        return {grpc::StatusCode::INVALID_ARGUMENT, "held quadric of a vertex out of the job"};
-      global[i] = job.global_vertex[held[i]];
-    }
+    for (size_t i = 0; i < held.size(); ++i) global[i] = job.global_vertex[state.vertices[held[i]]];
     std::vector<Quadric> quadrics;
     if (!held_.find(build, global, quadrics) ||
         quadrics_fingerprint(quadrics) != request.held_fingerprint())
-      return not_held();
-    put_back_held(job.state.quadric, held, quadrics);
+      return not_held(held.size());
+    put_back_held_quadrics(job.state.quadric, held, quadrics);
     return grpc::Status::OK;
   }
   if (!build.empty() && job.state.metric == "energy" && job.state.energy.positions) {
@@ -102,16 +103,17 @@ grpc::Status SubsetService::restore_held_state(const parapm::v1::SubsetRequest& 
     }
     std::vector<HeldPoint> points;
     std::vector<float> values;
-    if (!held_.find_points(build, ids, k, points, values)) return not_held();
+    if (!held_.find_points(build, ids, k, points, values)) return not_held(held.size());
     std::vector<uint64_t> fingerprints(held.size());
     for (size_t i = 0; i < held.size(); ++i)
       fingerprints[i] = point_fingerprint(points[i], values.data() + i * k, k);
-    if (fingerprints_fingerprint(fingerprints) != request.held_fingerprint()) return not_held();
+    if (fingerprints_fingerprint(fingerprints) != request.held_fingerprint())
+      return not_held(held.size());
     put_back_held_points(state, held, points, values);
     return grpc::Status::OK;
   }
   return {grpc::StatusCode::INVALID_ARGUMENT,
-          "held state named without a build key or for a job without a state to hold"};
+          "held state named for a job without a state to hold"};
 }
 
 void SubsetService::record_outcome(const grpc::Status& status, double seconds,
@@ -161,6 +163,10 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
         request->held_ids().empty()
             ? std::vector<uint32_t>{}
             : decode_increasing_ids(request->held_ids(), kNoId, "held state's ids");
+    if (!held_ids.empty() && request->build_key().empty())
+      return {grpc::StatusCode::INVALID_ARGUMENT, "held state named without a build key"};
+    // (each held item decodes to more than its id's byte: no more than this worker holds)
+    if (held_ids.size() > held_.item_bound(request->build_key())) return not_held(held_ids.size());
     SubsetJob job = decode_subset_job(request->job(), held_ids);
     if (grpc::Status held = restore_held_state(*request, held_ids, job); !held.ok()) return held;
     const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +

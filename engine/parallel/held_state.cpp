@@ -78,49 +78,16 @@ void follow_records(QuadricState& quadrics, const std::vector<CollapseRecord>& r
   }
 }
 
-HeldOut take_out_held(QuadricState& state, const std::vector<uint8_t>& held) {
-  if (held.size() != state.vertices.size())
-    throw_internal("take_out_held: one flag per quadric expected");
-  HeldOut out;
-  std::vector<Quadric> held_quadrics;
-  size_t kept = 0;
-  for (size_t i = 0; i < held.size(); ++i) {
-    if (held[i]) {
-      out.vertices.push_back(state.vertices[i]);
-      held_quadrics.push_back(state.quadrics[i]);
-    } else {
-      state.vertices[kept] = state.vertices[i];
-      state.quadrics[kept] = state.quadrics[i];
-      ++kept;
-    }
-  }
-  state.vertices.resize(kept);
-  state.quadrics.resize(kept);
-  out.fingerprint = quadrics_fingerprint(held_quadrics);
-  return out;
-}
-
-void put_back_held(QuadricState& state, const std::vector<VertexId>& vertices,
-                   const std::vector<Quadric>& quadrics) {
-  if (vertices.size() != quadrics.size())
-    throw_invalid("held quadrics: " + std::to_string(vertices.size()) + " vertices, " +
+void put_back_held_quadrics(QuadricState& state, const std::vector<uint32_t>& held,
+                            const std::vector<Quadric>& quadrics) {
+  if (held.size() != quadrics.size())
+    throw_invalid("held quadrics: " + std::to_string(held.size()) + " indices, " +
                   std::to_string(quadrics.size()) + " quadrics");
-  QuadricState merged;
-  merged.vertices.reserve(state.vertices.size() + vertices.size());
-  merged.quadrics.reserve(merged.vertices.capacity());
-  size_t i = 0, j = 0;
-  while (i < state.vertices.size() || j < vertices.size()) {
-    const bool from_held =
-        i == state.vertices.size() || (j < vertices.size() && vertices[j] < state.vertices[i]);
-    const VertexId v = from_held ? vertices[j] : state.vertices[i];
-    if (!merged.vertices.empty() && v <= merged.vertices.back())
-      throw_invalid("held quadrics: vertex " + std::to_string(v) +
-                    (v == merged.vertices.back() ? " is in the job's state too"
-                                                 : " out of increasing order"));
-    merged.vertices.push_back(v);
-    merged.quadrics.push_back(from_held ? quadrics[j++] : state.quadrics[i++]);
+  for (size_t j = 0; j < held.size(); ++j) {
+    if (held[j] >= state.quadrics.size())
+      throw_invalid("held quadric " + std::to_string(held[j]) + " past the job's quadrics");
+    state.quadrics[held[j]] = quadrics[j];
   }
-  state = std::move(merged);
 }
 
 std::vector<std::pair<uint32_t, uint64_t>> holdable_items(const SubsetJob& job) {

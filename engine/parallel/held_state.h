@@ -1,6 +1,7 @@
 // State a worker holds between the rounds of one build, so that later jobs of that worker
-// need not carry it: the coordinator, knowing what the worker keeps, leaves it out of the job,
-// sending ids and one fingerprint of what it left out instead. Two kinds, by the metric:
+// need not carry it: the coordinator, knowing what the worker keeps, leaves it out of the job
+// (job_codec.h: the state's items at the held indices travel as their ids alone), sending the
+// indices and one fingerprint of what it left out instead. Two kinds, by the metric:
 //  - the quadric's: a quadric job's free vertices end their round with quadrics both sides can
 //    compute alike, bit for bit, from the job and its records (88 bytes each);
 //  - the energy's: its sample points' positions and attribute values, which never change (24
@@ -35,20 +36,10 @@ QuadricState initial_free_quadrics(const SubsetJob& job);
 // names a vertex the state does not list.
 void follow_records(QuadricState& quadrics, const std::vector<CollapseRecord>& records);
 
-// Moves out of `state` (a job's quadric state, local ids) the quadrics at the indices `held`
-// flags (one flag per entry) and returns their vertices' local ids, increasing, and their
-// fingerprint (quadrics_fingerprint of them in that order).
-struct HeldOut {
-  std::vector<VertexId> vertices;
-  uint64_t fingerprint = 0;
-};
-HeldOut take_out_held(QuadricState& state, const std::vector<uint8_t>& held);
-
-// Puts `quadrics` back into `state` at `vertices` (local ids, increasing, none of them already
-// in `state`), keeping its ids increasing. Error(kInvalidInput) when the lists disagree in
-// size, are not increasing, or name a vertex `state` lists.
-void put_back_held(QuadricState& state, const std::vector<VertexId>& vertices,
-                   const std::vector<Quadric>& quadrics);
+// The quadric state's entries at `held` (indices in its order, increasing) get `quadrics` (in
+// `held`'s order). Error(kInvalidInput) when an index is past the entries or the sizes disagree.
+void put_back_held_quadrics(QuadricState& state, const std::vector<uint32_t>& held,
+                            const std::vector<Quadric>& quadrics);
 
 // What a job's state holds that its worker may hold already, as (id, fingerprint) pairs in
 // the state's order: a quadric job's (global vertex, quadric_fingerprint) per state entry; an

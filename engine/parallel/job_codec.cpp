@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 7;
+constexpr uint8_t kVersion = 8;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -218,12 +218,13 @@ uint8_t metric_code(const std::string& metric) {
 
 // ---- Metric state ------------------------------------------------------------------------
 
-// The points a job writes as their ids alone (its worker holds the rest of them): their
-// indices in the state's point order, increasing; `next`, the first not yet passed.
-struct HeldPoints {
+// The items of a job's state (the quadric's entries, the energy's points) that it writes as
+// their ids alone (its worker holds the rest of them): their indices in the state's order,
+// increasing; `next`, the first not yet passed.
+struct HeldItems {
   const std::vector<uint32_t>& indices;
   size_t next = 0;
-  // Whether point `index` (the points are visited in order) is held.
+  // Whether item `index` (the items are visited in order) is held.
   bool take(size_t index) {
     if (next < indices.size() && indices[next] == index) {
       ++next;
@@ -232,7 +233,7 @@ struct HeldPoints {
     return false;
   }
 };
-const std::vector<uint32_t> kNoHeldPoints;
+const std::vector<uint32_t> kNoHeldItems;
 
 // What a state's ids may reach: the job's local mesh, or (a summary, global ids) anything.
 struct StateBounds {
@@ -250,24 +251,39 @@ bool is_empty(const EnergyState& s) {
          s.wedge_values.empty() && s.wedge_class.empty();
 }
 
-void write_quadric(ByteWriter& out, const QuadricState& s) {
+void write_quadric(ByteWriter& out, const QuadricState& s,
+                   const std::vector<uint32_t>& held_items) {
   if (s.vertices.size() != s.quadrics.size()) cannot_encode("quadric state sizes disagree");
+  if (!held_items.empty() && held_items.back() >= s.quadrics.size())
+    cannot_encode("held quadrics beyond the state's");
   out.varint(s.vertices.size());
   write_increasing(out, s.vertices, "quadric state vertex");
-  for (const Quadric& q : s.quadrics)
+  HeldItems held{held_items};
+  for (size_t i = 0; i < s.quadrics.size(); ++i) {
+    if (held.take(i)) continue;  // its worker holds it
+    const Quadric& q = s.quadrics[i];
     for (double x : {q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.b0, q.b1, q.b2, q.c, q.weight})
       out.f64(x);
+  }
 }
 
-void read_quadric(ByteReader& in, const StateBounds& bounds, QuadricState& s) {
+// A held quadric is left at zero, for the caller to put back (put_back_held_quadrics).
+void read_quadric(ByteReader& in, const StateBounds& bounds,
+                  const std::vector<uint32_t>& held_items, QuadricState& s) {
   in.set_context("quadric state");
-  const uint64_t n = read_count(in, 1 + kQuadricBytes, "quadric vertices");
+  const uint64_t n = read_count(in, held_items.empty() ? 1 + kQuadricBytes : 1, "quadric vertices");
   read_increasing(in, n, bounds.vertices, s.vertices);
+  if (!held_items.empty() && held_items.back() >= n) in.fail("held quadrics beyond the state's");
+  in.check_fits(n - held_items.size(), kQuadricBytes, "quadrics");  // (the held are fewer)
   s.quadrics.resize(n);
-  for (Quadric& q : s.quadrics)
+  HeldItems held{held_items};
+  for (size_t i = 0; i < n; ++i) {
+    if (held.take(i)) continue;
+    Quadric& q = s.quadrics[i];
     for (double* x :
          {&q.a00, &q.a01, &q.a02, &q.a11, &q.a12, &q.a22, &q.b0, &q.b1, &q.b2, &q.c, &q.weight})
       *x = in.f64();
+  }
 }
 
 // The floats per point and per wedge of an energy state (one number: both are the module's
@@ -288,7 +304,7 @@ int energy_floats(const EnergyState& s) {
 }
 
 void write_point(ByteWriter& out, const EnergyState& s, size_t i, int k, bool residuals,
-                 bool as_f32, HeldPoints& held, uint32_t& previous_id) {
+                 bool as_f32, HeldItems& held, uint32_t& previous_id) {
   const EnergyState::Point& p = s.points[i];
   write_near(out, p.id, previous_id);
   if (s.positions && held.take(i)) return;  // its worker holds the rest
@@ -313,12 +329,12 @@ void write_energy(ByteWriter& out, const EnergyState& s, const std::vector<uint3
   if (!held_points.empty() && (!s.positions || held_points.back() >= s.points.size()))
     cannot_encode("held points beyond the state's");
   bool residuals = false, points_f32 = s.positions, samples_f32 = s.positions;
-  HeldPoints scan{held_points};
+  HeldItems scan{held_points};
   for (size_t i = 0; i < s.points.size(); ++i) {
     residuals |= std::bit_cast<uint64_t>(s.points[i].residual) != 0;
     points_f32 = points_f32 && (scan.take(i) || is_float(s.points[i].position));
   }
-  HeldPoints held{held_points};
+  HeldItems held{held_points};
   for (const EnergyState::CurveSample& c : s.samples)
     samples_f32 = samples_f32 && is_float(c.position);
   out.varint(s.faces.size());
@@ -385,7 +401,7 @@ void write_energy(ByteWriter& out, const EnergyState& s, const std::vector<uint3
 // A held point is its id alone: its position, distance, residual and values are left at zero
 // (its worker fills them in).
 void read_point(ByteReader& in, int k, bool residuals, bool as_f32, FaceId face, VertexId vertex,
-                HeldPoints& held, uint32_t& previous_id, EnergyState& s) {
+                HeldItems& held, uint32_t& previous_id, EnergyState& s) {
   EnergyState::Point p;
   p.id = read_near(in, kAnyId, previous_id, "point id");
   p.face = face;
@@ -407,7 +423,7 @@ void read_point(ByteReader& in, int k, bool residuals, bool as_f32, FaceId face,
 // (EnergyState::positions).
 void read_energy(ByteReader& in, const StateBounds& bounds, bool positions,
                  const std::vector<uint32_t>& held_points, EnergyState& s) {
-  HeldPoints held{held_points};
+  HeldItems held{held_points};
   in.set_context("energy state");
   read_increasing(in, read_count(in, 2, "energy faces"), bounds.faces, s.faces);
   read_increasing(in, read_count(in, 4, "energy vertices"), bounds.vertices, s.vertices);
@@ -493,24 +509,25 @@ void read_energy(ByteReader& in, const StateBounds& bounds, bool positions,
 }
 
 void write_state(ByteWriter& out, const MetricState& s,
-                 const std::vector<uint32_t>& held = kNoHeldPoints) {
+                 const std::vector<uint32_t>& held = kNoHeldItems) {
   const uint8_t code = metric_code(s.metric);
   out.u8(code);
   if ((code != 1 && !is_empty(s.quadric)) || (code != 2 && !is_empty(s.energy)))
     cannot_encode("a state holds another metric's part");
-  if (code == 1) write_quadric(out, s.quadric);
+  if (code == 1) write_quadric(out, s.quadric, held);
   if (code == 2) write_energy(out, s.energy, held);
 }
 
 // A job's state (`job`), or a returned one: without positions, and never the quadric's
 // (job_state.h, returns_state).
 void read_state(ByteReader& in, const StateBounds& bounds, bool job, MetricState& s,
-                const std::vector<uint32_t>& held = kNoHeldPoints) {
+                const std::vector<uint32_t>& held = kNoHeldItems) {
   in.set_context("state");
   s = MetricState{};
   s.metric = read_metric(in);
   if (s.metric == "quadric" && !job) in.fail("a returned quadric state (quadric jobs return none)");
-  if (s.metric == "quadric") read_quadric(in, bounds, s.quadric);
+  if (s.metric.empty() && !held.empty()) in.fail("held items for a job without a state");
+  if (s.metric == "quadric") read_quadric(in, bounds, held, s.quadric);
   if (s.metric == "energy") read_energy(in, bounds, job, held, s.energy);
 }
 
@@ -891,18 +908,18 @@ void read_summary(ByteReader& in, SubsetResult& r) {
 std::string encode_subset_job(const SubsetJob& job) {
   std::ostringstream stream;
   ByteWriter out(&stream);
-  write_job(out, job, job.state, kNoHeldPoints);
+  write_job(out, job, job.state, kNoHeldItems);
   return finish(out, stream);
 }
 
 std::string encode_subset_job(const SubsetJob& job, const MetricState& state,
-                              const std::vector<uint32_t>& held_points) {
-  if (std::adjacent_find(held_points.begin(), held_points.end(), std::greater_equal<>()) !=
-      held_points.end())
-    cannot_encode("held point indices not increasing");
+                              const std::vector<uint32_t>& held_items) {
+  if (std::adjacent_find(held_items.begin(), held_items.end(), std::greater_equal<>()) !=
+      held_items.end())
+    cannot_encode("held item indices not increasing");
   std::ostringstream stream;
   ByteWriter out(&stream);
-  write_job(out, job, state, held_points);
+  write_job(out, job, state, held_items);
   return finish(out, stream);
 }
 
@@ -926,13 +943,13 @@ std::vector<uint32_t> decode_increasing_ids(std::string_view bytes, uint64_t bou
   return ids;
 }
 
-SubsetJob decode_subset_job(std::string_view bytes, const std::vector<uint32_t>& held_points) {
-  if (std::adjacent_find(held_points.begin(), held_points.end(), std::greater_equal<>()) !=
-      held_points.end())
-    throw_invalid("subset job: held point indices not increasing");
+SubsetJob decode_subset_job(std::string_view bytes, const std::vector<uint32_t>& held_items) {
+  if (std::adjacent_find(held_items.begin(), held_items.end(), std::greater_equal<>()) !=
+      held_items.end())
+    throw_invalid("subset job: held item indices not increasing");
   ViewReader reader(bytes, "subset job");
   SubsetJob job;
-  read_job(reader.in, job, held_points);
+  read_job(reader.in, job, held_items);
   validate_subset_job(job);
   return job;
 }

@@ -9,7 +9,7 @@
 // one before it in its list, the first from 0). Every message starts with a 4-byte magic naming its
 // kind and a version byte, so that one kind is never decoded as another.
 //
-//   (The version byte is 7 for every kind; DECISIONS.md, "The job codec's versions", says
+//   (The version byte is 8 for every kind; DECISIONS.md, "The job codec's versions", says
 //   what each one added.)
 //   job     "PPJB" 4 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
@@ -25,8 +25,8 @@
 //           then all values f32, then (flag 16) per face 3 wedges near | global_wedge ids+ |
 //           owned_faces v | state | keys | deferred.
 //   state   metric u8, then the metric's part (the other part must be empty):
-//           quadric (a job's only: quadric jobs return none): n v, vertices ids+, n x 11 f64
-//           (a00 a01 a02 a11 a12 a22 b0 b1 b2 c w).
+//           quadric (a job's only: quadric jobs return none): n v, vertices ids+, per vertex
+//           but those its worker holds 11 f64 (a00 a01 a02 a11 a12 a22 b0 b1 b2 c w).
 //           energy: faces n v + ids+, vertices n v + ids+, k u8 (floats per point and per
 //           wedge, 0..9), flags u8 (1: residuals present; 2: positions present, set in a
 //           job's state and only there; 4: the points' positions as 3 f32, 8: the curve
@@ -39,8 +39,10 @@
 //           point: id near, [position 3 f64], distance_sq f64, [residual f64], [k f32 (with
 //           positions)]; its face or vertex is the one it is written under (export order);
 //           its id is near the point written before it, across faces and vertices. A point
-//           its worker holds is its id alone (their indices in the state's point order
-//           travel beside the job: encode_subset_job's held_points).
+//           its worker holds is its id alone.
+//           The items a job's worker holds (quadrics, points) are named by their indices in
+//           the state's order (its vertices', its points'), which travel beside the job:
+//           encode_subset_job's held_items.
 //   keys    n v, then per key (sorted by (a, b), a < b: edge_keys.h) a minus the previous
 //           key's a v, b - a - 1 v, cost f64 (NaN: the edge cannot be placed).
 //   deferred n v, then per edge (sorted by (a, b), a < b: simplifier.h, DeferredEdge) as a
@@ -79,17 +81,17 @@
 namespace parapm {
 
 std::string encode_subset_job(const SubsetJob& job);
-// The job with `state` in place of its own (its quadric state less the quadrics its worker
-// holds: held_state.h), and with the energy state's points at `held_points` (indices in its
-// point order, increasing: its worker holds them) as their ids alone.
+// The job with `state` in place of its own, leaving out the state's items at `held_items`
+// (indices in its order, increasing: its worker holds them): a held quadric's 11 numbers, a
+// held point's all but its id (a job's energy state, with positions, only).
 std::string encode_subset_job(const SubsetJob& job, const MetricState& state,
-                              const std::vector<uint32_t>& held_points = {});
+                              const std::vector<uint32_t>& held_items = {});
 // Also runs validate_subset_job and checks the state against the job's mesh (ids in range,
 // the attribute state E_scalar will need), so that simplify_subset can import it safely. The
-// points at `held_points` (indices in the state's point order, increasing) were encoded as
-// their ids alone: their positions, distances, residuals and values are left at zero, for the
-// caller to put back (put_back_held_points).
-SubsetJob decode_subset_job(std::string_view bytes, const std::vector<uint32_t>& held_points = {});
+// state's items at `held_items` (indices in its order, increasing) were left out: their
+// quadrics, or their points' positions, distances, residuals and values, are left at zero,
+// for the caller to put back (put_back_held_quadrics, put_back_held_points).
+SubsetJob decode_subset_job(std::string_view bytes, const std::vector<uint32_t>& held_items = {});
 
 // A list of strictly increasing ids (n v, ids+), and back: Error(kInvalidInput) "`what`: byte N
 // ..." for ids not below `bound`, trailing bytes or a short list.

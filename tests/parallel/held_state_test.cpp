@@ -1,8 +1,8 @@
 // What a worker keeps of a quadric job (held_state.h), its module's quadrics at the end, is
 // what the coordinator computes from the job and its records and what the master holds after
 // following them: its free vertices' quadrics, bit for bit, with or without a state (round 0's
-// jobs initialise their own); a state less its held quadrics, or an energy job less its held
-// points' positions, put back, is the state again.
+// jobs initialise their own); a job that leaves out the quadrics or points its worker holds,
+// put back, is the job again.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -74,39 +74,47 @@ TEST(HeldState, ARecordOfAVertexNotFreeIsRefused) {
   EXPECT_THROW(follow_records(state, {r}), Error);
 }
 
-TEST(HeldState, TakenOutAndPutBackTheStateIsTheSame) {
+// A quadric job's quadrics its worker holds travel as their vertices' ids alone, named by their
+// indices in the state's order; put back, the state is the job's again.
+TEST(HeldState, AQuadricJobLeavesOutTheQuadricsItsWorkerHolds) {
   testing::RoundZero round("stratocaster-9k.ply", SimplifyOptions{}, 2);
-  const QuadricState whole = round.jobs[0].state.quadric;
+  const SubsetJob& job = round.jobs[0];
+  const QuadricState& whole = job.state.quadric;
   ASSERT_GT(whole.vertices.size(), 10u);
-  std::vector<uint8_t> held(whole.vertices.size(), 0);
-  for (size_t i = 0; i < held.size(); i += 3) held[i] = 1;
-  QuadricState state = whole;
-  const HeldOut out = take_out_held(state, held);
-  EXPECT_EQ(out.vertices.size() + state.vertices.size(), whole.vertices.size());
+  const auto items = holdable_items(job);
+  ASSERT_EQ(items.size(), whole.vertices.size());
+  std::vector<uint32_t> held;
   std::vector<Quadric> quadrics;
-  for (size_t i = 0; i < held.size(); ++i)
-    if (held[i]) quadrics.push_back(whole.quadrics[i]);
-  EXPECT_EQ(out.fingerprint, quadrics_fingerprint(quadrics));
-  // The ids travel as the request's list.
-  EXPECT_EQ(
-      decode_increasing_ids(encode_increasing_ids(out.vertices), whole.vertices.back() + 1, "held"),
-      out.vertices);
+  std::vector<uint64_t> fingerprints;
+  for (uint32_t i = 0; i < whole.vertices.size(); i += 3) {
+    held.push_back(i);
+    quadrics.push_back(whole.quadrics[i]);
+    fingerprints.push_back(items[i].second);
+  }
+  EXPECT_EQ(fingerprints_fingerprint(fingerprints), quadrics_fingerprint(quadrics));
+  const std::string all = encode_subset_job(job);
+  const std::string bytes = encode_subset_job(job, job.state, held);
+  EXPECT_EQ(bytes.size(), all.size() - held.size() * 88);
+  // The indices travel as the request's list.
+  EXPECT_EQ(decode_increasing_ids(encode_increasing_ids(held), whole.vertices.size(), "held"),
+            held);
 
-  QuadricState doubled = state;
-  std::vector<VertexId> twice = out.vertices;
-  twice[1] = state.vertices[0];  // a vertex the state holds already
-  std::sort(twice.begin(), twice.end());
-  EXPECT_THROW(put_back_held(doubled, twice, quadrics), Error);
-  std::vector<VertexId> unsorted = out.vertices;
-  std::swap(unsorted[0], unsorted[1]);
-  QuadricState shuffled = state;
-  EXPECT_THROW(put_back_held(shuffled, unsorted, quadrics), Error);
-  EXPECT_THROW(put_back_held(shuffled, out.vertices, {}), Error);
-
-  put_back_held(state, out.vertices, quadrics);
+  SubsetJob decoded = decode_subset_job(bytes, held);
+  QuadricState& state = decoded.state.quadric;
   ASSERT_EQ(state.vertices, whole.vertices);
+  EXPECT_TRUE(same_bits(state.quadrics[held[0]], Quadric{}));
+  put_back_held_quadrics(state, held, quadrics);
   for (size_t i = 0; i < whole.quadrics.size(); ++i)
-    ASSERT_TRUE(same_bits(state.quadrics[i], whole.quadrics[i]));
+    ASSERT_TRUE(same_bits(state.quadrics[i], whole.quadrics[i])) << i;
+
+  // Indices past the quadrics, or not increasing, and lists that disagree are refused.
+  const std::vector<uint32_t> past = {uint32_t(whole.vertices.size())};
+  EXPECT_THROW(encode_subset_job(job, job.state, past), Error);
+  EXPECT_THROW(decode_subset_job(all, past), Error);
+  EXPECT_THROW(decode_subset_job(bytes, {1, 0}), Error);
+  EXPECT_THROW(decode_subset_job(bytes, {}), Error);  // the held quadrics' bytes are missing
+  EXPECT_THROW(put_back_held_quadrics(state, past, {Quadric{}}), Error);
+  EXPECT_THROW(put_back_held_quadrics(state, held, {}), Error);
 }
 
 TEST(HeldState, FingerprintsSeeEveryBit) {

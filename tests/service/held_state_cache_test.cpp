@@ -38,6 +38,9 @@ TEST(HeldStateCache, KeepsByBuildAndVertex) {
   ASSERT_TRUE(cache.find("a", {5, 9}, out));
   EXPECT_EQ(out[0].weight, 3);
   EXPECT_EQ(cache.bytes(), 4 * HeldStateCache::kQuadricBytes);
+  // A job may name no more held items than a build holds.
+  EXPECT_EQ(cache.item_bound("a"), 3u);
+  EXPECT_EQ(cache.item_bound("c"), 0u);
 }
 
 TEST(HeldStateCache, KeepsPointsById) {
@@ -76,6 +79,7 @@ TEST(HeldStateCache, KeepsPointsById) {
   EXPECT_FALSE(cache.find_points("b", {7}, 2, positions, values));
   EXPECT_FALSE(cache.find_points("a", {5}, 2, positions, values));
   EXPECT_EQ(cache.bytes(), 41 * (HeldStateCache::kPointBytes + 8));
+  EXPECT_EQ(cache.item_bound("a"), 41u);  // the ids up to the largest
   // Points beyond what the whole cache could hold are not kept.
   HeldStateCache small(100 * HeldStateCache::kPointBytes, std::chrono::minutes(10));
   state.points[2].id = 1000;
