@@ -23,9 +23,10 @@ inline bool is_sliver(const Vec3& n, const Vec3& a, const Vec3& b, const Vec3& c
 inline bool face_folds(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& q0,
                        const Vec3& q1, const Vec3& q2) {
   const Vec3 before = triangle_normal(p0, p1, p2);
-  if (is_sliver(before, p0, p1, p2)) return false;
   const Vec3 after = triangle_normal(q0, q1, q2);
-  return dot(before, after) <= 0 || is_sliver(after, q0, q1, q2);
+  // (the common case, a face that keeps its side and its area, needs no test of the face before)
+  if (!(dot(before, after) <= 0) && !is_sliver(after, q0, q1, q2)) return false;
+  return !is_sliver(before, p0, p1, p2);
 }
 
 }  // namespace parapm

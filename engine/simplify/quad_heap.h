@@ -76,22 +76,35 @@ class QuadHeap {
  private:
   void sift_down(size_t i, const T item) {
     const size_t n = items_.size();
+    T* const items = items_.data();
     for (;;) {
       const size_t first = 4 * i + 1;
-      if (first >= n) break;
-      size_t best = first;
-      const size_t end = std::min(first + 4, n);
-      // The grandchildren's blocks, one of which the next step reads: fetched while this
-      // step compares (the heap is far larger than the cache).
-      for (size_t c = first; c < end && 4 * c + 1 < n; ++c)
-        __builtin_prefetch(items_.data() + 4 * c + 1);
-      for (size_t c = first + 1; c < end; ++c)
-        if (before_(items_[c], items_[best])) best = c;
-      if (!before_(items_[best], item)) break;
-      items_[i] = items_[best];
+      size_t best;
+      if (first + 4 <= n) {
+        // The grandchildren's blocks, one of which the next step reads: fetched while this
+        // step compares (the heap is far larger than the cache).
+        if (4 * (first + 3) + 1 < n) {
+          for (size_t c = 0; c < 4; ++c) __builtin_prefetch(items + 4 * (first + c) + 1);
+        } else {
+          for (size_t c = first; c < first + 4 && 4 * c + 1 < n; ++c)
+            __builtin_prefetch(items + 4 * c + 1);
+        }
+        // The least of four in pairs; a tie goes to the earlier child, as in a scan.
+        const size_t low = before_(items[first + 1], items[first]) ? first + 1 : first;
+        const size_t high = before_(items[first + 3], items[first + 2]) ? first + 3 : first + 2;
+        best = before_(items[high], items[low]) ? high : low;
+      } else if (first < n) {
+        best = first;
+        for (size_t c = first + 1; c < n; ++c)
+          if (before_(items[c], items[best])) best = c;
+      } else {
+        break;
+      }
+      if (!before_(items[best], item)) break;
+      items[i] = items[best];
       i = best;
     }
-    items_[i] = item;
+    items[i] = item;
   }
 
   std::vector<T, ChildLineAllocator<T>> items_;

@@ -609,8 +609,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     if (!queue_.empty() && queue_.top().cost < now.cost) {
       queue_.push(now);
       ++stats_.requeued;
-      // (a cheap module costs the edge again for less than keeping its costing takes)
-      if (priority_.costly())
+      // (a seam collapse's costing also reads its other copies' stars and its parts' sizes,
+      // which requeued_outdated does not follow: it is costed again)
+      if (!candidate.seam)
         requeued_[edge_key(entry.a, entry.b)] = {collapses_, std::move(candidate)};
       continue;
     }
