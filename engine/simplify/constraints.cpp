@@ -16,6 +16,7 @@ class LockedVertices : public ConstraintModule {
  public:
   explicit LockedVertices(std::vector<uint8_t> locked) : locked_(std::move(locked)) {}
   std::string name() const override { return "locked-vertices"; }
+  bool star_local() const override { return true; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces&) const override {
     if (locked_.empty()) return true;
@@ -151,6 +152,7 @@ class BoundaryRule : public ConstraintModule {
  public:
   std::string name() const override { return "boundary"; }
   bool topological() const override { return true; }
+  bool star_local() const override { return true; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces& edge) const override {
     if (edge.left == kNoId && edge.right == kNoId) return false;  // not an edge any more
@@ -163,6 +165,7 @@ class LinkCondition : public ConstraintModule {
  public:
   std::string name() const override { return "link-condition"; }
   bool topological() const override { return true; }
+  bool star_local() const override { return true; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces& edge) const override {
     bool ok = true;
@@ -177,6 +180,7 @@ class LinkCondition : public ConstraintModule {
 class FaceGeometry : public ConstraintModule {
  public:
   std::string name() const override { return "face-geometry"; }
+  bool star_local() const override { return true; }
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces& edge) const override {
     for (VertexId moved : {c.vs, c.vt}) {

@@ -136,6 +136,10 @@ class ConstraintModule {
   // Whether the answer depends on the edge {vs, vt} only: not on which end survives nor on
   // the placement. Such a rule can veto an edge before any costing.
   virtual bool topological() const { return false; }
+  // Whether the answer depends only on the candidate and on the faces around its ends and
+  // their corners' positions, which stay as they are while no collapse changes the edge's star
+  // (Simplifier: a requeued candidate kept with its star unchanged is not asked again).
+  virtual bool star_local() const { return false; }
   // For a seam collapse (Simplifier::join_copies): removes from `collapses` those this rule
   // would veto once the ones before them were made because their part is at its smallest form
   // (the component minimum); such a copy stays where it is. A rule that vetoes for other

@@ -12,7 +12,9 @@ namespace parapm {
 
 Simplifier::Simplifier(CollapseMesh& mesh, PriorityModule& priority,
                        std::vector<std::unique_ptr<ConstraintModule>> constraints)
-    : mesh_(mesh), priority_(priority), constraints_(std::move(constraints)) {}
+    : mesh_(mesh), priority_(priority), constraints_(std::move(constraints)) {
+  queue_.drop_when([this](const Entry& e) { return is_stale(e); });
+}
 
 void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
                                     const CancelToken* cancel) {
@@ -179,10 +181,12 @@ bool Simplifier::take_requeued(const Entry& entry, CollapseCandidate& out) {
 }
 
 bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
-                       bool topology_checked) const {
-  for (const auto& module : constraints_)
-    if (!(topology_checked && module->topological()) && !module->allows(mesh_, candidate, edge))
-      return false;
+                       bool topology_checked, bool star_checked) const {
+  for (const auto& module : constraints_) {
+    if ((topology_checked && module->topological()) || (star_checked && module->star_local()))
+      continue;
+    if (!module->allows(mesh_, candidate, edge)) return false;
+  }
   return true;
 }
 
@@ -562,7 +566,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     CollapseCandidate candidate;
     // (topological rules are symmetric in the edge's ends: once passed, they hold for vs, vt)
     bool topology_checked = false;
-    if (!take_requeued(entry, candidate)) {
+    // (a kept requeued candidate passed every rule when it was requeued, its star as it is now)
+    const bool star_checked = take_requeued(entry, candidate);
+    if (!star_checked) {
       // Its ends unchanged, a neighbour's collapse may still have broken its link: then no
       // costing (with a costly module).
       topology_checked = screen_;
@@ -590,7 +596,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.over_ceiling;
       continue;
     }
-    if (!legal(candidate, edge, topology_checked)) {
+    if (!legal(candidate, edge, topology_checked, star_checked)) {
       ++stats_.rejected;
       reject(entry.a, entry.b);
       continue;

@@ -141,6 +141,9 @@ class Simplifier {
  public:
   Simplifier(CollapseMesh& mesh, PriorityModule& priority,
              std::vector<std::unique_ptr<ConstraintModule>> constraints);
+  // (its queue asks it which entries are stale: it stays where it was made)
+  Simplifier(const Simplifier&) = delete;
+  Simplifier& operator=(const Simplifier&) = delete;
 
   // Runs until the target is reached or no legal collapse is left. Calls progress every few
   // hundred collapses and polls `cancel` (may be null); on cancellation throws and leaves the
@@ -233,9 +236,11 @@ class Simplifier {
            version_[entry.a] + version_[entry.b] != (entry.stamp & kVersions);
   }
   void compact_queue();
-  // All constraints; with topology_checked, those that are not topological().
+  // All constraints; with topology_checked, those that are not topological(); with
+  // star_checked (a kept requeued candidate, which passed them all, its star unchanged since),
+  // those that are not star_local().
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
-             bool topology_checked = false) const;
+             bool topology_checked = false, bool star_checked = false) const;
   CollapseRecord perform(CollapseCandidate candidate, const EdgeFaces& edge);
   // After a collapse with survivor vs: the versions and star marks, the vetoed edges around
   // the changed star retried, the edges around vs queued again.

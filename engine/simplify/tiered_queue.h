@@ -6,13 +6,16 @@
 // sixteenth staying open). The heap stays small enough for the cache, and an item pushed far
 // above the water level costs an append instead of a sift through millions. Items come out
 // in exactly the order one heap of them all would give (the `Before` order), as every item
-// in a range or the open bucket has a larger key than every item in the heap.
+// in a range or the open bucket has a larger key than every item in the heap. Items that died
+// while they waited in a range (drop_when) are dropped as it moves into the heap, instead of
+// each sifted out of it.
 //
 // T has a float `cost`, its key, which Before orders first; NaN keys are not allowed.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -24,6 +27,10 @@ template <typename T, typename Before>
 class TieredQueue {
  public:
   static constexpr size_t kMinBatch = 4096;  // an open bucket this small goes to the heap whole
+
+  // Items for which `dead` holds are dropped as a range moves into the heap: they would
+  // come out only to be skipped (the collapse queue's stale entries).
+  void drop_when(std::function<bool(const T&)> dead) { dead_ = std::move(dead); }
 
   bool empty() const { return size() == 0; }
   size_t size() const { return heap_.size() + bucketed_; }
@@ -110,6 +117,7 @@ class TieredQueue {
       Items& range = ranges_[next_];
       threshold_ = bounds_[next_++];
       bucketed_ -= range.size();
+      if (dead_) std::erase_if(range, dead_);
       heap_.items().swap(range);
       heap_.rebuild();
       range = Items();
@@ -130,7 +138,9 @@ class TieredQueue {
     next_ = 0;
     if (count <= kMinBatch) {
       auto& items = heap_.items();
-      for (const Items& block : blocks) items.insert(items.end(), block.begin(), block.end());
+      for (const Items& block : blocks)
+        for (const T& item : block)
+          if (!(dead_ && dead_(item))) items.push_back(item);
       heap_.rebuild();
       bucketed_ -= count;
       threshold_ = std::numeric_limits<float>::infinity();
@@ -178,6 +188,7 @@ class TieredQueue {
   size_t next_ = 0;            // the first range not yet moved to the heap
   size_t bucketed_ = 0;        // the items in ranges and the open bucket
   std::vector<float> sample_;  // cut_open's working memory
+  std::function<bool(const T&)> dead_;
 };
 
 }  // namespace parapm

@@ -1,5 +1,5 @@
 // The collapse queue's tiers against one heap of the same items: the same order out, through
-// pushes between pops, keys tied, infinite and far apart, and removals.
+// pushes between pops, keys tied, infinite and far apart, removals, and items that die.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -111,6 +111,54 @@ TEST(TieredQueue, RemovesWhatItIsToldAndKeepsTheOrder) {
   EXPECT_TRUE(tiered.empty());
   tiered.push({2.0f, 2, 2});
   EXPECT_EQ(tiered.pop().a, 2u);
+}
+
+// Items that die after they were pushed (a collapse queue's stale entries) and are dropped as
+// their range reaches the heap: the live ones come out as one heap, skipping the dead, gives them.
+TEST(TieredQueue, DropsDeadItemsAndKeepsTheOrderOfTheLiveOnes) {
+  std::mt19937 random(11);
+  std::vector<uint8_t> dead;
+  TieredQueue<Item, ItemBefore> tiered;
+  tiered.drop_when([&](const Item& item) { return dead[item.b] != 0; });
+  QuadHeap<Item, ItemBefore> heap;
+  auto push = [&](float level) {
+    const Item item{draw_key(random, level), uint32_t(random() % 100000), uint32_t(dead.size())};
+    dead.push_back(0);
+    tiered.push(item);
+    heap.push(item);
+  };
+  size_t dead_from_heap = 0, dead_from_tiers = 0;  // dead items that came out to be skipped
+  auto next_live = [&]() -> Item {
+    for (;;) {
+      const Item out = heap.pop();
+      if (!dead[out.b]) return out;
+      ++dead_from_heap;
+    }
+  };
+  for (int i = 0; i < 60000; ++i) push(0.0f);
+  size_t popped = 0, live_left = 60000;
+  float level = 0;
+  while (live_left > 0) {
+    // The tiered queue may still hold dead items; it gives no live one out of order.
+    Item out = tiered.pop();
+    for (; dead[out.b]; out = tiered.pop()) ++dead_from_tiers;
+    ASSERT_TRUE(same(out, next_live())) << "item " << popped;
+    dead[out.b] = 1;  // out of the queue: any copy left is stale
+    --live_left;
+    ++popped;
+    if (std::isfinite(out.cost)) level = out.cost;
+    if (popped < 100000 && popped % 2 == 0) {
+      // A collapse: some queued items die, new ones come.
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t victim = uint32_t(random() % dead.size());
+        live_left -= !dead[victim];
+        dead[victim] = 1;
+      }
+      for (int k = 0; k < 3; ++k, ++live_left) push(level);
+    }
+  }
+  EXPECT_GT(popped, 50000u);
+  EXPECT_LT(dead_from_tiers, dead_from_heap / 2);  // most were dropped on the way
 }
 
 }  // namespace
