@@ -41,7 +41,7 @@ struct Flight {
   size_t index = 0;
   WorkerSlot slot;  // worker_id empty: in-process
   uint32_t attempt = 1;
-  // Set when the request made for the job leaves out quadrics another worker holds: this
+  // Set when the request made for the job leaves out state another worker holds: this
   // flight sends the job whole, encoded on its own thread.
   std::optional<parapm::v1::SubsetRequest> whole;
   uint64_t job_bytes = 0;   // what the call sent
@@ -135,14 +135,6 @@ std::vector<std::pair<uint32_t, uint64_t>> kept_fingerprints(QuadricState quadri
   for (size_t i = 0; i < kept.size(); ++i)
     kept[i] = {quadrics.vertices[i], quadric_fingerprint(quadrics.quadrics[i])};
   return kept;
-}
-
-// The items of the job's state that a worker may hold (holdable_items), counted.
-size_t holdable_count(const SubsetJob& job) {
-  if (job.state.metric == "quadric") return job.state.quadric.vertices.size();
-  if (job.state.metric == "energy" && job.state.energy.positions)
-    return job.state.energy.points.size();
-  return 0;
 }
 
 }  // namespace
@@ -385,7 +377,7 @@ class RemoteRunner::Dispatch {
         transport.result_bytes += f.result_bytes;
         ++transport.calls;
         transport.held_items += f.held_items;
-        transport.sent_items += holdable_count(job) - f.held_items;
+        transport.sent_items += items_[f.index].size() - f.held_items;
       }
       if (!f.kept.empty()) runner_.held_.record(f.slot.worker_id, f.kept);
       event(SubsetEvent::Kind::kDone, f);
@@ -425,7 +417,7 @@ class RemoteRunner::Dispatch {
     pending_.push_front(f.index);
   }
 
-  // The first waiting subset whose quadrics' holder can take it now, launched there.
+  // The first waiting subset whose held state's holder can take it now, launched there.
   bool dispatch_to_holders() {
     WorkerRegistry& registry = runner_.registry_;
     const bool queue_ahead = pending_.size() > registry.live_slots();
@@ -441,7 +433,7 @@ class RemoteRunner::Dispatch {
     return false;
   }
 
-  // Launches what waits on the free workers: first each on the worker holding its quadrics,
+  // Launches what waits on the free workers: first each on the worker holding its state,
   // then on any (another than the one it failed on, where possible), or in-process when no
   // worker is registered and the options allow it.
   void dispatch_pending() {
@@ -498,7 +490,7 @@ class RemoteRunner::Dispatch {
   std::deque<size_t> pending_;            // subsets waiting for a worker, retries first
   std::vector<uint32_t> attempts_;        // per subset
   std::vector<std::string> last_worker_;  // per subset: the worker it last failed on
-  // Per subset: the worker its request was made for (it leaves out the quadrics that worker
+  // Per subset: the worker its request was made for (it leaves out the state that worker
   // holds); empty: none, or that worker lost them (the job goes whole).
   std::vector<std::string> holder_;
   std::vector<uint64_t> held_count_;  // per subset: the items its request leaves out

@@ -79,9 +79,10 @@ grpc::Status not_held(size_t items) {
 grpc::Status SubsetService::restore_held_state(const parapm::v1::SubsetRequest& request,
                                                const std::vector<uint32_t>& held, SubsetJob& job) {
   if (held.empty()) return grpc::Status::OK;
+  // (the caller checked the build key; the decoder the indices against the state, and the
+  // quadric state's vertices against the job)
   const std::string& build = request.build_key();
-  if (!build.empty() && job.state.metric == "quadric") {
-    // (the decoder checked the indices against the state, and the state's vertices against the job)
+  if (job.state.metric == "quadric") {
     const QuadricState& state = job.state.quadric;
     std::vector<VertexId> global(held.size());
     for (size_t i = 0; i < held.size(); ++i) global[i] = job.global_vertex[state.vertices[held[i]]];
@@ -92,28 +93,20 @@ grpc::Status SubsetService::restore_held_state(const parapm::v1::SubsetRequest& 
     put_back_held_quadrics(job.state.quadric, held, quadrics);
     return grpc::Status::OK;
   }
-  if (!build.empty() && job.state.metric == "energy" && job.state.energy.positions) {
-    EnergyState& state = job.state.energy;
-    const size_t k = state.points.empty() ? 0 : state.point_values.size() / state.points.size();
-    std::vector<uint32_t> ids(held.size());
-    for (size_t i = 0; i < held.size(); ++i) {
-      if (held[i] >= state.points.size())
-        return {grpc::StatusCode::INVALID_ARGUMENT, "held point past the job's points"};
-      ids[i] = state.points[held[i]].id;
-    }
-    std::vector<HeldPoint> points;
-    std::vector<float> values;
-    if (!held_.find_points(build, ids, k, points, values)) return not_held(held.size());
-    std::vector<uint64_t> fingerprints(held.size());
-    for (size_t i = 0; i < held.size(); ++i)
-      fingerprints[i] = point_fingerprint(points[i], values.data() + i * k, k);
-    if (fingerprints_fingerprint(fingerprints) != request.held_fingerprint())
-      return not_held(held.size());
-    put_back_held_points(state, held, points, values);
-    return grpc::Status::OK;
-  }
-  return {grpc::StatusCode::INVALID_ARGUMENT,
-          "held state named for a job without a state to hold"};
+  EnergyState& state = job.state.energy;  // (with positions: only then does a job hold points)
+  const size_t k = state.points.empty() ? 0 : state.point_values.size() / state.points.size();
+  std::vector<uint32_t> ids(held.size());
+  for (size_t i = 0; i < held.size(); ++i) ids[i] = state.points[held[i]].id;
+  std::vector<HeldPoint> points;
+  std::vector<float> values;
+  if (!held_.find_points(build, ids, k, points, values)) return not_held(held.size());
+  std::vector<uint64_t> fingerprints(held.size());
+  for (size_t i = 0; i < held.size(); ++i)
+    fingerprints[i] = point_fingerprint(points[i], values.data() + i * k, k);
+  if (fingerprints_fingerprint(fingerprints) != request.held_fingerprint())
+    return not_held(held.size());
+  put_back_held_points(state, held, points, values);
+  return grpc::Status::OK;
 }
 
 void SubsetService::record_outcome(const grpc::Status& status, double seconds,
