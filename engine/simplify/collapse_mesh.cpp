@@ -1,6 +1,7 @@
 #include "simplify/collapse_mesh.h"
 
 #include <algorithm>
+#include <atomic>
 
 #include "util/error.h"
 
@@ -21,6 +22,8 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
   vertex_alive_.assign(mesh.positions.size(), 0);
   faces_of_.resize(mesh.positions.size());
   boundary_.assign(mesh.positions.size(), 0);
+  star_version_.assign(mesh.positions.size(), 0);
+  identity_ = Identity();
   live_faces_ = mesh.faces.size();
   mark_.assign(mesh.positions.size(), 0);
   // Each range of vertices lists its own corners' faces, in face order whatever the chunking.
@@ -45,6 +48,22 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
 
 EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
   EdgeFaces result;
+  if (faces_of_[b].size() < faces_of_[a].size()) {  // (a fan's hub holds hundreds)
+    for (FaceId f : faces_of_[b]) {
+      const Triangle& t = faces_[f];
+      const int i = corner_of(t, b);
+      const VertexId next = t[(i + 1) % 3];
+      const VertexId prev = t[(i + 2) % 3];
+      if (prev == a) {
+        result.left = f;
+        result.left_apex = next;
+      } else if (next == a) {
+        result.right = f;
+        result.right_apex = prev;
+      }
+    }
+    return result;
+  }
   for (FaceId f : faces_of_[a]) {
     const Triangle& t = faces_[f];
     const int i = corner_of(t, a);
@@ -173,6 +192,18 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
   // A legal collapse changes the boundary status of vs and of the apexes only.
   for (VertexId v : {vs, removed.left_apex, removed.right_apex})
     if (v != kNoId) boundary_[v] = !faces_of_[v].empty() && compute_boundary(v);
+  // Every vertex whose star lost a face or holds vs: vs, vt, the apexes (an apex may keep no
+  // face with vs) and the corners of vs's faces.
+  for (VertexId v : {vs, vt, removed.left_apex, removed.right_apex})
+    if (v != kNoId) ++star_version_[v];
+  for (FaceId f : faces_of_[vs])
+    for (VertexId v : faces_[f])
+      if (v != vs) ++star_version_[v];
+}
+
+uint64_t CollapseMesh::Identity::next() {
+  static std::atomic<uint64_t> drawn{0};
+  return ++drawn;
 }
 
 uint32_t connected_components(const CollapseMesh& mesh, std::vector<uint32_t>& component) {

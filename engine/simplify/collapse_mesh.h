@@ -7,7 +7,7 @@
 // ids for the whole run; a collapsed face is marked dead.
 //
 // Preconditions: the mesh is an oriented 2-manifold with boundary (repair_mesh output).
-// Memory: about 60 bytes per vertex plus 32 bytes per face beyond the input mesh.
+// Memory: about 64 bytes per vertex plus 32 bytes per face beyond the input mesh.
 #pragma once
 
 #include <array>
@@ -46,6 +46,12 @@ class CollapseMesh {
   const Vec3& position(VertexId v) const { return positions_[v]; }
   const std::vector<Vec3>& positions() const { return positions_; }  // removed ones included
   bool is_boundary(VertexId v) const { return boundary_[v]; }
+  // Changes whenever a collapse changes v's star (its faces, or where their corners are): sums
+  // over a star kept with it are current while it reads the same.
+  uint32_t star_version(VertexId v) const { return star_version_[v]; }
+  // A number no other mesh shares (a copy or a new build draws its own): says which mesh a
+  // kept star sum is of.
+  uint64_t identity() const { return identity_.value; }
 
   EdgeFaces edge_faces(VertexId a, VertexId b) const;
   // For every corner slot 3 f + k of a live face f, the face across its edge t[k] -> t[k + 1]
@@ -80,6 +86,8 @@ class CollapseMesh {
   struct RemovedCounts {
     size_t faces = 0, vertices = 0;
   };
+  // The star versions it changes are those of vs, vt, the apexes and vs's neighbours: all
+  // owned by the collapse's subset under the subset rule, so concurrent collapses share none.
   void collapse(VertexId vs, VertexId vt, const Vec3& position, const EdgeFaces& edge,
                 RemovedCounts* removed = nullptr);
   void count_removed(const RemovedCounts& removed);
@@ -97,6 +105,18 @@ class CollapseMesh {
   std::vector<uint8_t> vertex_alive_;  // a byte per vertex: the queue checks it on every pop
   std::vector<std::vector<FaceId>> faces_of_;
   std::vector<uint8_t> boundary_;
+  std::vector<uint32_t> star_version_;
+  // Drawn anew by every construction, copy and assignment.
+  struct Identity {
+    uint64_t value = next();
+    Identity() = default;
+    Identity(const Identity&) : value(next()) {}
+    Identity& operator=(const Identity&) {
+      value = next();
+      return *this;
+    }
+    static uint64_t next();
+  } identity_;
   size_t live_faces_ = 0;
   size_t live_vertices_ = 0;
   // Scratch marks for neighbourhood queries (instead of sorting): a vertex is marked when

@@ -184,6 +184,7 @@ class FaceGeometry : public ConstraintModule {
   bool allows(const CollapseMesh& mesh, const CollapseCandidate& c,
               const EdgeFaces& edge) const override {
     for (VertexId moved : {c.vs, c.vt}) {
+      if (c.position == mesh.position(moved)) continue;  // its faces stay as they are
       for (FaceId f : mesh.faces_of(moved)) {
         if (f == edge.left || f == edge.right) continue;
         const Triangle& t = mesh.face(f);

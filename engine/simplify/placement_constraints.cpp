@@ -76,8 +76,107 @@ bool PlacementConstraints::minimize(const Quadric& q, Vec3& out) const {
   return std::isfinite(out[0]) && std::isfinite(out[1]) && std::isfinite(out[2]);
 }
 
+namespace {
+
+// An end with this many faces has its star summed apart from the other end's, and kept.
+constexpr size_t kManyFaces = 16;
+constexpr size_t kKeptStars = 1024;  // slots of StarTermsScratch::kept
+
+using VertexStar = StarTermsScratch::VertexStar;
+
+// Adds face (end, p1, p2)'s terms to `sums`.
+void add_face(const Vec3& end, const Vec3& p1, const Vec3& p2, bool planes, VertexStar& sums) {
+  const Vec3 c = cross(sub(p1, end), sub(p2, end));
+  sums.cross = add(sums.cross, c);
+  sums.turn = add(sums.turn, sub(p2, p1));
+  if (!planes) return;
+  const double twice_area = length(c);
+  if (!(twice_area > 0)) return;
+  const Vec3 unit = scale(c, 1 / twice_area);
+  sums.planes += Quadric::from_plane(unit, -dot(unit, end), 0.5 * twice_area);
+}
+
+// The sums over every face around v, in the order of their corners' positions.
+VertexStar sum_vertex_star(const CollapseMesh& mesh, VertexId v, bool planes,
+                           StarTermsScratch& scratch) {
+  auto& terms = scratch.faces;
+  terms.clear();
+  const Vec3& end = mesh.position(v);
+  for (const FaceId f : mesh.faces_of(v)) {
+    const Triangle& t = mesh.face(f);
+    const int k = corner_of(t, v);
+    terms.push_back({mesh.position(t[(k + 1) % 3]), mesh.position(t[(k + 2) % 3]), end, false});
+  }
+  auto& order = scratch.order;
+  order.resize(terms.size());
+  for (uint32_t i = 0; i < terms.size(); ++i) order[i] = {terms[i].p1[0], i};
+  std::sort(order.begin(), order.end(), [&](const auto& x, const auto& y) {
+    if (x.first != y.first) return x.first < y.first;
+    const StarTermsScratch::FaceTerm &s = terms[x.second], &t = terms[y.second];
+    return s.p1 != t.p1 ? s.p1 < t.p1 : s.p2 < t.p2;
+  });
+  VertexStar sums;
+  for (const auto& [first, i] : order) add_face(end, terms[i].p1, terms[i].p2, planes, sums);
+  return sums;
+}
+
+// sum_vertex_star's, from the scratch's kept sums while v's star version holds.
+VertexStar vertex_star(const CollapseMesh& mesh, VertexId v, bool planes,
+                       StarTermsScratch& scratch) {
+  if (mesh.faces_of(v).size() < kManyFaces) return sum_vertex_star(mesh, v, planes, scratch);
+  if (scratch.kept.empty()) scratch.kept.resize(kKeptStars);
+  StarTermsScratch::KeptStar& slot = scratch.kept[v % kKeptStars];
+  if (slot.mesh != mesh.identity() || slot.v != v || slot.version != mesh.star_version(v) ||
+      (planes && !slot.planes))
+    slot = {mesh.identity(), v, mesh.star_version(v), planes,
+            sum_vertex_star(mesh, v, planes, scratch)};
+  return slot.sums;
+}
+
+// An edge's sums from its end `end`: end's star's less the edge's faces, with g and h taken
+// about `origin`. Each side depends on its own end's star alone, so a + b sums as b + a.
+void add_side(const CollapseMesh& mesh, VertexId end, const EdgeFaces& edge, const Vec3& origin,
+              bool with_planes, StarTermsScratch& scratch, Vec3& g, double& h, Quadric& planes) {
+  VertexStar sums = vertex_star(mesh, end, with_planes, scratch);
+  VertexStar gone;  // (at most two faces: their sum is the same in either order)
+  const Vec3& p = mesh.position(end);
+  for (const FaceId f : {edge.left, edge.right}) {
+    if (f == kNoId) continue;
+    const Triangle& t = mesh.face(f);
+    const int k = corner_of(t, end);
+    add_face(p, mesh.position(t[(k + 1) % 3]), mesh.position(t[(k + 2) % 3]), with_planes, gone);
+  }
+  sums.cross = sub(sums.cross, gone.cross);
+  sums.turn = sub(sums.turn, gone.turn);
+  sums.planes -= gone.planes;
+  // With d = end - origin, a face's (p1 - origin) x (p2 - origin) is (p1 - end) x (p2 - end)
+  // + d x (p2 - p1), and d . that is d . ((p1 - end) x (p2 - end)).
+  const Vec3 d = sub(p, origin);
+  g = add(sums.cross, cross(d, sums.turn));
+  h = dot(d, sums.cross);
+  planes = sums.planes;
+}
+
+}  // namespace
+
 void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& origin,
                  StarTermsScratch& scratch, Vec3& g, double& h, Quadric* planes) {
+  if (std::max(mesh.faces_of(a).size(), mesh.faces_of(b).size()) >= kManyFaces) {
+    // A face holding both ends adds nothing to h (origin lies on the edge) and vanishes.
+    Vec3 ga, gb;
+    double ha, hb;
+    Quadric qa, qb;
+    const EdgeFaces edge = mesh.edge_faces(a, b);
+    add_side(mesh, a, edge, origin, planes != nullptr, scratch, ga, ha, qa);
+    add_side(mesh, b, edge, origin, planes != nullptr, scratch, gb, hb, qb);
+    g = add(ga, gb);
+    h = ha + hb;
+    if (planes) {
+      qa += qb;
+      *planes += qa;
+    }
+    return;
+  }
   // A face holding both ends is summed once, from the end whose position comes first.
   auto& terms = scratch.faces;
   terms.clear();

@@ -53,6 +53,23 @@ struct StarTermsScratch {
   // faster than a term; ties on p1[0] are broken by the terms).
   std::vector<std::pair<double, uint32_t>> order;
   std::vector<std::pair<VertexId, VertexId>> border;  // directed as their faces hold them
+  // Sums over the faces around one vertex v, each face (v, p1, p2) as its corners follow v:
+  // cross = sum of (p1 - v) x (p2 - v), turn = sum of p2 - p1, planes = the faces' planes
+  // weighted by area (when asked for).
+  struct VertexStar {
+    Vec3 cross{}, turn{};
+    Quadric planes;
+  };
+  // The sums of vertices of many faces (a fan's hub in a CAD part: hundreds), direct-mapped by
+  // vertex id and kept while the vertex's star version stays.
+  struct KeptStar {
+    uint64_t mesh = 0;  // CollapseMesh::identity; 0: empty
+    VertexId v = kNoId;
+    uint32_t version = 0;
+    bool planes = false;
+    VertexStar sums;
+  };
+  std::vector<KeptStar> kept;
 };
 
 // The volume equation of collapsing {a, b}: g.(v - origin) = h, six times the volume the star's

@@ -44,6 +44,13 @@ struct Quadric {
     weight += q.weight;
     return *this;
   }
+  Quadric& operator-=(const Quadric& q) {
+    a00 -= q.a00, a01 -= q.a01, a02 -= q.a02, a11 -= q.a11, a12 -= q.a12, a22 -= q.a22;
+    b0 -= q.b0, b1 -= q.b1, b2 -= q.b2;
+    c -= q.c;
+    weight -= q.weight;
+    return *this;
+  }
   Quadric& operator*=(double s);
   double evaluate(const Vec3& p) const {
     const double x = p[0], y = p[1], z = p[2];

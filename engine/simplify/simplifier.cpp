@@ -153,7 +153,7 @@ void Simplifier::compact_queue() {
 
 void Simplifier::forget_outdated_requeued() {
   std::erase_if(requeued_, [this](const auto& record) {
-    return requeued_outdated(record.first, record.second.first);
+    return requeued_outdated(record.first, record.second);
   });
 }
 
@@ -171,9 +171,9 @@ bool Simplifier::take_requeued(const Entry& entry, CollapseCandidate& out) {
   if (!(entry.stamp & kRequeued)) return false;
   const auto it = requeued_.find(edge_key(entry.a, entry.b));
   if (it == requeued_.end()) return false;
-  const bool unchanged = !requeued_outdated(it->first, it->second.first);
+  const bool unchanged = !requeued_outdated(it->first, it->second);
   if (unchanged) {
-    out = std::move(it->second.second);
+    out = std::move(it->second.candidate);
     ++stats_.requeue_reused;
   }
   requeued_.erase(it);
@@ -226,9 +226,6 @@ CollapseRecord Simplifier::perform(CollapseCandidate c, const EdgeFaces& edge) {
 void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits& limits) {
   ++version_[vs];
   mesh_.neighbors(vs, ring_);
-  ++collapses_;
-  star_changed_at_[vs] = star_changed_at_[vt] = collapses_;
-  for (VertexId n : ring_) star_changed_at_[n] = collapses_;
   // Edges vetoed earlier around the changed star may be legal now: cost them again, after
   // the edges of vs. All are taken off the lists first: a push may veto its edge again, onto
   // the lists (screening).
@@ -462,8 +459,6 @@ void Simplifier::begin_run(const SimplifierLimits& limits) {
   priority_.initialize(mesh_);
   for (const auto& module : constraints_) module->initialize(mesh_);
   version_.assign_zeroed(mesh_.vertex_capacity());
-  star_changed_at_.assign_zeroed(mesh_.vertex_capacity());
-  collapses_ = 0;
   requeued_.clear();
   rejected_slot_.assign_zeroed(mesh_.vertex_capacity());
   rejected_lists_.clear();
@@ -618,7 +613,8 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       // (a seam collapse's costing also reads its other copies' stars and its parts' sizes,
       // which requeued_outdated does not follow: it is costed again)
       if (!candidate.seam)
-        requeued_[edge_key(entry.a, entry.b)] = {collapses_, std::move(candidate)};
+        requeued_[edge_key(entry.a, entry.b)] = {mesh_.star_version(entry.a),
+                                                 mesh_.star_version(entry.b), std::move(candidate)};
       continue;
     }
     if (candidate.seam) {

@@ -242,8 +242,8 @@ class Simplifier {
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
              bool topology_checked = false, bool star_checked = false) const;
   CollapseRecord perform(CollapseCandidate candidate, const EdgeFaces& edge);
-  // After a collapse with survivor vs: the versions and star marks, the vetoed edges around
-  // the changed star retried, the edges around vs queued again.
+  // After a collapse with survivor vs: its version bumped, the vetoed edges around the changed
+  // star retried, the edges around vs queued again.
   void requeue_around(VertexId vs, VertexId vt, const SimplifierLimits& limits);
   // The module's costing of edge {a, b}, or the seam collapse's between their groups.
   bool cost_edge(VertexId a, VertexId b, CollapseCandidate& out, Costing costing);
@@ -288,23 +288,24 @@ class Simplifier {
   std::vector<VertexId>* rejected_list(VertexId v) {
     return rejected_slot_[v] ? &rejected_lists_[rejected_slot_[v] - 1] : nullptr;
   }
-  // Requeued edges' costings, kept while no collapse changes the edge's star (a collapse
-  // changes the faces around vs, vt and the neighbours of vs): the edge needs no new costing
-  // when it comes out again.
+  // Requeued edges' costings, kept while neither end's star version changes (no collapse
+  // changed the edge's star): the edge needs no new costing when it comes out again.
   static uint64_t edge_key(VertexId a, VertexId b) { return uint64_t(a) << 32 | b; }
   bool take_requeued(const Entry& entry, CollapseCandidate& out);
+  struct KeptCosting {
+    uint32_t star_version_a, star_version_b;  // the ends' (a < b) when it was costed
+    CollapseCandidate candidate;
+  };
   // Whether a requeued costing is of no more use: the edge's star changed after it.
-  bool requeued_outdated(uint64_t key, uint32_t costed_at) const {
-    return star_changed_at_[VertexId(key >> 32)] > costed_at ||
-           star_changed_at_[VertexId(key & 0xffffffffu)] > costed_at;
+  bool requeued_outdated(uint64_t key, const KeptCosting& kept) const {
+    return mesh_.star_version(VertexId(key >> 32)) != kept.star_version_a ||
+           mesh_.star_version(VertexId(key & 0xffffffffu)) != kept.star_version_b;
   }
   void forget_outdated_requeued();
-  std::unordered_map<uint64_t, std::pair<uint32_t, CollapseCandidate>> requeued_;
-  ZeroedArray<uint32_t> star_changed_at_;  // per vertex: collapses_ when its star last changed
-  bool defer_ = false;                     // costly() and a limit below SIZE_MAX
+  std::unordered_map<uint64_t, KeptCosting> requeued_;
+  bool defer_ = false;  // costly() and a limit below SIZE_MAX
   // 3 per face: the key of the edge from corner k; NaN: none yet, infinite: refused
   std::vector<float> face_keys_;
-  uint32_t collapses_ = 0;
   const CopyGroups* groups_ = nullptr;
   std::vector<SeamPair> seam_pairs_;
   std::vector<Vec3> seam_places_;
