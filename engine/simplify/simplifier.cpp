@@ -129,6 +129,15 @@ void Simplifier::retry_edge(VertexId a, VertexId b) {
   push_edge(a, b);
 }
 
+bool Simplifier::seam_already_queued(VertexId a, VertexId b) {
+  if (!queueing_seams_ || !groups_->is_copy(a) || !groups_->is_copy(b)) return false;
+  const std::pair<uint32_t, uint32_t> pair = std::minmax(groups_->group[a], groups_->group[b]);
+  if (std::find(queued_seams_.begin(), queued_seams_.end(), pair) != queued_seams_.end())
+    return true;
+  queued_seams_.push_back(pair);
+  return false;
+}
+
 void Simplifier::reject(VertexId a, VertexId b) {
   remember_rejected(a, b);
   remember_rejected(b, a);
@@ -246,7 +255,7 @@ void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits
   }
   const bool defer = defer_ && mesh_.live_faces() > limits.defer_above_faces;
   for (VertexId n : ring_)
-    if (!(defer && defer_edge(vs, n))) push_edge(vs, n);
+    if (!seam_already_queued(vs, n) && !(defer && defer_edge(vs, n))) push_edge(vs, n);
   for (const auto& [n, other] : retry_) retry_edge(n, other);
 }
 
@@ -432,23 +441,29 @@ bool Simplifier::perform_seam(const CollapseCandidate& seam, const SimplifierLim
     return false;
   }
 
-  for (size_t i = 0; i < pairs.size(); ++i) {
+  size_t done = 0;
+  for (; done < pairs.size(); ++done) {
     // Costed on the mesh the earlier collapses left (the records' errors), checked again.
     CollapseCandidate c;
     ++stats_.evaluations;
-    const bool placed =
-        priority_.evaluate_seam(mesh_, pairs[i].vs, pairs[i].vt, &place, c, Costing::kPerform);
+    const bool placed = priority_.evaluate_seam(mesh_, pairs[done].vs, pairs[done].vt, &place, c,
+                                                Costing::kPerform);
     c.seam = true;
     c.cost = seam.cost;  // the records of one seam collapse stay together when merged by cost
-    const EdgeFaces edge = mesh_.edge_faces(pairs[i].vs, pairs[i].vt);
+    const EdgeFaces edge = mesh_.edge_faces(pairs[done].vs, pairs[done].vt);
     if (!placed || !legal(c, edge)) {
-      if (i == 0) return false;
+      if (done == 0) return false;
       ++stats_.seams_split;
       break;
     }
     records.push_back(perform(c, edge));
-    requeue_around(c.vs, c.vt, limits);
   }
+  // The edges around the survivors costed on the mesh the whole seam collapse left, a seam
+  // between two groups once (its costing reads the groups, not the copy it is queued on).
+  queued_seams_.clear();
+  queueing_seams_ = true;
+  for (size_t i = 0; i < done; ++i) requeue_around(pairs[i].vs, pairs[i].vt, limits);
+  queueing_seams_ = false;
   ++stats_.seam_collapses;
   stats_.seams_in_turn += in_turn;
   return true;

@@ -309,6 +309,10 @@ class Simplifier {
   const CopyGroups* groups_ = nullptr;
   std::vector<SeamPair> seam_pairs_;
   std::vector<Vec3> seam_places_;
+  // While a seam collapse requeues around its survivors: the group pairs queued so far.
+  bool seam_already_queued(VertexId a, VertexId b);
+  bool queueing_seams_ = false;
+  std::vector<std::pair<uint32_t, uint32_t>> queued_seams_;
   std::vector<CollapseCandidate> seam_planned_;
   std::vector<uint32_t> seam_mark_;  // per vertex: the pair whose ring holds it (rings_apart)
   std::vector<FaceId> seam_faces_;
