@@ -97,7 +97,7 @@ TEST(StarSums, AnEdgeAtAHubSumsItsStarFaceByFace) {
     EXPECT_TRUE(same_bits(summed(mesh, v, kNorth, scratch), first));
     EXPECT_TRUE(same_bits(summed(mesh, kNorth, v, scratch), first));
   }
-  const VertexId a = ring_vertex(3), b = VertexId(1 + 40 + 3);  // two rings down: small stars
+  const VertexId a = ring_vertex(3), b = VertexId(1 + 40 + 3);  // to the second ring: small stars
   expect_near(summed(mesh, a, b, scratch), by_definition(mesh, a, b), "small star");
 }
 
