@@ -47,34 +47,25 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
 }
 
 EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
+  // Read off the shorter face list (a fan's hub holds hundreds).
+  const bool from_a = faces_of_[a].size() <= faces_of_[b].size();
+  const VertexId from = from_a ? a : b, to = from_a ? b : a;
   EdgeFaces result;
-  if (faces_of_[b].size() < faces_of_[a].size()) {  // (a fan's hub holds hundreds)
-    for (FaceId f : faces_of_[b]) {
-      const Triangle& t = faces_[f];
-      const int i = corner_of(t, b);
-      const VertexId next = t[(i + 1) % 3];
-      const VertexId prev = t[(i + 2) % 3];
-      if (prev == a) {
-        result.left = f;
-        result.left_apex = next;
-      } else if (next == a) {
-        result.right = f;
-        result.right_apex = prev;
-      }
-    }
-    return result;
-  }
-  for (FaceId f : faces_of_[a]) {
+  FaceId& onward = from_a ? result.left : result.right;  // the face holding from -> to
+  VertexId& onward_apex = from_a ? result.left_apex : result.right_apex;
+  FaceId& back = from_a ? result.right : result.left;  // the face holding to -> from
+  VertexId& back_apex = from_a ? result.right_apex : result.left_apex;
+  for (FaceId f : faces_of_[from]) {
     const Triangle& t = faces_[f];
-    const int i = corner_of(t, a);
+    const int i = corner_of(t, from);
     const VertexId next = t[(i + 1) % 3];
     const VertexId prev = t[(i + 2) % 3];
-    if (next == b) {
-      result.left = f;
-      result.left_apex = prev;
-    } else if (prev == b) {
-      result.right = f;
-      result.right_apex = next;
+    if (next == to) {
+      onward = f;
+      onward_apex = prev;
+    } else if (prev == to) {
+      back = f;
+      back_apex = next;
     }
   }
   return result;

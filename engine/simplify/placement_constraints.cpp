@@ -84,6 +84,23 @@ constexpr size_t kKeptStars = 1024;  // slots of StarTermsScratch::kept
 
 using VertexStar = StarTermsScratch::VertexStar;
 
+// Fills scratch.order with scratch.faces's terms by p1, then p2 (then the rest, for faces
+// alike in both): the order of the positions, whatever the ids and face lists.
+void order_by_position(StarTermsScratch& scratch) {
+  const auto& terms = scratch.faces;
+  auto& order = scratch.order;
+  order.resize(terms.size());
+  for (uint32_t i = 0; i < terms.size(); ++i) order[i] = {terms[i].p1[0], i};
+  std::sort(order.begin(), order.end(), [&](const auto& x, const auto& y) {
+    if (x.first != y.first) return x.first < y.first;
+    const StarTermsScratch::FaceTerm &s = terms[x.second], &t = terms[y.second];
+    if (s.p1 != t.p1) return s.p1 < t.p1;
+    if (s.p2 != t.p2) return s.p2 < t.p2;
+    if (s.end != t.end) return s.end < t.end;
+    return s.vanishes < t.vanishes;
+  });
+}
+
 // Adds face (end, p1, p2)'s terms to `sums`.
 void add_face(const Vec3& end, const Vec3& p1, const Vec3& p2, bool planes, VertexStar& sums) {
   const Vec3 c = cross(sub(p1, end), sub(p2, end));
@@ -107,16 +124,10 @@ VertexStar sum_vertex_star(const CollapseMesh& mesh, VertexId v, bool planes,
     const int k = corner_of(t, v);
     terms.push_back({mesh.position(t[(k + 1) % 3]), mesh.position(t[(k + 2) % 3]), end, false});
   }
-  auto& order = scratch.order;
-  order.resize(terms.size());
-  for (uint32_t i = 0; i < terms.size(); ++i) order[i] = {terms[i].p1[0], i};
-  std::sort(order.begin(), order.end(), [&](const auto& x, const auto& y) {
-    if (x.first != y.first) return x.first < y.first;
-    const StarTermsScratch::FaceTerm &s = terms[x.second], &t = terms[y.second];
-    return s.p1 != t.p1 ? s.p1 < t.p1 : s.p2 < t.p2;
-  });
+  order_by_position(scratch);
   VertexStar sums;
-  for (const auto& [first, i] : order) add_face(end, terms[i].p1, terms[i].p2, planes, sums);
+  for (const auto& [first, i] : scratch.order)
+    add_face(end, terms[i].p1, terms[i].p2, planes, sums);
   return sums;
 }
 
@@ -192,21 +203,10 @@ void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& o
                        mesh.position(end), vanishes});
     }
   }
-  // By p1 then p2 (then the rest, for faces alike in both).
-  auto& order = scratch.order;
-  order.resize(terms.size());
-  for (uint32_t i = 0; i < terms.size(); ++i) order[i] = {terms[i].p1[0], i};
-  std::sort(order.begin(), order.end(), [&](const auto& x, const auto& y) {
-    if (x.first != y.first) return x.first < y.first;
-    const StarTermsScratch::FaceTerm &s = terms[x.second], &t = terms[y.second];
-    if (s.p1 != t.p1) return s.p1 < t.p1;
-    if (s.p2 != t.p2) return s.p2 < t.p2;
-    if (s.end != t.end) return s.end < t.end;
-    return s.vanishes < t.vanishes;
-  });
+  order_by_position(scratch);
   g = {0, 0, 0};
   h = 0;
-  for (const auto& [first, i] : order) {
+  for (const auto& [first, i] : scratch.order) {
     const StarTermsScratch::FaceTerm& term = terms[i];
     const Vec3 c = cross(sub(term.p1, origin), sub(term.p2, origin));
     h += dot(sub(term.end, origin), c);
