@@ -41,10 +41,19 @@ one_mesh() {
   set -euo pipefail
   local mesh="$1" name
   name="$(basename "$mesh")"; name="${name%.[gG][zZ]}"; name="${name%.*}"
-  # "rms hausdorff" of level N of a PM against the mesh
+  # "rms hausdorff" of level N of a PM against the mesh; fails, saying why, when lod or metro
+  # does (a missing figure must not read as an error of 0)
   level_error() {
+    local figures
     "$BIN" --log-level warn lod "$1" --faces "$2" -o "$3" > /dev/null
-    "$METRO" "$mesh" "$3" 2> /dev/null | jq -r '"\(.rms_rel) \(.hausdorff_rel)"'
+    figures="$("$METRO" "$mesh" "$3" 2> "$3.metro-err" | jq -r '"\(.rms_rel) \(.hausdorff_rel)"')" ||
+      true
+    if [[ ! "$figures" =~ ^[0-9.e+-]+\ [0-9.e+-]+$ ]]; then
+      echo "[parallel_quality] $name: metro on level $2 of $1 gave no figures: $(cat "$3.metro-err")" >&2
+      return 1
+    fi
+    rm -f "$3.metro-err"
+    echo "$figures"
   }
   local seq_pm="$OUT/$name.$METRIC.seq.pm" seq_json="$OUT/$name.$METRIC.seq.json"
   if [[ ! -s "$seq_json" ]]; then
@@ -105,7 +114,9 @@ one_mesh() {
     for level in 50 10 2 base; do
       if [[ "$level" == base ]]; then n=$base_n; else n=$(( in_faces * level / 100 )); fi
       local prms phd srms shd
-      read -r prms phd <<< "$(level_error "$par_pm" "$n" "$OUT/$name.$METRIC.$LABEL.p$p.$level.ply")"
+      local figures
+      figures="$(level_error "$par_pm" "$n" "$OUT/$name.$METRIC.$LABEL.p$p.$level.ply")"
+      read -r prms phd <<< "$figures"
       read -r srms shd <<< "${seq_err[$level]}"
       row+="$(awk -v a="$prms" -v b="$srms" -v c="$phd" -v d="$shd" \
         'BEGIN { printf "\t%.3f\t%.3f", (b > 0 ? a / b : 1), (d > 0 ? c / d : 1) }')"

@@ -78,6 +78,12 @@ class ComponentMinimum : public ConstraintModule {
   }
   void drop_too_small(const CollapseMesh&,
                       std::vector<CollapseCandidate>& collapses) const override {
+    // Where every collapse's component could take them all, none is dropped.
+    if (std::all_of(collapses.begin(), collapses.end(), [&](const CollapseCandidate& c) {
+          const uint32_t comp = component_[c.vs];
+          return count_[comp] > smallest(comp) + collapses.size();
+        }))
+      return;
     std::vector<std::pair<uint32_t, uint32_t>> made;  // (component, collapses kept in it)
     std::erase_if(collapses, [&](const CollapseCandidate& c) {
       const uint32_t comp = component_[c.vs];

@@ -280,12 +280,14 @@ bool Simplifier::pair_seam(uint32_t from, uint32_t into) {
   }
   // Copies in parts too small to shrink stay.
   std::vector<CollapseCandidate>& pairs = seam_planned_;
-  pairs.assign(seam_pairs_.size(), CollapseCandidate{});
+  pairs.resize(seam_pairs_.size());
   for (size_t i = 0; i < pairs.size(); ++i) {
-    pairs[i].vs = seam_pairs_[i].vs;
-    pairs[i].vt = seam_pairs_[i].vt;
-    pairs[i].position = mesh_.position(pairs[i].vs);
-    pairs[i].seam = true;
+    CollapseCandidate& c = pairs[i];
+    c.vs = seam_pairs_[i].vs;
+    c.vt = seam_pairs_[i].vt;
+    c.position = mesh_.position(c.vs);
+    c.cost = c.error = 0;
+    c.seam = true;
   }
   for (const auto& module : constraints_) module->drop_too_small(mesh_, pairs);
   seam_pairs_.clear();
@@ -369,13 +371,12 @@ bool Simplifier::seam_holds_in_turn(const Vec3& place) {
 bool Simplifier::cost_seam_at(const Vec3& at, Costing costing, CollapseCandidate& out) {
   double cost = 0, error = 0;
   for (size_t i = 0; i < seam_pairs_.size(); ++i) {
-    CollapseCandidate c;
+    CollapseCandidate& c = i == 0 ? out : seam_other_cost_;
     ++stats_.evaluations;
     if (!priority_.evaluate_seam(mesh_, seam_pairs_[i].vs, seam_pairs_[i].vt, &at, c, costing))
       return false;
     cost += c.cost;
     error = std::max(error, c.error);
-    if (i == 0) out = std::move(c);
   }
   out.cost = cost;
   out.error = error;

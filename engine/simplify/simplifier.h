@@ -314,7 +314,8 @@ class Simplifier {
   bool queueing_seams_ = false;
   std::vector<std::pair<uint32_t, uint32_t>> queued_seams_;
   std::vector<CollapseCandidate> seam_planned_;
-  std::vector<uint32_t> seam_mark_;  // per vertex: the pair whose ring holds it (rings_apart)
+  CollapseCandidate seam_other_cost_;  // cost_seam_at's costing of a pair after the first
+  std::vector<uint32_t> seam_mark_;    // per vertex: the pair whose ring holds it (rings_apart)
   std::vector<FaceId> seam_faces_;
   std::vector<std::unique_ptr<ConstraintModule>> seam_rules_;  // neighbourhood_constraints()
   uint32_t seam_stamp_ = 0;
