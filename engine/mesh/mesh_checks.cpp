@@ -219,13 +219,13 @@ bool wedges_are_consistent(const Mesh& mesh, std::string* why) {
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     for (int i = 0; i < 3; ++i) {
       const WedgeId w = mesh.face_wedges[f][i];
-      const std::string corner = "face " + std::to_string(f) + " corner " + std::to_string(i);
+      auto corner = [&] { return "face " + std::to_string(f) + " corner " + std::to_string(i); };
       if (w >= wedges) {
-        return fail(corner + " uses wedge " + std::to_string(w) + ", but the mesh has " +
+        return fail(corner() + " uses wedge " + std::to_string(w) + ", but the mesh has " +
                     std::to_string(wedges) + " wedges");
       }
       if (mesh.wedge_vertex[w] != mesh.faces[f][i]) {
-        return fail(corner + " uses wedge " + std::to_string(w) + " of vertex " +
+        return fail(corner() + " uses wedge " + std::to_string(w) + " of vertex " +
                     std::to_string(mesh.wedge_vertex[w]) + ", but the corner's vertex is " +
                     std::to_string(mesh.faces[f][i]));
       }

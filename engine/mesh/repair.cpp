@@ -157,13 +157,13 @@ void check_wedges(const Mesh& mesh) {
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     for (int i = 0; i < 3; ++i) {
       const WedgeId w = mesh.face_wedges[f][i];
-      const std::string corner = "face " + std::to_string(f) + " corner " + std::to_string(i);
+      auto corner = [&] { return "face " + std::to_string(f) + " corner " + std::to_string(i); };
       if (w >= wedges) {
-        throw_invalid(corner + " uses wedge " + std::to_string(w) + ", but the mesh has " +
+        throw_invalid(corner() + " uses wedge " + std::to_string(w) + ", but the mesh has " +
                       std::to_string(wedges) + " wedges");
       }
       if (mesh.wedge_vertex[w] != mesh.faces[f][i]) {
-        throw_invalid(corner + " (vertex " + std::to_string(mesh.faces[f][i]) + ") uses wedge " +
+        throw_invalid(corner() + " (vertex " + std::to_string(mesh.faces[f][i]) + ") uses wedge " +
                       std::to_string(w) + ", which belongs to vertex " +
                       std::to_string(mesh.wedge_vertex[w]));
       }
