@@ -101,16 +101,21 @@ void order_by_position(StarTermsScratch& scratch) {
   });
 }
 
+// Adds to `planes` the plane through `corner` of a face whose normal is n (twice its area),
+// weighted by its area; nothing for a face without area.
+void add_face_plane(const Vec3& n, const Vec3& corner, Quadric& planes) {
+  const double twice_area = length(n);
+  if (!(twice_area > 0)) return;
+  const Vec3 unit = scale(n, 1 / twice_area);
+  planes += Quadric::from_plane(unit, -dot(unit, corner), 0.5 * twice_area);
+}
+
 // Adds face (end, p1, p2)'s terms to `sums`.
 void add_face(const Vec3& end, const Vec3& p1, const Vec3& p2, bool planes, VertexStar& sums) {
   const Vec3 c = cross(sub(p1, end), sub(p2, end));
   sums.cross = add(sums.cross, c);
   sums.turn = add(sums.turn, sub(p2, p1));
-  if (!planes) return;
-  const double twice_area = length(c);
-  if (!(twice_area > 0)) return;
-  const Vec3 unit = scale(c, 1 / twice_area);
-  sums.planes += Quadric::from_plane(unit, -dot(unit, end), 0.5 * twice_area);
+  if (planes) add_face_plane(c, end, sums.planes);
 }
 
 // The sums over every face around v, in the order of their corners' positions.
@@ -212,12 +217,8 @@ void star_volume(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& o
     h += dot(sub(term.end, origin), c);
     if (term.vanishes) continue;
     g = add(g, c);
-    if (!planes) continue;
-    const Vec3 n = cross(sub(term.p1, term.end), sub(term.p2, term.end));
-    const double twice_area = length(n);
-    if (!(twice_area > 0)) continue;
-    const Vec3 unit = scale(n, 1 / twice_area);
-    *planes += Quadric::from_plane(unit, -dot(unit, term.end), 0.5 * twice_area);
+    if (planes)
+      add_face_plane(cross(sub(term.p1, term.end), sub(term.p2, term.end)), term.end, *planes);
   }
 }
 
