@@ -45,8 +45,8 @@ void check_deferred_edges(const std::vector<DeferredEdge>& edges, size_t vertex_
 // since, without costing it again. Keys costed here, or answered once, are remembered but not
 // answered: within a run the simplifier asks again only when it needs a new costing (an end
 // changed, or a rejected edge's star changed), so a run given the keys it would have costed
-// itself is the run without them (tested). Costing::kPerform always goes to the inner module. Not
-// thread-safe (like the modules it wraps); its const reads (for_each_current*) may run
+// itself is the run without them (tested). Any other costing than kQueue goes to the inner module.
+// Not thread-safe (like the modules it wraps); its const reads (for_each_current*) may run
 // concurrently.
 class KeyMemo : public PriorityWrapper {
  public:

@@ -54,9 +54,10 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
   Simplifier seams(local, costing, {});
   if (!groups.empty()) seams.join_copies(&groups);
   const size_t carried = keys.size();
+  const Costing sample_costing = carry_keys ? Costing::kQueue : Costing::kEstimate;
   for (const auto& [a, b] : sampled.edges) {
     CollapseCandidate c;
-    const bool placed = seams.queue_cost(a, b, c);
+    const bool placed = seams.cost_now(a, b, sample_costing, c);
     out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
     // A seam collapse's cost is no key of the module's, which cannot place the edge.
     const bool seam = groups.is_copy(a) && groups.is_copy(b);
@@ -82,7 +83,8 @@ SubsetSample sample_on_master(const SubsetJob& job, const SampledEdges& edges,
                                 (job_group(a) == kNoId || job_group(b) == kNoId);
     CollapseCandidate c;
     const bool placed =
-        !seam_elsewhere && master_costs.queue_cost(job.global_vertex[a], job.global_vertex[b], c);
+        !seam_elsewhere &&
+        master_costs.cost_now(job.global_vertex[a], job.global_vertex[b], Costing::kEstimate, c);
     out.costs.push_back(placed ? c.cost : std::numeric_limits<double>::infinity());
   }
   out.costings = master.costings() - costings_before;

@@ -62,11 +62,12 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 // costed by the job's own module, imported from the job's state as simplify_subset imports
 // it, so that the subsets' samples are costed side by side (in the extraction's tasks), not
 // one after the other on the master's critical path. An edge between copies of two groups is
-// costed as the seam collapse the job would make of it (Simplifier::queue_cost): a subset
+// costed as the seam collapse the job would make of it (Simplifier::cost_now): a subset
 // whose copies simplify only by seam collapses is as cheap as they are.
 // `free`: free_vertices of the job. `keys` (with carry_keys): the job's carried keys (local
 // ids, sorted), which answer the edges they cover; the sampled edges join them, so that the
-// job does not cost them again (its module costs them alike: same state).
+// job does not cost them again (its module costs them alike: same state). Costed as
+// Costing::kEstimate, or with carry_keys as kQueue: those costs become the job's queue keys.
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
                            std::vector<EdgeKey>& keys);
 

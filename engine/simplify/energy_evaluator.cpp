@@ -202,7 +202,7 @@ void EnergyEvaluator::place(const CollapseMesh& mesh, const CollapseCandidate& o
   // "Queue keys from fewer starts").
   std::array<Vec3, 3> starts{placing.pa, placing.pb, mid};
   std::span<const Vec3> tried(starts);
-  if (costing == Costing::kQueue) {
+  if (costing != Costing::kPerform) {  // (kEstimate: the same key)
     if (placing.by_moments) {
       tried = tried.subspan(2);
     } else if (!scratch_.parked_ends.empty()) {
@@ -215,7 +215,7 @@ void EnergyEvaluator::place(const CollapseMesh& mesh, const CollapseCandidate& o
     measure(placing, v, fit);
     for (int i = 0; i < module_.options_.solves_per_start; ++i) {
       v = solve(placing, fit, v);
-      if (costing == Costing::kQueue && i + 1 == module_.options_.solves_per_start) {
+      if (costing != Costing::kPerform && i + 1 == module_.options_.solves_per_start) {
         // A queue key: the last solve is costed on the model it minimised, not measured
         // again, which halves the projections. For projected points the model is an upper
         // bound of the measured energy (each point's barycentric coordinates put it on a

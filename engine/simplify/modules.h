@@ -34,8 +34,11 @@ struct CollapseCandidate {
 // and cost go into the PM. kQueue: a key for the priority queue, which a module may estimate
 // more cheaply: an edge is costed again, with kPerform, when it reaches the top. Most queued
 // costs are never used (a neighbouring collapse changes the edge first), so the estimate is
-// where a costly metric saves most of its time.
-enum class Costing { kPerform, kQueue };
+// where a costly metric saves most of its time. kEstimate: a cost for a sample of the mesh's
+// costs (the parallel build's water level, round_shares.h), read only for its cost: kQueue's
+// key, or where that key is a loose lower bound (the quadric's where its A is singular), one
+// near the cost kPerform would give.
+enum class Costing { kPerform, kQueue, kEstimate };
 
 class PriorityModule {
  public:

@@ -61,6 +61,11 @@ struct Quadric {
   // relative_threshold x trace^3); false otherwise. A positive definite A (a caller that adds a
   // positive multiple of the identity) needs no threshold: 0.
   bool minimizer(Vec3& out, double relative_threshold = 1e-9) const;
+  // The least value of Q over all points, 0 or more, for any A (a flat or creased one too):
+  // Q(about) less what a move from `about` saves along A's eigenvectors, over those whose
+  // eigenvalue is above 1e-12 x the largest (along the others Q is flat up to rounding). A
+  // lower bound of Q anywhere; `about` near the points that matter keeps its rounding small.
+  double least_value(const Vec3& about) const;
 };
 
 }  // namespace parapm

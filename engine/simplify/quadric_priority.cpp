@@ -173,8 +173,15 @@ bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, Col
     out.position = mesh.position(out.vs);
   } else if (!options_.keep_volume && !options_.keep_border) {
     out.position = place(q, pa, pb);
-  } else if (costing == Costing::kQueue && q.minimizer(kept)) {
+  } else if (costing != Costing::kPerform && q.minimizer(kept)) {
     out.position = kept;  // no placement costs less: a lower bound of the constrained cost
+  } else if (costing == Costing::kQueue) {
+    // A flat or creased star (A singular): the accumulated quadric's least value, a lower
+    // bound of the constrained cost as well, without the star's sums.
+    out.position = scale(add(pa, pb), 0.5);
+    out.cost = q.least_value(out.position);
+    out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
+    return true;
   } else {
     // Placed with the star's planes; costed by the accumulated quadric alone, whose free
     // optimum's cost (the queue key) stays a lower bound.

@@ -3,8 +3,10 @@
 // is taken among the placements that keep the volume the edge's star encloses and the area
 // its border edges sweep (Lindstrom-Turk 98's first two constraints, placement_constraints.h):
 // without them a coarse level shrinks where the surface or its outline curves. A queue key is
-// the unconstrained optimum's cost, a lower bound of the constrained cost, which reads the
-// star's faces and is paid only for the edge at the top (Costing).
+// the accumulated quadric's least value (its unconstrained optimum's cost), a lower bound of
+// the constrained cost, which reads the star's faces and is paid only for the edge at the top
+// (Costing). A sample's estimate (kEstimate) is the constrained cost where the quadric has no
+// unique optimum (a flat or creased star), where the least value says least about the cost.
 #pragma once
 
 #include <cstdint>
@@ -47,7 +49,7 @@ class QuadricPriority : public PriorityModule {
   // quadric summed in its chunk (the same bits).
   void initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) override;
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
-                Costing costing) override;  // kQueue: the unconstrained optimum's cost
+                Costing costing) override;
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                      CollapseCandidate& out, Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;

@@ -394,7 +394,7 @@ bool Simplifier::cost_seam(VertexId a, VertexId b, CollapseCandidate& out, Costi
     // collapses would each put it (the first's only for a queue key).
     places.assign(1, mesh_.position(seam_pairs_[0].vs));
     if (all_survive(into)) {
-      const size_t free_places = costing == Costing::kQueue ? 1 : seam_pairs_.size();
+      const size_t free_places = costing == Costing::kPerform ? seam_pairs_.size() : 1;
       for (size_t i = 0; i < free_places; ++i) {
         CollapseCandidate c;
         ++stats_.evaluations;

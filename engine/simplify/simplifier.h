@@ -166,12 +166,13 @@ class Simplifier {
   // copies stays. Off (null) by default; `groups` must outlive the run.
   void join_copies(const CopyGroups* groups) { groups_ = groups; }
   static constexpr size_t kMaxSeamCopies = 16;
-  // The queue key a run would give edge {a, b} of the mesh as it is: the module's costing or,
-  // between copies of two groups, the seam collapse's. Outside a run, the rules are not asked
-  // (not even which copies stay in parts too small to shrink): an estimate of the mesh's costs
-  // (round_shares.h), for which the constraints may be none and the module already set up.
-  bool queue_cost(VertexId a, VertexId b, CollapseCandidate& out) {
-    return cost_edge(a, b, out, Costing::kQueue);
+  // Edge {a, b} of the mesh as it is, costed as a run would cost it with `costing` (kQueue: its
+  // queue key; kEstimate): the module's costing or, between copies of two groups, the seam
+  // collapse's. Outside a run, the rules are not asked (not even which copies stay in parts
+  // too small to shrink): an estimate of the mesh's costs (round_shares.h), for which the
+  // constraints may be none and the module already set up.
+  bool cost_now(VertexId a, VertexId b, Costing costing, CollapseCandidate& out) {
+    return cost_edge(a, b, out, costing);
   }
   // After run(): the edges still waiting in the queue to be costed (deferred, neither end
   // changed since), with the key they were deferred from, sorted by (a, b). Empty when the run

@@ -116,7 +116,7 @@ TEST(RoundShares, TheMasterCostsTheSampleAsTheJobsModuleDoes) {
 }
 
 // An edge between copies of two groups, which the module alone cannot place, is sampled at the
-// cost of the seam collapse the job would make of it (Simplifier::queue_cost), by the job's
+// cost of the seam collapse the job would make of it (Simplifier::cost_now), by the job's
 // module and by the master alike: a subset of a double-sided sheet, whose copies simplify
 // only by seam collapses, samples as cheap as it is, and is asked for its share of the faces.
 TEST(RoundShares, AnEdgeBetweenCopiesCostsItsSeamCollapse) {

@@ -148,7 +148,7 @@ TEST(QuadricCostingView, CostsAsItsOwnerOnSeveralThreads) {
       out[i].placed = module.evaluate(working, edges[i].first, edges[i].second, out[i].c, costing);
     return out;
   };
-  for (Costing costing : {Costing::kQueue, Costing::kPerform}) {
+  for (Costing costing : {Costing::kQueue, Costing::kEstimate, Costing::kPerform}) {
     const std::vector<Cost> expected = costs_of(owner, costing);
     const uint64_t owner_costings = owner.costings();
     const std::unique_ptr<PriorityModule> a = owner.costing_view(), b = owner.costing_view();
@@ -173,6 +173,92 @@ TEST(QuadricCostingView, CostsAsItsOwnerOnSeveralThreads) {
     EXPECT_EQ(owner.costings(), owner_costings);
     CollapseCandidate done = expected.front().c;
     EXPECT_THROW(a->collapsed(working, done, EdgeFaces{}), Error);
+  }
+}
+
+// A quadric's least value (Quadric::least_value) is its value at the optimum where it has
+// one, and where it has none (planes through a line or one plane) the value of its flat
+// valley: a lower bound of its value anywhere, whatever point it is taken about.
+TEST(Quadric, ItsLeastValueIsItsValueAtTheOptimumOrAlongItsValley) {
+  auto plane = [](Vec3 n, double d, double w) {
+    return Quadric::from_plane(scale(n, 1 / length(n)), d / length(n), w);
+  };
+  const Vec3 far{1e3, -2e3, 5e2}, near{0.3, 0.1, -0.2};
+  Quadric flat = plane({0, 0, 1}, -2, 3);  // z = 2
+  EXPECT_NEAR(flat.least_value(near), 0, 1e-12);
+  EXPECT_NEAR(flat.least_value(far), 0, 1e-6);
+  Quadric crease = flat;
+  crease += plane({1, 1, 0}, -1, 2);  // x + y = 1: the valley is a line
+  Vec3 unused;
+  EXPECT_FALSE(crease.minimizer(unused));
+  EXPECT_NEAR(crease.least_value(near), 0, 1e-12);
+  Quadric offset = crease;
+  offset.c += 0.25;  // the valley raised: its least value is 0.25 everywhere along it
+  EXPECT_NEAR(offset.least_value(near), 0.25, 1e-12);
+  EXPECT_NEAR(offset.least_value(far), 0.25, 1e-6);
+  Quadric corner = crease;
+  corner += plane({1, -2, 0.5}, 4, 1);
+  corner += plane({0, 1, 0}, 7, 0.5);  // four planes without a common point
+  Vec3 optimum;
+  ASSERT_TRUE(corner.minimizer(optimum));
+  const double at_optimum = corner.evaluate(optimum);
+  EXPECT_GT(at_optimum, 0.1);
+  EXPECT_NEAR(corner.least_value(near), at_optimum, 1e-9 * at_optimum);
+  for (const Vec3& p : {near, far, optimum, Vec3{3, 3, 3}})
+    EXPECT_LE(corner.least_value(p), corner.evaluate(p) + 1e-9);
+}
+
+// On a CAD part (flat and creased stars, borders), as read and a third of the way down, every
+// edge's queue key is at most its sample's estimate, and that at most the cost it has when
+// performed: the queue pops no edge after one that costs less. Where the quadric has no
+// optimum the estimate is that cost, and the key, the quadric's least value, is sometimes
+// below it.
+TEST(QuadricCostings, AKeyIsAtMostTheEstimateAndThatAtMostTheCost) {
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  for (const size_t faces : {repaired.mesh.face_count(), repaired.mesh.face_count() / 3}) {
+    CollapseMesh working(repaired.mesh);
+    QuadricPriority priority(locked, QuadricOptions{});
+    Simplifier simplifier(working, priority, standard_constraints(locked));
+    simplifier.run({faces}, {}, nullptr);
+    Vec3 lo = working.position(0), hi = lo;
+    double area = 0;
+    for (FaceId f = 0; f < working.face_capacity(); ++f) {
+      if (!working.face_alive(f)) continue;
+      const Triangle& t = working.face(f);
+      area += 0.5 * length(triangle_normal(working.position(t[0]), working.position(t[1]),
+                                           working.position(t[2])));
+      for (VertexId v : t)
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::min(lo[k], working.position(v)[k]);
+          hi[k] = std::max(hi[k], working.position(v)[k]);
+        }
+    }
+    // Rounding: a cost is an area times a squared length.
+    const double tolerance = 1e-12 * area * dot(sub(hi, lo), sub(hi, lo));
+    size_t edges = 0, at_cost = 0, below = 0;
+    std::vector<VertexId> ring;
+    for (VertexId v = 0; v < working.vertex_capacity(); ++v) {
+      if (!working.vertex_alive(v)) continue;
+      working.neighbors(v, ring);
+      for (VertexId u : ring) {
+        if (u < v) continue;
+        CollapseCandidate key, estimate, cost;
+        const bool placed = priority.evaluate(working, v, u, cost, Costing::kPerform);
+        if (!priority.evaluate(working, v, u, key, Costing::kQueue) || !placed) continue;
+        ASSERT_TRUE(priority.evaluate(working, v, u, estimate, Costing::kEstimate));
+        ++edges;
+        ASSERT_LE(key.cost, estimate.cost + tolerance) << v << " " << u;
+        ASSERT_LE(estimate.cost, cost.cost + tolerance) << v << " " << u;
+        at_cost += estimate.cost == cost.cost ? 1 : 0;
+        below += estimate.cost == cost.cost && key.cost < cost.cost - tolerance ? 1 : 0;
+      }
+    }
+    EXPECT_GT(edges, faces);
+    if (faces == repaired.mesh.face_count()) {  // (the input's stars: many flat ones)
+      EXPECT_GT(at_cost, edges / 10);
+      EXPECT_GT(below, 100u);
+    }
   }
 }
 
