@@ -40,7 +40,8 @@ def simplify(binary, mesh, metric, ratio, extra):
 def outside(run):
     """Read, repair (with a core per chunk where the run read and repaired in chunks) and write."""
     return (run.get("read_critical_seconds", run["read_seconds"]) +
-            run.get("repair_critical_seconds", run["repair_seconds"]) + run["write_seconds"])
+            run.get("repair_critical_seconds", run["repair_seconds"]) +
+            run.get("write_critical_seconds", run["write_seconds"]))
 
 
 def parallel_figures(run):

@@ -155,8 +155,10 @@ int run_simplify(const SimplifyArgs& args) {
   bar.finish();
 
   const auto write_start = std::chrono::steady_clock::now();
-  write_pm_file(pm, args.output);
+  const LoopClock write_clock(loops);
+  write_pm_file(pm, args.output, loops);
   const double write_seconds = seconds_since(write_start);
+  const double write_critical_seconds = write_clock.critical_seconds();
   const uint64_t pm_bytes = std::filesystem::file_size(args.output);
   const uint64_t ply_bytes = binary_ply_size(loaded.repaired.mesh);
   const uint64_t peak = peak_memory_bytes();
@@ -180,6 +182,7 @@ int run_simplify(const SimplifyArgs& args) {
                           {"read_critical_seconds", loaded.read_critical_seconds},
                           {"repair_critical_seconds", loaded.repair_critical_seconds},
                           {"write_seconds", write_seconds},
+                          {"write_critical_seconds", write_critical_seconds},
                           {"metric", pm.info.metric},
                           {"stop_reason", stats.stop_reason},
                           {"costings", stats.costings},

@@ -662,7 +662,8 @@ void Coordinator::execute(JobRecord& record, Running& running,
   t = std::chrono::steady_clock::now();
   record.base_faces = pm.base.face_count();
   record.vsplits = pm.splits.size();
-  std::shared_ptr<LoadedPm> stored = written_pm(std::move(pm));
+  ChunkedLoops write_loops(spec.parallel.subsets, spec.parallel.threads);
+  std::shared_ptr<LoadedPm> stored = written_pm(std::move(pm), write_loops);
   record.pm_sha256 = blobs_.put(stored->bytes);
   library_.put(record.pm_sha256, std::move(stored));  // its first download reads no blob
   transport.set_store_seconds(seconds_since(t));

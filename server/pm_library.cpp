@@ -51,9 +51,14 @@ uint64_t memory_of(const LoadedPm& loaded) {
 }  // namespace
 
 std::shared_ptr<LoadedPm> written_pm(ProgressiveMesh pm) {
+  ChunkedLoops one_thread;
+  return written_pm(std::move(pm), one_thread);
+}
+
+std::shared_ptr<LoadedPm> written_pm(ProgressiveMesh pm, ChunkedLoops& loops) {
   auto written = std::make_shared<LoadedPm>();
   std::ostringstream bytes;
-  write_pm(pm, bytes, &written->split_begin);
+  write_pm(pm, bytes, loops, &written->split_begin);
   written->bytes = std::move(bytes).str();
   written->splits_begin = written->split_begin.front();
   written->pm = std::move(pm);

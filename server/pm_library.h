@@ -14,6 +14,7 @@
 
 #include "pm/progressive_mesh.h"
 #include "storage/blob_store.h"
+#include "util/chunked_loops.h"
 
 namespace parapm::service {
 
@@ -26,6 +27,8 @@ struct LoadedPm {
 
 // `pm` written as a .pm file, kept with its bytes and the writer's split offsets: what the
 // coordinator stores as a blob and puts in the library (validate_pm first: kInvalidInput).
+// The splits are encoded in `loops`' chunks (the same bytes on any).
+std::shared_ptr<LoadedPm> written_pm(ProgressiveMesh pm, ChunkedLoops& loops);
 std::shared_ptr<LoadedPm> written_pm(ProgressiveMesh pm);
 
 class PmLibrary {

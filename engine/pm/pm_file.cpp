@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "pm/byte_io.h"
 #include "pm/float_ordinal.h"
@@ -18,25 +21,49 @@ namespace parapm {
 
 namespace fmt = pm_format;
 
+namespace {
+
+// Grows `box` (empty while `first`) to hold p.
+void add_to_box(const Vec3& p, Box& box, bool& first) {
+  if (first) {
+    box.min = box.max = p;
+    first = false;
+    return;
+  }
+  for (int k = 0; k < 3; ++k) {
+    box.min[k] = std::min(box.min[k], p[k]);
+    box.max[k] = std::max(box.max[k], p[k]);
+  }
+}
+
+}  // namespace
+
 Box pm_bounding_box(const ProgressiveMesh& pm) {
+  ChunkedLoops one_thread;
+  return pm_bounding_box(pm, one_thread);
+}
+
+Box pm_bounding_box(const ProgressiveMesh& pm, ChunkedLoops& loops) {
   Box box;
   bool first = true;
-  auto add = [&](const Vec3& p) {
-    if (first) {
-      box.min = box.max = p;
-      first = false;
-      return;
+  for (const Vec3& p : pm.base.positions) add_to_box(p, box, first);
+  // Per range of splits its own box, joined in order: minima and maxima, the same box.
+  const size_t ranges = loops.ranges(pm.splits.size());
+  std::vector<Box> boxes(ranges);
+  std::vector<uint8_t> empty(ranges, 1);
+  loops.run_indexed(pm.splits.size(), [&](size_t range, size_t begin, size_t end) {
+    bool none = true;
+    for (size_t i = begin; i < end; ++i) {
+      add_to_box(pm.splits[i].vs_after, boxes[range], none);
+      add_to_box(pm.splits[i].vt_after, boxes[range], none);
     }
-    for (int k = 0; k < 3; ++k) {
-      box.min[k] = std::min(box.min[k], p[k]);
-      box.max[k] = std::max(box.max[k], p[k]);
+    empty[range] = none;
+  });
+  for (size_t r = 0; r < ranges; ++r)
+    if (!empty[r]) {
+      add_to_box(boxes[r].min, box, first);
+      add_to_box(boxes[r].max, box, first);
     }
-  };
-  for (const Vec3& p : pm.base.positions) add(p);
-  for (const VertexSplit& s : pm.splits) {
-    add(s.vs_after);
-    add(s.vt_after);
-  }
   return box;
 }
 
@@ -64,61 +91,17 @@ void write_position_delta(ByteWriter& out, const Vec3& after, const Vec3& before
   }
 }
 
-// The caller has validated `pm` (validate_pm): the encoding relies on its invariants.
-void write_all(const ProgressiveMesh& pm, ByteWriter& out,
-               std::vector<uint64_t>* split_offsets = nullptr) {
-  const Mesh& base = pm.base;
-  const bool float32 = base.positions_are_float;
-  const bool attributes = base.layout.any();
-  const size_t fpw = size_t(base.layout.floats_per_wedge());
-  if (pm.info.metric.size() > fmt::kMaxMetricLength)
-    throw_invalid("the metric name is longer than " + std::to_string(fmt::kMaxMetricLength) +
-                  " bytes");
-
-  // Header.
-  out.bytes(fmt::kMagic, sizeof fmt::kMagic);
-  out.u32(fmt::kVersion);
-  out.u32(header_flags(pm));
-  out.u32(uint32_t(base.vertex_count()));
-  out.u32(uint32_t(base.face_count()));
-  out.u32(uint32_t(attributes ? base.wedge_count() : 0));
-  out.u32(uint32_t(pm.splits.size()));
-  out.u32(uint32_t(pm.full_vertex_count()));
-  out.u32(uint32_t(pm.full_face_count()));
-  out.u32(uint32_t(attributes ? pm.full_wedge_count() : 0));
-  out.u32(uint32_t(pm.vertex_copies.size()));
-  out.u64(pm.info.input_vertices);
-  out.u64(pm.info.input_faces);
-  const Box box = pm_bounding_box(pm);
-  for (double c : box.min) out.f64(c);
-  for (double c : box.max) out.f64(c);
-  out.u32(uint32_t(pm.info.metric.size()));
-  out.bytes(pm.info.metric.data(), pm.info.metric.size());
-
-  // Base mesh.
-  for (const Vec3& p : base.positions)
-    for (double c : p) float32 ? out.f32(float(c)) : out.f64(c);
-  for (const Triangle& t : base.faces)
-    for (VertexId v : t) out.u32(v);
-  if (attributes) {
-    for (const auto& corners : base.face_wedges)
-      for (WedgeId w : corners) out.u32(w);
-    for (WedgeId w = 0; w < base.wedge_count(); ++w) {
-      out.u32(base.wedge_vertex[w]);
-      for (size_t k = 0; k < fpw; ++k) out.f32(base.wedge_values[w * fpw + k]);
-    }
-  }
-  out.u32(out.crc());
-  out.reset_crc();
-
-  // Splits.
-  uint64_t wedges = base.wedge_count();
-  size_t next_new_value = 0;  // into pm.new_wedge_values
-  if (split_offsets) {
-    split_offsets->clear();
-    split_offsets->reserve(pm.splits.size() + 1);
-  }
-  for (const VertexSplit& s : pm.splits) {
+// Splits [begin, end) of `pm`, the first of them introducing wedge `wedges` and reading new
+// wedge values from `next_new_value`; `split_offsets` (when given) gets where each begins in
+// `out`.
+void write_split_range(const ProgressiveMesh& pm, size_t begin, size_t end, uint64_t wedges,
+                       size_t next_new_value, ByteWriter& out,
+                       std::vector<uint64_t>* split_offsets) {
+  const bool float32 = pm.base.positions_are_float;
+  const bool attributes = pm.base.layout.any();
+  const size_t fpw = size_t(pm.base.layout.floats_per_wedge());
+  for (size_t i = begin; i < end; ++i) {
+    const VertexSplit& s = pm.splits[i];
     if (split_offsets) split_offsets->push_back(out.offset());
     out.varint(s.vs);
     out.varint(s.has_fl() ? uint64_t(s.vl) + 1 : 0);
@@ -148,8 +131,99 @@ void write_all(const ProgressiveMesh& pm, ByteWriter& out,
       for (size_t j = 0; j < fpw; ++j) out.zigzag32(float_delta(coarse[fpw + j], coarse[j]));
     }
   }
+}
 
+// Every split, then (with `split_offsets`) where the last one ends. In `loops`' ranges, each
+// range into a buffer of its own, from the wedge counts of the splits before it
+// (new_wedge_count, which validate_pm checked against the corners), joined in order: the same
+// bytes.
+void write_splits(const ProgressiveMesh& pm, ByteWriter& out, std::vector<uint64_t>* split_offsets,
+                  ChunkedLoops& loops) {
+  const size_t n = pm.splits.size();
+  const uint64_t base_wedges = pm.base.wedge_count();
+  const size_t fpw = size_t(pm.base.layout.floats_per_wedge());
+  if (split_offsets) {
+    split_offsets->clear();
+    split_offsets->reserve(n + 1);
+  }
+  const size_t ranges = loops.ranges(n);
+  if (ranges <= 1) {
+    write_split_range(pm, 0, n, base_wedges, 0, out, split_offsets);
+  } else {
+    std::vector<uint64_t> new_wedges(ranges + 1, 0);  // before each range, once summed
+    loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) new_wedges[range + 1] += pm.splits[i].new_wedge_count;
+    });
+    for (size_t r = 0; r < ranges; ++r) new_wedges[r + 1] += new_wedges[r];
+    std::vector<std::string> bytes(ranges);
+    std::vector<std::vector<uint64_t>> offsets(ranges);
+    loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+      std::ostringstream buffer;
+      ByteWriter writer(&buffer);
+      write_split_range(pm, begin, end, base_wedges + new_wedges[range],
+                        size_t(new_wedges[range]) * fpw, writer,
+                        split_offsets ? &offsets[range] : nullptr);
+      writer.flush();
+      bytes[range] = std::move(buffer).str();
+    });
+    for (size_t r = 0; r < ranges; ++r) {
+      if (split_offsets)
+        for (uint64_t offset : offsets[r]) split_offsets->push_back(out.offset() + offset);
+      out.bytes(bytes[r].data(), bytes[r].size());
+    }
+  }
   if (split_offsets) split_offsets->push_back(out.offset());
+}
+
+// The caller has validated `pm` (validate_pm): the encoding relies on its invariants.
+void write_all(const ProgressiveMesh& pm, ByteWriter& out, ChunkedLoops& loops,
+               std::vector<uint64_t>* split_offsets = nullptr) {
+  const Mesh& base = pm.base;
+  const bool float32 = base.positions_are_float;
+  const bool attributes = base.layout.any();
+  const size_t fpw = size_t(base.layout.floats_per_wedge());
+  if (pm.info.metric.size() > fmt::kMaxMetricLength)
+    throw_invalid("the metric name is longer than " + std::to_string(fmt::kMaxMetricLength) +
+                  " bytes");
+
+  // Header.
+  out.bytes(fmt::kMagic, sizeof fmt::kMagic);
+  out.u32(fmt::kVersion);
+  out.u32(header_flags(pm));
+  out.u32(uint32_t(base.vertex_count()));
+  out.u32(uint32_t(base.face_count()));
+  out.u32(uint32_t(attributes ? base.wedge_count() : 0));
+  out.u32(uint32_t(pm.splits.size()));
+  out.u32(uint32_t(pm.full_vertex_count()));
+  out.u32(uint32_t(pm.full_face_count()));
+  out.u32(uint32_t(attributes ? pm.full_wedge_count() : 0));
+  out.u32(uint32_t(pm.vertex_copies.size()));
+  out.u64(pm.info.input_vertices);
+  out.u64(pm.info.input_faces);
+  const Box box = pm_bounding_box(pm, loops);
+  for (double c : box.min) out.f64(c);
+  for (double c : box.max) out.f64(c);
+  out.u32(uint32_t(pm.info.metric.size()));
+  out.bytes(pm.info.metric.data(), pm.info.metric.size());
+
+  // Base mesh.
+  for (const Vec3& p : base.positions)
+    for (double c : p) float32 ? out.f32(float(c)) : out.f64(c);
+  for (const Triangle& t : base.faces)
+    for (VertexId v : t) out.u32(v);
+  if (attributes) {
+    for (const auto& corners : base.face_wedges)
+      for (WedgeId w : corners) out.u32(w);
+    for (WedgeId w = 0; w < base.wedge_count(); ++w) {
+      out.u32(base.wedge_vertex[w]);
+      for (size_t k = 0; k < fpw; ++k) out.f32(base.wedge_values[w * fpw + k]);
+    }
+  }
+  out.u32(out.crc());
+  out.reset_crc();
+
+  // Splits.
+  write_splits(pm, out, split_offsets, loops);
 
   // Tail.
   for (const auto& [copy, original] : pm.vertex_copies) {
@@ -165,25 +239,37 @@ void write_all(const ProgressiveMesh& pm, ByteWriter& out,
 }  // namespace
 
 void write_pm(const ProgressiveMesh& pm, std::ostream& out, std::vector<uint64_t>* split_offsets) {
+  ChunkedLoops one_thread;
+  write_pm(pm, out, one_thread, split_offsets);
+}
+
+void write_pm(const ProgressiveMesh& pm, std::ostream& out, ChunkedLoops& loops,
+              std::vector<uint64_t>* split_offsets) {
   validate_pm(pm);
   ByteWriter writer(&out);
-  write_all(pm, writer, split_offsets);
+  write_all(pm, writer, loops, split_offsets);
 }
 
 size_t pm_encoded_size(const ProgressiveMesh& pm) {
   validate_pm(pm);
   ByteWriter counter(nullptr);
-  write_all(pm, counter);
+  ChunkedLoops one_thread;
+  write_all(pm, counter, one_thread);
   return size_t(counter.offset());
 }
 
 void write_pm_file(const ProgressiveMesh& pm, const std::string& path) {
+  ChunkedLoops one_thread;
+  write_pm_file(pm, path, one_thread);
+}
+
+void write_pm_file(const ProgressiveMesh& pm, const std::string& path, ChunkedLoops& loops) {
   validate_pm(pm);  // before the file is created
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(ErrorCode::kIo, "cannot open " + path + " for writing");
   try {
     ByteWriter writer(&out);
-    write_all(pm, writer);
+    write_all(pm, writer, loops);
     out.close();
     if (!out) throw Error(ErrorCode::kIo, "writing " + path + " failed");
   } catch (const Error& e) {

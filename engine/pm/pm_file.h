@@ -19,6 +19,7 @@
 
 #include "mesh/mesh.h"
 #include "pm/progressive_mesh.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -118,6 +119,11 @@ class PmReader {
 void write_pm(const ProgressiveMesh& pm, std::ostream& out,
               std::vector<uint64_t>* split_offsets = nullptr);
 void write_pm_file(const ProgressiveMesh& pm, const std::string& path);
+// The same bytes, the splits encoded in `loops`' chunks side by side (and the bounding box
+// found in them): what a parallel build's process writes on its threads.
+void write_pm(const ProgressiveMesh& pm, std::ostream& out, ChunkedLoops& loops,
+              std::vector<uint64_t>* split_offsets = nullptr);
+void write_pm_file(const ProgressiveMesh& pm, const std::string& path, ChunkedLoops& loops);
 // Bytes write_pm() would write.
 size_t pm_encoded_size(const ProgressiveMesh& pm);
 
@@ -130,5 +136,6 @@ ProgressiveMesh read_pm_file(const std::string& path);
 // Bounding box of every position at every level: the base positions, vs_after and vt_after of
 // every split (the header's box; a viewer can frame any level with it).
 Box pm_bounding_box(const ProgressiveMesh& pm);
+Box pm_bounding_box(const ProgressiveMesh& pm, ChunkedLoops& loops);  // the same box
 
 }  // namespace parapm

@@ -139,6 +139,28 @@ TEST(PmFile, TheWritersSplitOffsetsAreTheReaders) {
   }
 }
 
+// Written in chunks side by side (a parallel build's process), the splits make the same bytes
+// and the same offsets, the bounding box is the same: every PM, cut into ranges as short as one
+// split, on two threads, with attributes (new wedges counted from the ranges before) and without.
+TEST(PmFile, TheSplitsWrittenInChunksAreTheSameBytes) {
+  for (const ProgressiveMesh& pm : round_trip_pms()) {
+    std::vector<uint64_t> plain_offsets;
+    std::ostringstream plain;
+    write_pm(pm, plain, &plain_offsets);
+    for (const unsigned chunks : {2u, 7u, 64u}) {
+      ChunkedLoops loops(chunks, 2, 1);
+      std::vector<uint64_t> chunked_offsets;
+      std::ostringstream chunked;
+      write_pm(pm, chunked, loops, &chunked_offsets);
+      EXPECT_EQ(chunked.str(), plain.str()) << chunks << " chunks, " << pm.splits.size();
+      EXPECT_EQ(chunked_offsets, plain_offsets);
+      const Box a = pm_bounding_box(pm), b = pm_bounding_box(pm, loops);
+      EXPECT_EQ(a.min, b.min);
+      EXPECT_EQ(a.max, b.max);
+    }
+  }
+}
+
 TEST(PmFile, Float64PositionsSurviveExactly) {
   // Positions no float32 can hold, negative zero, tiny and huge magnitudes.
   ProgressiveMesh pm = testing::strip_pm();
