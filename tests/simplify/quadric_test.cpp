@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -221,7 +222,8 @@ TEST(QuadricCostings, AKeyIsAtMostTheEstimateAndThatAtMostTheCost) {
     QuadricPriority priority(locked, QuadricOptions{});
     Simplifier simplifier(working, priority, standard_constraints(locked));
     simplifier.run({faces}, {}, nullptr);
-    Vec3 lo = working.position(0), hi = lo;
+    const double inf = std::numeric_limits<double>::infinity();
+    Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
     double area = 0;
     for (FaceId f = 0; f < working.face_capacity(); ++f) {
       if (!working.face_alive(f)) continue;
