@@ -230,18 +230,23 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
       else if (faces)
         front_weight *= 3;
       if (counted + front_weight <= cumulative_target) {
-        for (uint32_t v : front) {
-          counted += mark(v, k);
-          members.push_back(v);
-        }
+        // The whole front joins k. Marked first, so that one pass over each vertex's
+        // neighbours both lowers the updated degrees of the unmarked ones (as mark() does; the
+        // front's own vertices, marked anyway, need none, and the partial front is empty
+        // here) and queues them for the next front: front order, then neighbour order.
+        for (uint32_t v : front) subset[v] = k;
         ++front_number;
         next_front.clear();
         for (uint32_t v : front) {
           for (uint32_t u : graph.neighbours_of(v)) {
-            if (subset[u] != kNoId || queued[u] == front_number) continue;
+            if (subset[u] != kNoId) continue;
+            touched.push(u, --updated_degree[u]);
+            if (queued[u] == front_number) continue;
             queued[u] = front_number;
             next_front.push_back(u);
           }
+          counted += faces ? faces->join(v, k) : graph.weight[v];
+          members.push_back(v);
         }
         std::swap(front, next_front);
       } else {
