@@ -19,6 +19,12 @@ Vec3 normal_of(const CollapseMesh& mesh, FaceId f) {
   return triangle_normal(mesh.position(t[0]), mesh.position(t[1]), mesh.position(t[2]));
 }
 
+// The error a collapse of cost `cost` under q records: the root mean squared distance to q's
+// planes (q.weight is their area), in model units.
+double rms_error(const Quadric& q, double cost) {
+  return q.weight > 0 ? std::sqrt(cost / q.weight) : 0.0;
+}
+
 // An optimum far from the edge comes from a nearly flat quadric; it folds the mesh.
 bool near_edge(const Vec3& p, const Vec3& pa, const Vec3& pb) {
   const Vec3 d = sub(p, scale(add(pa, pb), 0.5));
@@ -180,7 +186,7 @@ bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, Col
     // bound of the constrained cost as well, without the star's sums.
     out.position = scale(add(pa, pb), 0.5);
     out.cost = q.least_value(out.position);
-    out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
+    out.error = rms_error(q, out.cost);
     return true;
   } else {
     // Placed with the star's planes; costed by the accumulated quadric alone, whose free
@@ -200,7 +206,7 @@ bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, Col
     }
   }
   out.cost = std::max(0.0, q.evaluate(out.position));
-  out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
+  out.error = rms_error(q, out.cost);
   return std::isfinite(out.cost);
 }
 
@@ -219,7 +225,7 @@ bool QuadricPriority::cost_seam(const CollapseMesh& mesh, VertexId vs, VertexId 
   out.position =
       at ? *at : place(q, mesh.position(std::min(vs, vt)), mesh.position(std::max(vs, vt)));
   out.cost = std::max(0.0, q.evaluate(out.position));
-  out.error = q.weight > 0 ? std::sqrt(out.cost / q.weight) : 0.0;
+  out.error = rms_error(q, out.cost);
   return std::isfinite(out.cost);
 }
 
