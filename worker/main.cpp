@@ -102,7 +102,10 @@ int main(int argc, char** argv) {
   app.add_option("--advertise", args.advertise,
                  "the address the coordinator should call (default: the listening address; "
                  "set it behind NAT or in a container)");
-  app.add_option("--threads", args.threads, "subsets run at once (0: one per hardware thread)")
+  app.add_option(
+         "--threads", args.threads,
+         "subsets run at once (0: one per hardware thread); a subset started while slots are "
+         "idle shares them for its energy point projections")
       ->capture_default_str();
   app.add_option("--capacity", args.capacity,
                  "relative speed of this machine; the coordinator gives faster workers more work")

@@ -122,7 +122,7 @@ void SubsetService::record_outcome(const grpc::Status& status, double seconds,
   if (status.ok()) metrics_.subset_seconds.Observe(seconds);
 }
 
-bool SubsetService::acquire_slot(grpc::ServerContext* context) {
+bool SubsetService::acquire_slot(grpc::ServerContext* context, JobTeam& team) {
   std::unique_lock lock(mutex_);
   while (busy_ >= slots_) {
     if (context->IsCancelled()) return false;
@@ -130,6 +130,8 @@ bool SubsetService::acquire_slot(grpc::ServerContext* context) {
   }
   ++busy_;
   ++running_;
+  const unsigned share = slots_ / busy_;
+  if (share > 1) team = {share, share, JobTeam::kDefaultMinItems};
   return true;
 }
 
@@ -165,7 +167,9 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
     const std::string name = "job " + request->job_id() + " round " + std::to_string(job.round) +
                              " subset " + std::to_string(job.subset);
     const auto decoded = std::chrono::steady_clock::now();
-    if (!acquire_slot(context)) return {grpc::StatusCode::CANCELLED, "cancelled while queued"};
+    JobTeam team;
+    if (!acquire_slot(context, team))
+      return {grpc::StatusCode::CANCELLED, "cancelled while queued"};
     struct SlotGuard {
       SubsetService* service;
       ~SlotGuard() { service->release_slot(); }
@@ -209,7 +213,7 @@ grpc::Status SubsetService::SimplifySubset(grpc::ServerContext* context,
     QuadricState kept;
     SubsetResult result;
     try {
-      result = simplify_subset(std::move(job), progress, &cancel, keeps ? &kept : nullptr);
+      result = simplify_subset(std::move(job), progress, &cancel, keeps ? &kept : nullptr, team);
     } catch (const Error& e) {
       if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded)
         spdlog::info("{}: stopped ({}) after {:.3f} s", name, e.what(), seconds_since(start));

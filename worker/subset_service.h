@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "held_state_cache.h"
+#include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
 #include "parapm.grpc.pb.h"
 #include "rpc_security.h"
@@ -40,8 +41,10 @@ class SubsetService final : public parapm::v1::WorkerService::Service {
   // worker does not hold them.
   grpc::Status restore_held_state(const parapm::v1::SubsetRequest& request,
                                   const std::vector<uint32_t>& held, SubsetJob& job);
-  // Waits for a free slot; false when the call was cancelled meanwhile.
-  bool acquire_slot(grpc::ServerContext* context);
+  // Waits for a free slot; false when the call was cancelled meanwhile. `team`: the slots left
+  // idle as it starts, shared with the jobs running (JobTeam: the energy's rich collapses of a
+  // round's last few jobs use this worker's idle cores; the same records either way).
+  bool acquire_slot(grpc::ServerContext* context, JobTeam& team);
   void release_slot();
 
   rpc::TokenCheck auth_;

@@ -11,8 +11,14 @@ namespace parapm {
 std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
                                                 const CancelToken* cancel) {
   std::vector<SubsetResult> results(jobs.size());
+  JobTeam team;
+  if (!jobs.empty() && team_min_items_ > 0 && jobs.size() < cores_) {
+    team.chunks = unsigned(cores_ / jobs.size());
+    team.threads = std::max<unsigned>(1, pool_threads(threads_, cores_) / unsigned(jobs.size()));
+    team.min_items = team_min_items_;
+  }
   run_jobs(jobs.size(), threads_, [&](size_t i) {
-    results[i] = simplify_subset(std::move(jobs[i]), {}, cancel);
+    results[i] = simplify_subset(std::move(jobs[i]), {}, cancel, nullptr, team);
     jobs[i] = SubsetJob{};  // its memory is not needed any more
   });
   return results;

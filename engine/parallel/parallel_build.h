@@ -82,9 +82,10 @@ struct ParallelOptions {
   // deferred again as the sequential build would hold them. Off: for measuring what it saves.
   bool carry_deferred = true;
   // A band pass's or the final pass's collapse that moves at least this many of the energy's
-  // points projects them on a team of p chunks on the pool's threads (the same PM: fewer take
-  // less time than waking the team does); 0: none.
-  uint32_t team_min_points = 512;
+  // points projects them on a team of p chunks on the pool's threads, a job's of a round with
+  // fewer than p subsets on a team of p / subsets chunks (ThreadPoolRunner) (the same PM: fewer
+  // take less time than waking the team does); 0: none.
+  uint32_t team_min_points = JobTeam::kDefaultMinItems;
   // Tests only: the master follows each round by re-running its module's collapsed() on every
   // merged record (the first step's path) instead of importing the jobs' returned states.
   bool replay_state = false;
@@ -199,14 +200,20 @@ class SubsetRunner {
 };
 
 // Runs the jobs with simplify_subset on a pool of `threads` threads (0: one per subset, up to
-// the hardware's).
+// the hardware's). A round of fewer jobs than `cores` (the build's p: a core per subset) gives
+// each job a team (JobTeam) of cores / jobs chunks on the threads the pool leaves idle, loops
+// of at least `team_min_items` points (0: no teams): the tail rounds' few jobs, whose
+// collapses each move hundreds of the energy's points, use the cores the round leaves.
 class ThreadPoolRunner : public SubsetRunner {
  public:
-  explicit ThreadPoolRunner(unsigned threads) : threads_(threads) {}
+  explicit ThreadPoolRunner(unsigned threads, unsigned cores = 0, size_t team_min_items = 0)
+      : threads_(threads), cores_(cores), team_min_items_(team_min_items) {}
   std::vector<SubsetResult> run(std::vector<SubsetJob>& jobs, const CancelToken* cancel) override;
 
  private:
   unsigned threads_;
+  unsigned cores_;
+  size_t team_min_items_;
 };
 
 // What a build tells an observer as it goes (for a job's event stream); all optional, called

@@ -335,7 +335,7 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
       st_(stats ? *stats : local_stats_),
       progress_(progress),
       cancel_(cancel),
-      pool_(requested.threads),
+      pool_(requested.threads, requested.subsets, requested.team_min_points),
       master_loops_(requested.subsets, requested.threads),
       runner_(runner ? runner : &pool_),
       events_(events),
@@ -799,9 +799,10 @@ void ParallelBuilder::merge(Round& r) {
   for (SubsetResult& result : r.results) {
     rs.subsets.push_back({result.subset, result.faces, result.owned_faces, result.records.size(),
                           result.wall_seconds, result.cpu_seconds, result.stats.stop_reason});
-    subsets_cpu_ += result.cpu_seconds;
+    subsets_cpu_ += result.cpu_seconds + result.team_cpu_seconds;
     job_costings_ += result.costings;
-    rs.slowest_subset_cpu_seconds = std::max(rs.slowest_subset_cpu_seconds, result.cpu_seconds);
+    rs.slowest_subset_cpu_seconds =
+        std::max(rs.slowest_subset_cpu_seconds, result.cpu_seconds - result.team_saved_seconds);
     r.lists.push_back(std::move(result.records));
     rs.keys_reused += result.keys_reused;
   }

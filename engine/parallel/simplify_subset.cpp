@@ -11,6 +11,7 @@
 #include "simplify/quadric_priority.h"
 #include "simplify/simplify.h"
 #include "util/clock.h"
+#include "util/thread_team.h"
 
 namespace parapm {
 namespace {
@@ -62,7 +63,8 @@ namespace {
 // `release` (null, or `job` itself when the caller gives it up): its mesh, state and keys are
 // released once the working mesh, the module and the memo hold them.
 SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCallback& progress,
-                      const CancelToken* cancel, QuadricState* free_quadrics) {
+                      const CancelToken* cancel, QuadricState* free_quadrics,
+                      const JobTeam& job_team) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
   validate_subset_job(job);
@@ -83,7 +85,12 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
   }
 
   CollapseMesh working(job.mesh);
+  std::optional<ThreadTeam> team;  // outlives the metric, which uses it
   std::unique_ptr<PriorityModule> metric = job_module(job, working);
+  if (job_team.chunks > 1 && job_team.min_items > 0 && metric->costly()) {
+    team.emplace(job_team.chunks, job_team.threads, job_team.min_items);
+    metric->use_team(&*team);
+  }
   // With a state, the metric is the master's over the job: imported, not initialised.
   std::unique_ptr<PriorityModule> imported;
   const bool had_state = !job.state.empty();
@@ -145,6 +152,10 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
   result.costings = metric->costings();
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
+  if (team) {
+    result.team_saved_seconds = team->seconds() - team->critical_seconds();
+    result.team_cpu_seconds = team->worker_cpu_seconds();
+  }
   spdlog::debug(
       "round {} subset {} simplified {}->{} faces ({} owned, {} free vertices) in {:.3f} s"
       " ({:.3f} s CPU; {} collapses, {} seam collapses, {} evaluations, {} deferred, {} keys "
@@ -160,12 +171,13 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
 
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress,
                              const CancelToken* cancel, QuadricState* free_quadrics) {
-  return simplify(job, nullptr, progress, cancel, free_quadrics);
+  return simplify(job, nullptr, progress, cancel, free_quadrics, {});
 }
 
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress,
-                             const CancelToken* cancel, QuadricState* free_quadrics) {
-  return simplify(job, &job, progress, cancel, free_quadrics);
+                             const CancelToken* cancel, QuadricState* free_quadrics,
+                             const JobTeam& team) {
+  return simplify(job, &job, progress, cancel, free_quadrics, team);
 }
 
 }  // namespace parapm

@@ -39,6 +39,21 @@ struct SubsetResult {
   SimplifierStats stats;
   double wall_seconds = 0;
   double cpu_seconds = 0;  // of the calling thread (CLOCK_THREAD_CPUTIME_ID)
+  // With a JobTeam: what its loops took beyond their time with a core per chunk (the
+  // critical path counts cpu_seconds less this), and the CPU its own threads spent.
+  double team_saved_seconds = 0;
+  double team_cpu_seconds = 0;
+};
+
+// The cores a job may use beside its own thread: its metric's point projections (the energy's,
+// PriorityModule::use_team) cut into `chunks` on `threads` threads (the caller's among them),
+// loops of at least `min_items` points. The same records whatever the team.
+struct JobTeam {
+  // The smallest loop worth a team: fewer points take less time than waking it does.
+  static constexpr size_t kDefaultMinItems = 512;
+  unsigned chunks = 1;  // 1: no team
+  unsigned threads = 1;
+  size_t min_items = 0;
 };
 
 // Throws Error(kInvalidInput) for an invalid job or options, Error(kCancelled /
@@ -53,7 +68,7 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
 // locked flags and options.
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr,
-                             QuadricState* free_quadrics = nullptr);
+                             QuadricState* free_quadrics = nullptr, const JobTeam& team = {});
 
 // The options a job's metric is made with (Error(kInvalidInput) for invalid ones).
 SimplifyOptions simplify_options_of(const SubsetOptions& subset);

@@ -4,6 +4,7 @@
 // subsets' borders at coarse levels.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -298,21 +299,29 @@ TEST(ParallelBuild, SameBytesWhateverTheThreadCount) {
 }
 
 // The band passes' and the final pass's collapses that move many points project them, list
-// them and sum their moments on a team of threads (ParallelOptions::team_min_points): the
-// same PM whether every collapse does, none, or only the rich ones, on one thread or four;
-// and lossless. With colours, the points go where their attributes fit too (E_scalar).
-TEST(ParallelBuild, TheMastersTeamChangesNoByte) {
+// them and sum their moments on a team of threads (ParallelOptions::team_min_points), and so do
+// the jobs of a round with fewer subsets than p, each on a team of its own: the same PM whether
+// every collapse does, none, or only the rich ones, on one thread or four; and lossless. With
+// colours, the points go where their attributes fit too (E_scalar).
+TEST(ParallelBuild, TheTeamsChangeNoByte) {
   for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
     const RepairedMesh repaired = testing::repaired_test_mesh(name);
     SimplifyOptions options = metric_options("energy");
     options.samples_per_face = 4;
-    auto build = [&](uint32_t on_team, unsigned threads) {
+    auto build = [&](uint32_t on_team, unsigned threads, ParallelStats* stats = nullptr) {
       ParallelOptions parallel = with_p(4, threads);
       parallel.team_min_points = on_team;
-      return build_progressive_mesh_parallel(repaired, options, parallel);
+      parallel.min_subset_faces = 2000;  // rounds of 4 subsets, and of fewer at the tail
+      return build_progressive_mesh_parallel(repaired, options, parallel, stats);
     };
     const std::string none = testing::pm_bytes(build(0, 4));
-    EXPECT_TRUE(testing::pm_bytes(build(1, 4)) == none) << name << ": every collapse on the team";
+    ParallelStats stats;
+    EXPECT_TRUE(testing::pm_bytes(build(1, 4, &stats)) == none)
+        << name << ": every collapse on the team";
+    // (Rounds of fewer jobs than p: their jobs had teams.)
+    EXPECT_TRUE(std::any_of(stats.round_stats.begin(), stats.round_stats.end(),
+                            [](const RoundStats& r) { return r.subsets.size() < 4; }))
+        << name;
     EXPECT_TRUE(testing::pm_bytes(build(1, 1)) == none) << name << ": on one thread";
     const ProgressiveMesh rich = build(64, 3);
     EXPECT_TRUE(testing::pm_bytes(rich) == none) << name << ": the rich ones on the team";
