@@ -94,7 +94,7 @@ class ParallelBuilder {
   void append_pending();
   // What the team's loops so far took beyond their time with a core per chunk (seconds): the
   // critical path counts the latter.
-  double team_saving() const { return team_ ? team_->seconds() - team_->critical_seconds() : 0; }
+  double team_saving() const { return team_ ? team_->saved_seconds() : 0; }
   std::shared_ptr<const std::vector<uint32_t>> whole_components();
 
   // The build's inputs.

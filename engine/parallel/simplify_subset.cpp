@@ -153,7 +153,7 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   if (team) {
-    result.team_saved_seconds = team->seconds() - team->critical_seconds();
+    result.team_saved_seconds = team->saved_seconds();
     result.team_cpu_seconds = team->worker_cpu_seconds();
   }
   spdlog::debug(

@@ -38,6 +38,8 @@ class ThreadTeam {
   // each loop's slowest range (the parallel build's critical path).
   double seconds() const { return seconds_; }
   double critical_seconds() const { return critical_seconds_; }
+  // What the loops took beyond their time with a core per chunk: seconds() less that.
+  double saved_seconds() const { return seconds_ - critical_seconds_; }
   // CPU seconds the team's own threads (not the caller) spent in ranges.
   double worker_cpu_seconds() const;
 
