@@ -34,11 +34,11 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
     const RangeItems corners(corners_of_range, range, 3 * faces_.size());
     std::vector<uint32_t> valence(end - begin, 0);
     for (size_t j = 0; j < corners.size(); ++j) ++valence[vertex_of(corners[j]) - begin];
-    for (size_t v = begin; v < end; ++v) faces_of_[v].reserve(valence[v - begin]);
+    for (size_t v = begin; v < end; ++v) faces_of_.reserve_list(VertexId(v), valence[v - begin]);
     for (size_t j = 0; j < corners.size(); ++j)
-      faces_of_[vertex_of(corners[j])].push_back(FaceId(corners[j] / 3));
+      faces_of_.push(vertex_of(corners[j]), FaceId(corners[j] / 3));
     for (size_t v = begin; v < end; ++v) {
-      if (faces_of_[v].empty()) continue;
+      if (faces_of(VertexId(v)).empty()) continue;
       vertex_alive_[v] = 1;
       boundary_[v] = compute_boundary(VertexId(v));
     }
@@ -48,14 +48,14 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
 
 EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
   // Read off the shorter face list (a fan's hub holds hundreds).
-  const bool from_a = faces_of_[a].size() <= faces_of_[b].size();
+  const bool from_a = faces_of(a).size() <= faces_of(b).size();
   const VertexId from = from_a ? a : b, to = from_a ? b : a;
   EdgeFaces result;
   FaceId& onward = from_a ? result.left : result.right;  // the face holding from -> to
   VertexId& onward_apex = from_a ? result.left_apex : result.right_apex;
   FaceId& back = from_a ? result.right : result.left;  // the face holding to -> from
   VertexId& back_apex = from_a ? result.right_apex : result.left_apex;
-  for (FaceId f : faces_of_[from]) {
+  for (FaceId f : faces_of(from)) {
     const Triangle& t = faces_[f];
     const int i = corner_of(t, from);
     const VertexId next = t[(i + 1) % 3];
@@ -83,9 +83,9 @@ std::vector<FaceId> CollapseMesh::twin_faces(ChunkedLoops& loops) const {
     std::vector<std::pair<VertexId, FaceId>> fan;  // (the vertex before a, the face) around a
     for (size_t a = begin; a < end; ++a) {
       fan.clear();
-      for (FaceId f : faces_of_[a])
+      for (FaceId f : faces_of(VertexId(a)))
         fan.emplace_back(faces_[f][(corner_of(faces_[f], VertexId(a)) + 2) % 3], f);
-      for (FaceId f : faces_of_[a]) {
+      for (FaceId f : faces_of(VertexId(a))) {
         const int i = corner_of(faces_[f], VertexId(a));
         const VertexId next = faces_[f][(i + 1) % 3];
         // The face holding next -> a: next comes before a there (the last one, as edge_faces).
@@ -109,7 +109,7 @@ void CollapseMesh::neighbors(VertexId v, std::vector<VertexId>& out) const {
   out.clear();
   const uint32_t seen = next_stamp();
   mark_[v] = seen;
-  for (FaceId f : faces_of_[v])
+  for (FaceId f : faces_of(v))
     for (VertexId n : faces_[f])
       if (mark_[n] != seen) {
         mark_[n] = seen;
@@ -123,7 +123,7 @@ void CollapseMesh::neighbors(VertexId v, std::vector<VertexId>& out) const {
 // a_first to a_last != a_first), they differ by a_first - a_last. O(valence).
 bool CollapseMesh::compute_boundary(VertexId v) const {
   uint64_t next_sum = 0, prev_sum = 0;
-  for (FaceId f : faces_of_[v]) {
+  for (FaceId f : faces_of(v)) {
     const Triangle& t = faces_[f];
     const int i = corner_of(t, v);
     next_sum += t[(i + 1) % 3];
@@ -133,11 +133,8 @@ bool CollapseMesh::compute_boundary(VertexId v) const {
 }
 
 void CollapseMesh::remove_face_from(VertexId v, FaceId f) {
-  auto& list = faces_of_[v];
-  auto it = std::find(list.begin(), list.end(), f);
-  if (it == list.end()) throw_internal("collapse: face missing from its vertex's list");
-  *it = list.back();
-  list.pop_back();
+  if (!faces_of_.remove_swapping_last(v, f))
+    throw_internal("collapse: face missing from its vertex's list");
 }
 
 void CollapseMesh::count_removed(const RemovedCounts& removed) {
@@ -154,21 +151,19 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
     ++here.faces;
     for (VertexId v : faces_[f]) remove_face_from(v, f);
   }
-  auto& moved = faces_of_[vt];
-  for (FaceId f : moved) {
+  for (FaceId f : faces_of(vt)) {
     Triangle& t = faces_[f];
     t[corner_of(t, vt)] = vs;
-    faces_of_[vs].push_back(f);
+    faces_of_.push(vs, f);
   }
-  moved.clear();
-  moved.shrink_to_fit();
+  faces_of_.release(vt);
   vertex_alive_[vt] = 0;
   ++here.vertices;
   // The collapse of a component's last triangle (ComponentMinimum, when components may vanish)
   // leaves vs and the apex without faces: they stay in the mesh (the split that brings the
   // triangle back needs them) but are no longer alive, as alive means having faces.
   for (VertexId v : {vs, removed.left_apex, removed.right_apex})
-    if (v != kNoId && vertex_alive_[v] && faces_of_[v].empty()) {
+    if (v != kNoId && vertex_alive_[v] && faces_of(v).empty()) {
       vertex_alive_[v] = 0;
       ++here.vertices;
     }
@@ -182,12 +177,12 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
   boundary_[vt] = 0;
   // A legal collapse changes the boundary status of vs and of the apexes only.
   for (VertexId v : {vs, removed.left_apex, removed.right_apex})
-    if (v != kNoId) boundary_[v] = !faces_of_[v].empty() && compute_boundary(v);
+    if (v != kNoId) boundary_[v] = !faces_of(v).empty() && compute_boundary(v);
   // Every vertex whose star lost a face or holds vs: vs, vt, the apexes (an apex may keep no
   // face with vs) and the corners of vs's faces.
   for (VertexId v : {vs, vt, removed.left_apex, removed.right_apex})
     if (v != kNoId) ++star_version_[v];
-  for (FaceId f : faces_of_[vs])
+  for (FaceId f : faces_of(vs))
     for (VertexId v : faces_[f])
       if (v != vs) ++star_version_[v];
 }

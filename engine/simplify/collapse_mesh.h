@@ -7,14 +7,17 @@
 // ids for the whole run; a collapsed face is marked dead.
 //
 // Preconditions: the mesh is an oriented 2-manifold with boundary (repair_mesh output).
-// Memory: about 64 bytes per vertex plus 32 bytes per face beyond the input mesh.
+// Memory: about 100 bytes per vertex (a 64-byte face list, face_lists.h) plus 32 bytes per
+// face beyond the input mesh.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "mesh/mesh.h"
+#include "pm/face_lists.h"
 #include "util/chunked_loops.h"
 
 namespace parapm {
@@ -38,11 +41,18 @@ class CollapseMesh {
   size_t live_vertices() const { return live_vertices_; }
 
   bool vertex_alive(VertexId v) const { return vertex_alive_[v]; }  // has faces
+  void prefetch_vertex_alive(VertexId v) const { __builtin_prefetch(&vertex_alive_[v]); }
+  // Starts loading v's position and face list.
+  void prefetch_vertex(VertexId v) const {
+    __builtin_prefetch(&positions_[v]);
+    faces_of_.prefetch(v);
+  }
   bool face_alive(FaceId f) const { return face_alive_[f]; }
   const Triangle& face(FaceId f) const { return faces_[f]; }
   const std::array<WedgeId, 3>& corner_wedges(FaceId f) const { return corner_wedges_[f]; }
   bool has_wedges() const { return !corner_wedges_.empty(); }
-  const std::vector<FaceId>& faces_of(VertexId v) const { return faces_of_[v]; }
+  // The faces around v, valid until a collapse changes v's star.
+  std::span<const FaceId> faces_of(VertexId v) const { return faces_of_.of(v); }
   const Vec3& position(VertexId v) const { return positions_[v]; }
   const std::vector<Vec3>& positions() const { return positions_; }  // removed ones included
   bool is_boundary(VertexId v) const { return boundary_[v]; }
@@ -67,10 +77,10 @@ class CollapseMesh {
   template <typename Visit>
   void for_each_common_neighbor(VertexId a, VertexId b, Visit visit) const {
     const uint32_t seen = next_stamp();
-    for (FaceId f : faces_of_[a])
+    for (FaceId f : faces_of(a))
       for (VertexId n : faces_[f]) mark_[n] = seen;
     const uint32_t done = next_stamp();
-    for (FaceId f : faces_of_[b])
+    for (FaceId f : faces_of(b))
       for (VertexId n : faces_[f])
         if (n != a && n != b && mark_[n] == seen) {
           mark_[n] = done;
@@ -103,7 +113,7 @@ class CollapseMesh {
   std::vector<std::array<WedgeId, 3>> corner_wedges_;
   std::vector<uint8_t> face_alive_;
   std::vector<uint8_t> vertex_alive_;  // a byte per vertex: the queue checks it on every pop
-  std::vector<std::vector<FaceId>> faces_of_;
+  FaceLists faces_of_;
   std::vector<uint8_t> boundary_;
   std::vector<uint32_t> star_version_;
   // Drawn anew by every construction, copy and assignment.

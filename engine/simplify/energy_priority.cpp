@@ -304,7 +304,7 @@ void EnergyPriority::prepare_fan(const CollapseMesh& mesh, VertexId vs) {
 // (a point on a seam is as close to the faces of both sides and belongs to the side whose
 // attributes it has); the distance is a lower bound of that too.
 std::pair<int, Projection> EnergyPriority::closest_fan_face(const CollapseMesh& mesh,
-                                                            const std::vector<FaceId>& faces,
+                                                            std::span<const FaceId> faces,
                                                             const FacePoint& point,
                                                             int home) const {
   const Vec3& x = point.position;

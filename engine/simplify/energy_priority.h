@@ -75,6 +75,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -251,8 +252,8 @@ class EnergyPriority : public PriorityModule {
 
   void prepare_fan(const CollapseMesh& mesh, VertexId vs);
   std::pair<int, Projection> closest_fan_face(const CollapseMesh& mesh,
-                                              const std::vector<FaceId>& faces,
-                                              const FacePoint& point, int home) const;
+                                              std::span<const FaceId> faces, const FacePoint& point,
+                                              int home) const;
   void update_attributes(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge);
   // The stored squared distance of a point of face f, raised by f's drift (an upper bound).
   double bounded_distance_sq(FaceId f, const FacePoint& p) const {

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,10 @@ class PriorityModule {
   // pieces (the energy's point projections), with the same results as on one thread; null
   // (the default): none. The team outlives the module, or its use ends with use_team(nullptr).
   virtual void use_team(ThreadTeam* /*team*/) {}
+  // A hint: the edges from `from` to each of `to` are costed next. A module whose costings
+  // read per-vertex state scattered in memory may start loading it now, so that the loads
+  // overlap instead of waiting one after another. No effect on any result (the default: none).
+  virtual void will_cost(VertexId /*from*/, std::span<const VertexId> /*to*/) const {}
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every
@@ -110,6 +115,9 @@ class PriorityWrapper : public PriorityModule {
   uint64_t costings() const override { return inner_.costings(); }
   void release_caches() override { inner_.release_caches(); }
   void use_team(ThreadTeam* team) override { inner_.use_team(team); }
+  void will_cost(VertexId from, std::span<const VertexId> to) const override {
+    inner_.will_cost(from, to);
+  }
   void initialize(const CollapseMesh& mesh) override { inner_.initialize(mesh); }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override {

@@ -90,7 +90,7 @@ bool QuadricPriority::sum_by_vertex(const CollapseMesh& mesh, const std::vector<
   std::atomic<bool> in_order{true};
   loops.run(mesh.vertex_capacity(), [&](size_t begin, size_t end) {
     for (size_t v = begin; v < end; ++v) {
-      const std::vector<FaceId>& fan = mesh.faces_of(VertexId(v));
+      const std::span<const FaceId> fan = mesh.faces_of(VertexId(v));
       if (!std::is_sorted(fan.begin(), fan.end()) ||
           std::adjacent_find(fan.begin(), fan.end()) != fan.end()) {
         in_order = false;
@@ -260,6 +260,17 @@ class QuadricCostingView : public PriorityModule {
 
 std::unique_ptr<PriorityModule> QuadricPriority::costing_view() const {
   return std::make_unique<QuadricCostingView>(*this);
+}
+
+void QuadricPriority::will_cost(VertexId from, std::span<const VertexId> to) const {
+  auto prefetch = [&](VertexId v) {
+    const char* q = reinterpret_cast<const char*>(&quadrics_[v]);
+    __builtin_prefetch(q);
+    __builtin_prefetch(q + sizeof(Quadric) - 1);
+    if (!locked_.empty()) __builtin_prefetch(&locked_[v]);
+  };
+  prefetch(from);
+  for (VertexId v : to) prefetch(v);
 }
 
 void QuadricPriority::collapsed(const CollapseMesh&, CollapseCandidate& done, const EdgeFaces&) {

@@ -53,6 +53,8 @@ class QuadricPriority : public PriorityModule {
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                      CollapseCandidate& out, Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
+  // Prefetches the quadrics (two cache lines each) and lock flags of `from` and `to`.
+  void will_cost(VertexId from, std::span<const VertexId> to) const override;
   uint64_t costings() const override { return costings_; }
   std::unique_ptr<PriorityModule> costing_view() const override;
 

@@ -43,7 +43,8 @@ void Simplifier::push_edge(VertexId a, VertexId b) {
 
 bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   if (a > b) std::swap(a, b);
-  CollapseCandidate candidate;
+  CollapseCandidate& candidate = queued_;
+  candidate.seam = false;
   if (!cost_edge(a, b, candidate, Costing::kQueue)) {
     // Refused (a job's subset rule or cost ceiling, locked ends): once its star changes it is
     // deferred to the end of the queue, not costed at once to be refused again.
@@ -235,6 +236,7 @@ CollapseRecord Simplifier::perform(CollapseCandidate c, const EdgeFaces& edge) {
 void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits& limits) {
   ++version_[vs];
   mesh_.neighbors(vs, ring_);
+  priority_.will_cost(vs, ring_);
   // Edges vetoed earlier around the changed star may be legal now: cost them again, after
   // the edges of vs. All are taken off the lists first: a push may veto its edge again, onto
   // the lists (screening).
@@ -559,6 +561,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
     if (queue_.size() > std::max<size_t>(2 * mesh_.live_faces() + 1024, 2 * compacted_size_))
       compact_queue();
     const Entry entry = queue_.pop();
+    if (const Entry* next = queue_.peek()) prefetch_staleness(*next);
     if (is_stale(entry)) {
       ++stats_.stale;
       continue;
@@ -600,6 +603,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.stale;
       continue;
     }
+    // (the collapse edits the apexes' face lists: loaded while the rules are checked)
+    for (VertexId apex : {edge.left_apex, edge.right_apex})
+      if (apex != kNoId) mesh_.prefetch_vertex(apex);
     // Its key was under the ceiling (a float, or a star changed since) but its cost is not:
     // left out of the queue, like an edge refused, until its star changes; its key stays
     // remembered for a deferral.

@@ -236,6 +236,17 @@ class Simplifier {
     return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
            version_[entry.a] + version_[entry.b] != (entry.stamp & kVersions);
   }
+  // Starts loading what is_stale(entry) reads: the entry next in line, while this one is
+  // handled (most entries that come out are stale, each check a cache miss otherwise).
+  void prefetch_staleness(const Entry& entry) const {
+    mesh_.prefetch_vertex_alive(entry.a);
+    mesh_.prefetch_vertex_alive(entry.b);
+    __builtin_prefetch(&version_[entry.a]);
+    __builtin_prefetch(&version_[entry.b]);
+    mesh_.prefetch_vertex(entry.a);
+    mesh_.prefetch_vertex(entry.b);
+    priority_.will_cost(entry.a, std::span(&entry.b, 1));
+  }
   void compact_queue();
   // All constraints; with topology_checked, those that are not topological(); with
   // star_checked (a kept requeued candidate, which passed them all, its star unchanged since),
@@ -321,6 +332,9 @@ class Simplifier {
   std::vector<std::unique_ptr<ConstraintModule>> seam_rules_;  // neighbourhood_constraints()
   uint32_t seam_stamp_ = 0;
   std::vector<VertexId> ring_, seam_ring_;
+  // queue_entry's costing, reused: a queue key reads only its cost, and a fresh candidate's
+  // zeroing cost as much as a cheap costing.
+  CollapseCandidate queued_;
   std::vector<std::pair<VertexId, VertexId>> retry_;
   SimplifierStats stats_;
 };

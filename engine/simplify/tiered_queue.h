@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <vector>
@@ -61,6 +62,8 @@ class TieredQueue {
     if (heap_.empty()) refill();
     return heap_.pop();
   }
+  // The item pop() returns next when the heap holds it already (no refill), else null.
+  const T* peek() const { return heap_.empty() ? nullptr : &heap_.top(); }
 
   template <typename Visit>
   void for_each(Visit visit) const {
@@ -94,9 +97,13 @@ class TieredQueue {
   using Items = std::vector<T, ChildLineAllocator<T>>;  // the heap's array, swapped in whole
   static constexpr size_t kBlock = 8192;                // items per block of the open bucket
 
-  // The range from `first` on whose keys take `key`; bounds_.size(): the open bucket.
+  // The range from `first` on whose keys take `key`; bounds_.size(): the open bucket. The
+  // first bound not below the key (bounds ascend), found by counting those below it: at most
+  // kParts - 1 compares without a branch, where a binary search mispredicts at every step.
   size_t range_of(float key, size_t first) const {
-    return size_t(std::lower_bound(bounds_.begin() + first, bounds_.end(), key) - bounds_.begin());
+    size_t i = first;
+    for (size_t k = first; k < bounds_.size(); ++k) i += bounds_[k] < key;
+    return i;
   }
   void push_open(const T& item) {
     if (open_.empty() || open_.back().size() == kBlock) {
@@ -160,13 +167,16 @@ class TieredQueue {
       if (bounds_.empty() || bound > bounds_.back()) bounds_.push_back(bound);
     }
     std::vector<size_t> counts(bounds_.size() + 1, 0);
+    range_index_.resize(count);
+    size_t at = 0;
     for (const Items& block : blocks)
-      for (const T& item : block) ++counts[range_of(item.cost, 0)];
+      for (const T& item : block) ++counts[range_index_[at++] = uint8_t(range_of(item.cost, 0))];
     ranges_.resize(bounds_.size());
     for (size_t i = 0; i < ranges_.size(); ++i) ranges_[i].reserve(counts[i]);
+    at = 0;
     for (Items& block : blocks) {
       for (const T& item : block) {
-        const size_t i = range_of(item.cost, 0);
+        const size_t i = range_index_[at++];
         if (i < ranges_.size())
           ranges_[i].push_back(item);
         else
@@ -178,6 +188,7 @@ class TieredQueue {
 
   static constexpr size_t kSample = 1024;
   static constexpr size_t kParts = 16;
+  static_assert(kParts <= 256, "a range index is a byte");
   QuadHeap<T, Before> heap_;
   float threshold_ = -std::numeric_limits<float>::infinity();  // the heap's keys are at most it
   // ranges_[i] holds the keys in (bounds_[i - 1], bounds_[i]] (the first from threshold_); the
@@ -185,9 +196,10 @@ class TieredQueue {
   std::vector<float> bounds_;
   std::vector<Items> ranges_;
   std::vector<Items> open_;
-  size_t next_ = 0;            // the first range not yet moved to the heap
-  size_t bucketed_ = 0;        // the items in ranges and the open bucket
-  std::vector<float> sample_;  // cut_open's working memory
+  size_t next_ = 0;                   // the first range not yet moved to the heap
+  size_t bucketed_ = 0;               // the items in ranges and the open bucket
+  std::vector<float> sample_;         // cut_open's working memory
+  std::vector<uint8_t> range_index_;  // and each item's range (kParts fit a byte)
   std::function<bool(const T&)> dead_;
 };
 
