@@ -22,6 +22,7 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
   vertex_alive_.assign(mesh.positions.size(), 0);
   faces_of_.resize(mesh.positions.size());
   boundary_.assign(mesh.positions.size(), 0);
+  imbalance_.assign(mesh.positions.size(), 0);
   star_version_.assign(mesh.positions.size(), 0);
   identity_ = Identity();
   live_faces_ = mesh.faces.size();
@@ -40,7 +41,8 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
     for (size_t v = begin; v < end; ++v) {
       if (faces_of(VertexId(v)).empty()) continue;
       vertex_alive_[v] = 1;
-      boundary_[v] = compute_boundary(VertexId(v));
+      imbalance_[v] = fan_imbalance(VertexId(v));
+      boundary_[v] = imbalance_[v] != 0;
     }
   });
   live_vertices_ = size_t(std::count(vertex_alive_.begin(), vertex_alive_.end(), 1));
@@ -121,7 +123,7 @@ void CollapseMesh::neighbors(VertexId v, std::vector<VertexId>& out) const {
 // manifold the faces (v, a, b) around v form a fan: closed, every "next" corner a is also the
 // "previous" corner b of the face before it, so the two id sums agree; open (a chain from
 // a_first to a_last != a_first), they differ by a_first - a_last. O(valence).
-bool CollapseMesh::compute_boundary(VertexId v) const {
+uint64_t CollapseMesh::fan_imbalance(VertexId v) const {
   uint64_t next_sum = 0, prev_sum = 0;
   for (FaceId f : faces_of(v)) {
     const Triangle& t = faces_[f];
@@ -129,7 +131,7 @@ bool CollapseMesh::compute_boundary(VertexId v) const {
     next_sum += t[(i + 1) % 3];
     prev_sum += t[(i + 2) % 3];
   }
-  return next_sum != prev_sum;
+  return next_sum - prev_sum;
 }
 
 void CollapseMesh::remove_face_from(VertexId v, FaceId f) {
@@ -149,13 +151,25 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
     if (f == kNoId) continue;
     face_alive_[f] = 0;
     ++here.faces;
-    for (VertexId v : faces_[f]) remove_face_from(v, f);
+    const Triangle& t = faces_[f];
+    for (int k = 0; k < 3; ++k) {
+      remove_face_from(t[k], f);
+      imbalance_[t[k]] -= uint64_t(t[(k + 1) % 3]) - t[(k + 2) % 3];
+    }
   }
+  // vt's corners become vs's, with what they add to the sums; the corner after vt in a face
+  // has vs before it now, the corner before vt has vs after it.
+  const uint64_t step = uint64_t(vs) - vt;
   for (FaceId f : faces_of(vt)) {
     Triangle& t = faces_[f];
-    t[corner_of(t, vt)] = vs;
+    const int k = corner_of(t, vt);
+    t[k] = vs;
+    imbalance_[t[(k + 1) % 3]] -= step;
+    imbalance_[t[(k + 2) % 3]] += step;
     faces_of_.push(vs, f);
   }
+  imbalance_[vs] += imbalance_[vt];
+  imbalance_[vt] = 0;
   faces_of_.release(vt);
   vertex_alive_[vt] = 0;
   ++here.vertices;
@@ -177,7 +191,7 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
   boundary_[vt] = 0;
   // A legal collapse changes the boundary status of vs and of the apexes only.
   for (VertexId v : {vs, removed.left_apex, removed.right_apex})
-    if (v != kNoId) boundary_[v] = !faces_of(v).empty() && compute_boundary(v);
+    if (v != kNoId) boundary_[v] = imbalance_[v] != 0;
   // Every vertex whose star lost a face or holds vs: vs, vt, the apexes (an apex may keep no
   // face with vs) and the corners of vs's faces.
   for (VertexId v : {vs, vt, removed.left_apex, removed.right_apex})

@@ -7,7 +7,7 @@
 // ids for the whole run; a collapsed face is marked dead.
 //
 // Preconditions: the mesh is an oriented 2-manifold with boundary (repair_mesh output).
-// Memory: about 100 bytes per vertex (a 64-byte face list, face_lists.h) plus 32 bytes per
+// Memory: about 110 bytes per vertex (a 64-byte face list, face_lists.h) plus 32 bytes per
 // face beyond the input mesh.
 #pragma once
 
@@ -106,7 +106,9 @@ class CollapseMesh {
   void build(const Mesh& mesh, ChunkedLoops& loops);
   void remove_face_from(VertexId v, FaceId f);
   uint32_t next_stamp() const;
-  bool compute_boundary(VertexId v) const;
+  // Over v's faces, the sum of the corners after v less the sum of the corners before it (ids,
+  // modulo 2^64): not 0 exactly when v is on the boundary (see compute_boundary's comment).
+  uint64_t fan_imbalance(VertexId v) const;
 
   std::vector<Vec3> positions_;
   std::vector<Triangle> faces_;
@@ -115,6 +117,10 @@ class CollapseMesh {
   std::vector<uint8_t> vertex_alive_;  // a byte per vertex: the queue checks it on every pop
   FaceLists faces_of_;
   std::vector<uint8_t> boundary_;
+  // Per vertex, fan_imbalance() as collapses change it (a few corners each), so that the
+  // apexes' boundary status needs no pass over their faces: boundary_[v] is imbalance_[v] != 0
+  // for vs and the apexes after each collapse.
+  std::vector<uint64_t> imbalance_;
   std::vector<uint32_t> star_version_;
   // Drawn anew by every construction, copy and assignment.
   struct Identity {

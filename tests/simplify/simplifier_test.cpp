@@ -182,6 +182,39 @@ TEST(Simplifier, AFlatGridSimplifiesWithoutAHub) {
               (unsigned long long)simplifier.stats().rejected);
 }
 
+TEST(Simplifier, BoundaryFlagsAfterCollapsesAreThoseOfTheMeshBuiltAnew) {
+  // A grid with a square hole: an outer and an inner border. The flags collapses keep up to
+  // date (vs's and the apexes') must agree, for every vertex left, with a mesh built from the
+  // live faces, and so must the faces around every vertex.
+  const int n = 20;
+  const Mesh grid = jittered_flat_grid(n);
+  Mesh holed;
+  holed.positions = grid.positions;
+  for (size_t f = 0; f < grid.faces.size(); ++f) {
+    const int cell = int(f / 2), i = cell % (n - 1), j = cell / (n - 1);
+    if (i >= 7 && i < 11 && j >= 7 && j < 11) continue;
+    holed.faces.push_back(grid.faces[f]);
+  }
+  for (const size_t target : {holed.face_count() / 2, holed.face_count() / 8, size_t(20)}) {
+    CollapseMesh cm(holed);
+    simplify(holed, target, cm);
+    Mesh live;
+    live.positions = holed.positions;
+    for (FaceId f = 0; f < cm.face_capacity(); ++f)
+      if (cm.face_alive(f)) live.faces.push_back(cm.face(f));
+    const CollapseMesh anew(live);
+    size_t on_border = 0;
+    for (VertexId v = 0; v < cm.vertex_capacity(); ++v) {
+      ASSERT_EQ(cm.vertex_alive(v), anew.vertex_alive(v)) << "target " << target << " vertex " << v;
+      if (!cm.vertex_alive(v)) continue;
+      EXPECT_EQ(cm.is_boundary(v), anew.is_boundary(v)) << "target " << target << " vertex " << v;
+      EXPECT_EQ(cm.faces_of(v).size(), anew.faces_of(v).size()) << "target " << target;
+      on_border += cm.is_boundary(v);
+    }
+    EXPECT_GT(on_border, 0u);
+  }
+}
+
 // The first key's edge costs more now than the next key: it goes back in the queue with
 // its present cost, and the cheaper collapses come first.
 TEST(Simplifier, AnEdgeWhoseCostGrewGoesBackInTheQueue) {
