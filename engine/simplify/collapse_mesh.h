@@ -107,7 +107,7 @@ class CollapseMesh {
   void remove_face_from(VertexId v, FaceId f);
   uint32_t next_stamp() const;
   // Over v's faces, the sum of the corners after v less the sum of the corners before it (ids,
-  // modulo 2^64): not 0 exactly when v is on the boundary (see compute_boundary's comment).
+  // modulo 2^64): not 0 exactly when v is on the boundary (the reason at its definition).
   uint64_t fan_imbalance(VertexId v) const;
 
   std::vector<Vec3> positions_;
