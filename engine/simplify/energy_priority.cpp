@@ -118,7 +118,44 @@ void EnergyPriority::unpark(VertexId v) {
   const uint32_t id = parked_point_[v];
   if (id == kNoPoint) return;
   parked_point_[v] = kNoPoint;
-  moved_.points.push_back(parked(id));
+  moved_.sources.push_back({kNoId, -1, false, moved_.count, parked(id)});
+  ++moved_.count;
+}
+
+void EnergyPriority::take(FaceId f, int home, bool removed) {
+  moved_.sources.push_back({f, home, removed, moved_.count, {}});
+  moved_.count += face_points_[f].size();
+  evaluator_.forget(f);
+  drift_[f] = 0;
+}
+
+void EnergyPriority::move_taken_points() {
+  const size_t count = moved_.count;
+  for (auto* buffer : {&moved_.homes, &moved_.in_fan})
+    if (buffer->size() < count) buffer->resize(count);
+  if (moved_.points.size() < count) moved_.points.resize(count);
+  if (moved_.faces.size() < count) moved_.faces.resize(count);
+  if (moved_.bary.size() < count) moved_.bary.resize(count);
+  auto move = [&](size_t begin, size_t end) {
+    for (size_t s = begin; s < end; ++s) {
+      const Reprojection::Source& source = moved_.sources[s];
+      if (source.face == kNoId) {
+        moved_.points[source.at] = source.sample;
+        moved_.homes[source.at] = source.home;
+        continue;
+      }
+      std::vector<FacePoint>& list = face_points_[source.face];
+      std::copy(list.begin(), list.end(), moved_.points.begin() + ptrdiff_t(source.at));
+      std::fill_n(moved_.homes.begin() + ptrdiff_t(source.at), list.size(), source.home);
+      list.clear();
+      if (source.removed) list.shrink_to_fit();
+    }
+  };
+  if (team_ && count >= team_->min_items()) {
+    team_->run(moved_.sources.size(), move);
+  } else {
+    move(0, moved_.sources.size());
+  }
 }
 
 // E_scalar after a performed collapse: the wedges joined for good, the star's wedges given the
@@ -139,7 +176,7 @@ void EnergyPriority::update_attributes(const CollapseMesh& mesh, CollapseCandida
     const auto& w = mesh.corner_wedges(f);
     return std::array<WedgeId, 3>{w[k], w[(k + 1) % 3], w[(k + 2) % 3]};
   };
-  for (size_t i = 0; i < moved_.points.size(); ++i) {
+  for (size_t i = 0; i < moved_.count; ++i) {
     const FaceId f = moved_.faces[i];
     const int k = corner_of(mesh.face(f), done.vs);
     const auto& b = moved_.bary[i];
@@ -148,7 +185,7 @@ void EnergyPriority::update_attributes(const CollapseMesh& mesh, CollapseCandida
                 b[(k + 2) % 3]);
   }
   scalar_.apply(done.changed_wedges, done.changed_values);
-  for (size_t i = 0; i < moved_.points.size(); ++i) {
+  for (size_t i = 0; i < moved_.count; ++i) {
     const FaceId f = moved_.faces[i];
     const uint32_t id = moved_.points[i].id;
     scalar_.set_residual(id, scalar_.residual_against(id, mesh.corner_wedges(f), moved_.bary[i]));
@@ -171,34 +208,27 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
       if (corner_of(mesh.face(faces[j]), corner) >= 0) return int(j);
     return -1;
   };
-  moved_.points.clear();
-  moved_.homes.clear();
-  auto take = [&](FaceId f, int home) {
-    auto& list = face_points_[f];
-    moved_.points.insert(moved_.points.end(), list.begin(), list.end());
-    moved_.homes.insert(moved_.homes.end(), list.size(), home);
-    list.clear();
-    evaluator_.forget(f);
-    drift_[f] = 0;
-  };
+  // The points that move, in this order: the removed faces', the fan's (unless it keeps
+  // them), the unparked samples, the fan's faces that drifted. Listed first, moved after.
+  moved_.sources.clear();
+  moved_.count = 0;
   for (const auto& [removed, apex] :
        {std::pair{edge.left, edge.left_apex}, std::pair{edge.right, edge.right_apex}})
-    if (removed != kNoId) {
-      // (Its stored distances may lag: moved again, each point's is computed anew.)
-      take(removed, index_of(apex));
-      face_points_[removed].shrink_to_fit();
-    }
+    if (removed != kNoId)  // (its stored distances may lag: moved, each is computed anew)
+      take(removed, index_of(apex), true);
   if (!keep_faces)
-    for (size_t j = 0; j < faces.size(); ++j) take(faces[j], int(j));
+    for (size_t j = 0; j < faces.size(); ++j) take(faces[j], int(j), false);
   unpark(done.vt);
   const uint32_t vs_sample = parked_point_[done.vs];
   // vs's own sample stays exact while vs stays put, unless E_scalar gives its wedges new
   // values.
   if (vs_sample != kNoPoint && (positions_[vs_sample] != done.position || scalar_.enabled()))
     unpark(done.vs);
-  moved_.homes.resize(moved_.points.size(), -1);  // the unparked samples: no home
   double max_distance_sq = curves_.collapsed(done.vs, done.vt, mesh);
-  if (faces.empty()) return;
+  if (faces.empty()) {
+    move_taken_points();  // (the lists of a component's last faces emptied)
+    return;
+  }
   if (keep_faces) {
     // A point's closest point on a face of the fan is b0 v + b1 p1 + b2 p2, with v where vs
     // or vt was: it moves by at most b0 |v - old|.
@@ -211,7 +241,7 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
       // A face whose corners have moved by more than a quarter of its size since its points
       // were projected no longer lies over them: they are projected again.
       if (drift_[f] + shift > 0.25 * face_size(mesh, f)) {
-        take(f, int(j));
+        take(f, int(j), false);
         continue;
       }
       // The points are the same (their moments too), the corners not.
@@ -221,13 +251,11 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
       max_distance_sq = std::max(max_distance_sq, bound * bound);
     }
   }
+  move_taken_points();
   prepare_fan(mesh, done.vs);
-  const size_t moving = moved_.points.size();
-  moved_.faces.resize(moving);
-  moved_.bary.resize(moving);
+  const size_t moving = moved_.count;
   // Each point's face and projection, independent of the others': on the team when there
   // are enough of them.
-  moved_.in_fan.resize(moving);
   auto project = [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       FacePoint& point = moved_.points[i];
@@ -242,20 +270,25 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   if (team_ && moving >= team_->min_items()) {
     team_->run(moving, project);
     // By face on the team: its points, then its moments, which the next costings of the
-    // edges around vs need (a star this rich is costed on them).
+    // edges around vs need (a star this rich is costed on them), and their largest distance
+    // (every point goes to a face of the fan).
+    moved_.fan_max_sq.assign(faces.size(), 0.0);
     team_->run(faces.size(), [&](size_t begin, size_t end) {
       for (size_t j = begin; j < end; ++j) {
         bool gained = false;
+        double largest_sq = 0;
         for (size_t i = moving; i-- > 0;)
           if (moved_.in_fan[i] == int(j)) {
             face_points_[faces[j]].push_back(moved_.points[i]);
+            largest_sq = std::max(largest_sq, moved_.points[i].distance_sq);
             gained = true;
           }
         if (gained) evaluator_.recompute(faces[j]);
+        moved_.fan_max_sq[j] = largest_sq;
       }
     });
-    for (const FacePoint& point : moved_.points)
-      max_distance_sq = std::max(max_distance_sq, point.distance_sq);
+    for (double largest_sq : moved_.fan_max_sq)
+      max_distance_sq = std::max(max_distance_sq, largest_sq);
   } else {
     project(0, moving);
     for (size_t i = moving; i-- > 0;) {

@@ -261,7 +261,14 @@ class EnergyPriority : public PriorityModule {
     const double d = std::sqrt(p.distance_sq) + drift_[f];
     return d * d;
   }
+  // collapsed()'s plan of the points that move (Reprojection::sources): v's parked sample;
+  // face f's points (its moments and drift dropped now), `home` the index of f's image among
+  // vs's faces, `removed` for a face the collapse removes. move_taken_points() moves them.
   void unpark(VertexId v);
+  void take(FaceId f, int home, bool removed);
+  // The planned points into the first Reprojection::count of Reprojection::points, their
+  // faces emptied: on the team when there are enough of them.
+  void move_taken_points();
   FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
   double diagonal_of(const CollapseMesh& mesh) const;
   void initialize_curves(const CollapseMesh& mesh, ChunkedLoops& loops);  // curves_ only
@@ -299,6 +306,19 @@ class EnergyPriority : public PriorityModule {
     Vec3 normal{};      // unit (0 for a degenerate face)
   };
   struct Reprojection {
+    // Where the points come from, in order: a face's whole list, or one sample (face kNoId),
+    // starting at index `at` of points.
+    struct Source {
+      FaceId face;
+      int home;
+      bool removed;
+      size_t at;
+      FacePoint sample;
+    };
+    std::vector<Source> sources;
+    // The points moving are the first `count` of each per-point buffer (buffers that only
+    // grow: filled on the team, not constructed again at each collapse).
+    size_t count = 0;
     std::vector<FacePoint> points;
     // Per point: the index among vs's faces of its old face's image (-1: an unparked sample).
     std::vector<int> homes;
@@ -307,6 +327,7 @@ class EnergyPriority : public PriorityModule {
     std::vector<int> in_fan;                  // per point, its new face's index among vs's
     std::vector<FaceId> faces;                // and the face
     std::vector<std::array<double, 3>> bary;  // and its barycentric coordinates there
+    std::vector<double> fan_max_sq;           // per face of the fan: its points' largest distance
   };
   Reprojection moved_;
   // check_global's marks: (generation << 10) | (subset << 1) | given. Each check writes its own
