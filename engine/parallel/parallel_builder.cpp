@@ -41,9 +41,32 @@ struct LiveCopy {
   Mesh mesh;
   std::vector<VertexId> compact;
 };
+// The repaired mesh as a CollapseMesh built from it first shows it (every face alive, a
+// vertex alive while a face holds it), for the first round's live copy before that build.
+class FreshMesh {
+ public:
+  explicit FreshMesh(const Mesh& mesh) : mesh_(mesh), held_(mesh.positions.size(), 0) {
+    for (const Triangle& t : mesh.faces)
+      for (VertexId v : t) held_[v] = 1;
+  }
+  size_t vertex_capacity() const { return mesh_.positions.size(); }
+  size_t face_capacity() const { return mesh_.faces.size(); }
+  bool vertex_alive(VertexId v) const { return held_[v]; }
+  bool face_alive(FaceId) const { return true; }
+  const Vec3& position(VertexId v) const { return mesh_.positions[v]; }
+  const Triangle& face(FaceId f) const { return mesh_.faces[f]; }
+  size_t live_vertices() const { return size_t(std::count(held_.begin(), held_.end(), 1)); }
+
+ private:
+  const Mesh& mesh_;
+  std::vector<uint8_t> held_;
+};
+
 // In `loops`' chunks: the live vertices numbered per range (a group's first live copy numbers
-// it), then the others of a group given its number, then the live faces.
-LiveCopy live_copy(const CollapseMesh& mesh, const CopyGroups& groups, ChunkedLoops& loops) {
+// it), then the others of a group given its number, then the live faces. `Source`: a
+// CollapseMesh, or a FreshMesh (the copy a CollapseMesh just built from it would give).
+template <class Source>
+LiveCopy live_copy(const Source& mesh, const CopyGroups& groups, ChunkedLoops& loops) {
   // The live vertex whose number v takes: itself, or its group's first live copy.
   auto numbered_as = [&](VertexId v) {
     if (!groups.is_copy(v)) return v;
@@ -314,7 +337,8 @@ uint64_t border_bounded_goal(uint64_t faces, uint64_t border, double excess) {
 
 // A live copy of the mesh and its partition graph, for several partitions of the same mesh.
 struct ParallelBuilder::LiveGraph {
-  LiveGraph(const CollapseMesh& mesh, const CopyGroups& groups, ChunkedLoops& loops)
+  template <class Source>
+  LiveGraph(const Source& mesh, const CopyGroups& groups, ChunkedLoops& loops)
       : live(live_copy(mesh, groups, loops)), graph(live.mesh, Balance::kFaces, &loops) {}
   // Per vertex of the mesh, its subset (subsets_of_copied).
   std::vector<uint32_t> draw(uint32_t p, const PartitionOptions& options) const {
@@ -369,52 +393,61 @@ void ParallelBuilder::set_up() {
   // The passes over the whole mesh run in p chunks: with a core per subset (the critical
   // path's assumption) each pass takes its slowest chunk.
   ChunkedLoops loops(requested_.subsets, requested_.threads);
-  const LoopClock before_clock(loops);
-  whole_.emplace(mesh_, loops);
-  CollapseMesh& whole = *whole_;
+  const LoopClock start_clock(loops);
   master_ = make_priority_module(options_, mesh_, locked_);
   if (master_->costly() && requested_.team_min_points > 0) {
     team_.emplace(requested_.subsets, requested_.threads, requested_.team_min_points);
     master_->use_team(&*team_);
   }
   parallel_ = with_metric_floor(requested_, *master_);
-  // The first round's partition needs the mesh only: it is drawn beside the master's
-  // initialisation, which reads `whole` too (none through its marks).
-  const uint32_t first_subsets = round_subsets(parallel_, whole.live_faces());
-  first_round_ = first_subsets >= std::min(2u, parallel_.subsets) &&
-                 whole.live_vertices() >= 4 * size_t(first_subsets) &&
-                 whole.live_faces() > handover_;
-  const double before_seconds = before_clock.critical_seconds();
+  const double start_seconds = start_clock.critical_seconds();
+  // The first round's partition needs the repaired mesh only: it is drawn beside the whole
+  // mesh's build and the master's initialisation, on the mesh as that build shows it
+  // (first_round_ repeats the round's plan there).
+  const uint32_t first_subsets = round_subsets(parallel_, mesh_.face_count());
+  const bool may_partition = first_subsets >= std::min(2u, parallel_.subsets) &&
+                             mesh_.vertex_count() >= 4 * size_t(first_subsets) &&
+                             mesh_.face_count() > handover_;
+  bool first_round = false;
   auto partition_first_round = [&] {
     const LoopClock clock(master_loops_);
-    auto source = std::make_shared<const LiveGraph>(whole, copy_groups_, master_loops_);
+    const FreshMesh fresh(mesh_);
+    first_round = fresh.live_vertices() >= 4 * size_t(first_subsets);
+    if (!first_round) return;
+    auto source = std::make_shared<const LiveGraph>(fresh, copy_groups_, master_loops_);
     PartitionOptions partition_options;
     partition_options.seed = round_seed(options_.seed, 0);
     partition_options.loops = &master_loops_;
     first_partition_ = source->draw(first_subsets, partition_options);
     first_partition_seconds_ = clock.critical_seconds();
-    if (parallel_.early_partition) draw_round_one(std::move(source), first_subsets, before_seconds);
+    if (parallel_.early_partition) draw_round_one(std::move(source), first_subsets, start_seconds);
   };
+  double build_seconds = 0, initialize_seconds = 0;
   run_beside(
       parallel_.threads,
       [&] {
+        const LoopClock build_clock(loops);
+        whole_.emplace(mesh_, loops);
+        build_seconds = build_clock.critical_seconds();
         const LoopClock clock(loops);
-        master_->initialize_in_chunks(whole, loops);
-        initialize_seconds_ = clock.critical_seconds();
+        master_->initialize_in_chunks(*whole_, loops);
+        initialize_seconds = clock.critical_seconds();
       },
-      first_round_ ? std::vector<std::function<void()>>{partition_first_round}
-                   : std::vector<std::function<void()>>{});
+      may_partition ? std::vector<std::function<void()>>{partition_first_round}
+                    : std::vector<std::function<void()>>{});
+  first_round_ = first_round;
+  partition_beside_seconds_ = build_seconds + initialize_seconds;
   const LoopClock after_clock(loops);
-  keys_.emplace(*master_, whole.vertex_capacity());
+  keys_.emplace(*master_, whole_->vertex_capacity());
   carry_keys_ = parallel_.carry_keys && master_->costly();
   carry_deferred_ = carry_keys_ && parallel_.carry_deferred;
   master_queue_ = carry_keys_ ? static_cast<PriorityModule*>(&*keys_) : master_.get();
   subset_options_ = subset_options_of(options_, mesh_);
-  records_.reserve(whole.live_vertices());
+  records_.reserve(whole_->live_vertices());
   // The set-up's own time, its loops at their critical path; the first partition is round 0's
-  // (which the critical path counts only where it outlasts the initialisation:
+  // (which the critical path counts only where it outlasts the build and the initialisation:
   // RoundStats::partition_overlap_seconds).
-  st_.setup_seconds = before_seconds + initialize_seconds_ + after_clock.critical_seconds();
+  st_.setup_seconds = start_seconds + partition_beside_seconds_ + after_clock.critical_seconds();
 }
 
 std::shared_ptr<const std::vector<uint32_t>> ParallelBuilder::whole_components() {
@@ -542,7 +575,7 @@ void ParallelBuilder::partition(Round& r) {
     // Drawn during the setup (whose first_round_ repeats the plan's checks).
     r.vertex_subset = std::move(first_partition_);
     rs.partition_seconds = first_partition_seconds_;
-    rs.partition_overlap_seconds = std::min(first_partition_seconds_, initialize_seconds_);
+    rs.partition_overlap_seconds = std::min(first_partition_seconds_, partition_beside_seconds_);
   } else if (early_taken) {
     // Drawn beside round 0: the critical path counts what of it outlasted round 0, and its
     // check. The previous round's records are appended beside this round's jobs.
