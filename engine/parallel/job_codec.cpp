@@ -31,7 +31,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 8;
+constexpr uint8_t kVersion = 9;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -876,6 +876,8 @@ void write_summary(ByteWriter& out, const SubsetResult& r) {
   out.bytes(s.stop_reason.data(), s.stop_reason.size());
   out.f64(r.wall_seconds);
   out.f64(r.cpu_seconds);
+  out.f64(r.team_saved_seconds);
+  out.f64(r.team_cpu_seconds);
 }
 
 void read_summary(ByteReader& in, SubsetResult& r) {
@@ -900,6 +902,8 @@ void read_summary(ByteReader& in, SubsetResult& r) {
   in.set_context("timings");
   r.wall_seconds = read_not_nan(in, "wall seconds");
   r.cpu_seconds = read_not_nan(in, "cpu seconds");
+  r.team_saved_seconds = read_not_nan(in, "team saved seconds");
+  r.team_cpu_seconds = read_not_nan(in, "team cpu seconds");
   expect_end(in);
 }
 

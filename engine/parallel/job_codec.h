@@ -9,7 +9,7 @@
 // one before it in its list, the first from 0). Every message starts with a 4-byte magic naming its
 // kind and a version byte, so that one kind is never decoded as another.
 //
-//   (The version byte is 8 for every kind; DECISIONS.md, "The job codec's versions", says
+//   (The version byte is 9 for every kind; DECISIONS.md, "The job codec's versions", says
 //   what each one added.)
 //   job     "PPJB" 4 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
@@ -55,7 +55,7 @@
 //   summary "PPSS" 4 | round v, subset v | state | keys | deferred | keys_reused v,
 //           costings v, faces v, owned_faces v, free_vertices v | collapses rejected stale
 //           reevaluated evaluations v, stop_reason (length v <= 4096, bytes) | wall_seconds
-//           f64, cpu_seconds f64.
+//           f64, cpu_seconds f64, team_saved_seconds f64, team_cpu_seconds f64.
 //
 // Decoding is written for hostile input (a network peer): every count is checked against the
 // bytes that remain before anything is reserved, every id against what it indexes, positions
