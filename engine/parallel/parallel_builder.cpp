@@ -177,8 +177,9 @@ Beside run_beside(unsigned threads, const std::function<void()>& work,
 // partitions bind 1-13% of those vertices again.
 // `bound`: the partition's bound vertices, found here.
 bool repeats_borders(const CollapseMesh& mesh, const std::vector<uint32_t>& vertex_subset,
-                     const std::vector<uint8_t>& bound_before, std::vector<uint8_t>& bound) {
-  bound = bound_vertices(mesh, vertex_subset);
+                     const std::vector<uint8_t>& bound_before, std::vector<uint8_t>& bound,
+                     ChunkedLoops& loops) {
+  bound = bound_vertices(mesh, vertex_subset, &loops);
   size_t before = 0, again = 0;
   for (VertexId v = 0; v < bound_before.size() && v < bound.size(); ++v)
     if (bound_before[v] && mesh.vertex_alive(v)) {
@@ -564,13 +565,14 @@ void ParallelBuilder::partition(Round& r) {
   RoundStats& rs = r.rs;
   const uint32_t round = rs.round;
   if (round == 1 && round_one_.valid()) take_round_one();
-  auto t = std::chrono::steady_clock::now();
+  const LoopClock check_clock(master_loops_);
   // Round 1's partition drawn beside round 0, unless it keeps round 0's borders.
   const bool early_drawn =
       foreseen_.drawn && !foreseen_.beside_band && foreseen_.subsets == r.subsets;
-  const bool early_taken = early_drawn && !repeats_borders(*whole_, foreseen_.vertex_subset,
-                                                           bound_before_, early_bound_);
-  const double early_check_seconds = seconds_since(t);
+  const bool early_taken =
+      early_drawn && !repeats_borders(*whole_, foreseen_.vertex_subset, bound_before_, early_bound_,
+                                      master_loops_);
+  const double early_check_seconds = check_clock.critical_seconds();
   if (round == 0 && first_round_) {
     // Drawn during the setup (whose first_round_ repeats the plan's checks).
     r.vertex_subset = std::move(first_partition_);
@@ -623,16 +625,16 @@ void ParallelBuilder::partition(Round& r) {
   if (events_.partitioned) events_.partitioned(round, r.subsets, rs.faces_before);
 }
 
-// The partition's border (sequential, O(faces), counted with the partition), and the goal a
-// scheduled round may reach with it (ParallelOptions::border_excess).
+// The partition's border (O(faces) in the master's chunks, counted with the partition), and the
+// goal a scheduled round may reach with it (ParallelOptions::border_excess).
 void ParallelBuilder::bound_goal_by_border(Round& r) {
   RoundStats& rs = r.rs;
-  const auto t = std::chrono::steady_clock::now();
-  r.bound =
-      early_bound_.empty() ? bound_vertices(*whole_, r.vertex_subset) : std::move(early_bound_);
+  const LoopClock clock(master_loops_);
+  r.bound = early_bound_.empty() ? bound_vertices(*whole_, r.vertex_subset, &master_loops_)
+                                 : std::move(early_bound_);
   early_bound_.clear();
-  rs.border_faces = border_faces(*whole_, r.bound);
-  rs.partition_seconds += seconds_since(t);
+  rs.border_faces = border_faces(*whole_, r.bound, &master_loops_);
+  rs.partition_seconds += clock.critical_seconds();
   if (r.scheduled && parallel_.border_excess > 0) {
     const uint64_t bounded =
         border_bounded_goal(rs.faces_before, rs.border_faces, parallel_.border_excess);

@@ -1,5 +1,6 @@
 #include "parallel/subset_rule.h"
 
+#include <atomic>
 #include <utility>
 
 namespace parapm {
@@ -89,24 +90,39 @@ uint64_t removable_faces(const Mesh& mesh, const std::vector<uint8_t>& free) {
 }
 
 std::vector<uint8_t> bound_vertices(const CollapseMesh& mesh,
-                                    const std::vector<uint32_t>& vertex_subset) {
+                                    const std::vector<uint32_t>& vertex_subset,
+                                    ChunkedLoops* loops) {
   std::vector<uint8_t> bound(mesh.vertex_capacity(), 0);
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-    if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    if (vertex_subset[t[0]] != vertex_subset[t[1]] || vertex_subset[t[1]] != vertex_subset[t[2]])
-      bound[t[0]] = bound[t[1]] = bound[t[2]] = 1;
-  }
+  // (Chunks may mark a corner they share: the same 1, stored atomically.)
+  auto mark = [&](size_t begin, size_t end) {
+    for (FaceId f = FaceId(begin); f < end; ++f) {
+      if (!mesh.face_alive(f)) continue;
+      const Triangle& t = mesh.face(f);
+      if (vertex_subset[t[0]] != vertex_subset[t[1]] || vertex_subset[t[1]] != vertex_subset[t[2]])
+        for (VertexId v : t) std::atomic_ref<uint8_t>(bound[v]).store(1, std::memory_order_relaxed);
+    }
+  };
+  ChunkedLoops one_thread;
+  (loops ? *loops : one_thread).run(mesh.face_capacity(), mark);
   return bound;
 }
 
-uint64_t border_faces(const CollapseMesh& mesh, const std::vector<uint8_t>& bound) {
+uint64_t border_faces(const CollapseMesh& mesh, const std::vector<uint8_t>& bound,
+                      ChunkedLoops* loops) {
+  ChunkedLoops one_thread;
+  ChunkedLoops& chunks = loops ? *loops : one_thread;
+  std::vector<uint64_t> counts(chunks.ranges(mesh.face_capacity()), 0);
+  chunks.run_indexed(mesh.face_capacity(), [&](size_t range, size_t begin, size_t end) {
+    uint64_t count = 0;
+    for (FaceId f = FaceId(begin); f < end; ++f) {
+      if (!mesh.face_alive(f)) continue;
+      const Triangle& t = mesh.face(f);
+      count += bound[t[0]] + bound[t[1]] + bound[t[2]] >= 2;
+    }
+    counts[range] = count;
+  });
   uint64_t count = 0;
-  for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
-    if (!mesh.face_alive(f)) continue;
-    const Triangle& t = mesh.face(f);
-    count += bound[t[0]] + bound[t[1]] + bound[t[2]] >= 2;
-  }
+  for (uint64_t c : counts) count += c;
   return count;
 }
 

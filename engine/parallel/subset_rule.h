@@ -38,6 +38,7 @@
 #include "mesh/mesh.h"
 #include "simplify/collapse_mesh.h"
 #include "simplify/modules.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 
@@ -53,13 +54,16 @@ uint64_t removable_faces(const Mesh& mesh, const std::vector<uint8_t>& free);
 // entry per vertex): a neighbour of it lies in another subset, so it is not free and no job
 // moves it this round. A vertex with a neighbour in another subset shares a face with it (the
 // mesh is manifold after the repair), so a face with corners in two subsets marks all three.
+// With `loops`, over the faces in its chunks (null: on the calling thread).
 std::vector<uint8_t> bound_vertices(const CollapseMesh& mesh,
-                                    const std::vector<uint32_t>& vertex_subset);
+                                    const std::vector<uint32_t>& vertex_subset,
+                                    ChunkedLoops* loops = nullptr);
 
 // The live faces that no subset can remove in the round whose bound vertices are `bound`
 // (bound_vertices): those with two or more bound corners, removable_faces' complement, counted
-// without extracting the jobs.
-uint64_t border_faces(const CollapseMesh& mesh, const std::vector<uint8_t>& bound);
+// without extracting the jobs. With `loops`, in its chunks.
+uint64_t border_faces(const CollapseMesh& mesh, const std::vector<uint8_t>& bound,
+                      ChunkedLoops* loops = nullptr);
 
 // The rule as a constraint module, checked on every pop (after the standard constraints).
 // It tests the adjacency of vs and vt on the present mesh, not the static free flags, so that

@@ -162,7 +162,7 @@ TEST(SubsetRule, JobsRemoveOnlyTheirRemovableFaces) {
 
 // The border the round's bound counts without extracting the jobs (border_faces over
 // bound_vertices) is exactly what the jobs cannot remove: with their removable faces it makes
-// every live face of the mesh, on a real mesh cut in 2 and 8.
+// every live face of the mesh, on a real mesh cut in 2 and 8; found in chunks, the same.
 TEST(SubsetRule, BorderFacesAreWhatNoJobCanRemove) {
   for (uint32_t p : {2u, 8u}) {
     const RepairedMesh repaired = testing::repaired_test_mesh("gmsh-aneurysm-20k.stl.gz");
@@ -181,6 +181,10 @@ TEST(SubsetRule, BorderFacesAreWhatNoJobCanRemove) {
     const uint64_t border = border_faces(whole, bound);
     EXPECT_GT(border, 0u) << "p = " << p;
     EXPECT_EQ(border + removable, whole.live_faces()) << "p = " << p;
+    // In chunks on threads, the same flags and count.
+    ChunkedLoops loops(7, 3);
+    EXPECT_EQ(bound_vertices(whole, partition.vertex_subset, &loops), bound) << "p = " << p;
+    EXPECT_EQ(border_faces(whole, bound, &loops), border) << "p = " << p;
     for (const SubsetJob& job : jobs) {
       const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
       for (VertexId v = 0; v < job.mesh.vertex_count(); ++v) {
