@@ -657,7 +657,6 @@ void ParallelBuilder::extract_jobs(Round& r) {
   const LoopClock owned_clock(master_loops_);
   const std::vector<std::vector<VertexId>> owned =
       owned_vertices(whole, r.vertex_subset, subsets, master_loops_);
-  double sequential_extract = owned_clock.critical_seconds();
   const bool sample = parallel_.water_level_factor > 0 || parallel_.cost_shares;
   std::vector<SubsetJob>& jobs = r.jobs;
   jobs.resize(subsets);
@@ -673,6 +672,8 @@ void ParallelBuilder::extract_jobs(Round& r) {
   std::vector<SampledEdges> sampled(sample && !sample_in_tasks && !master_in_tasks ? subsets : 0);
   // Per face, the subset whose job owns its three corners: the only state that may list it.
   face_subset_.assign(whole.face_capacity(), kNoId);
+  // The master's own steps, before the jobs' extraction and after it, are on the critical path.
+  double sequential_extract = owned_clock.critical_seconds();
   std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
   run_jobs(jobs.size(), parallel_.threads, [&](size_t i) {
     const double cpu = thread_cpu_seconds();
@@ -706,10 +707,10 @@ void ParallelBuilder::extract_jobs(Round& r) {
     if (carry_deferred_) jobs[i].deferred = deferred_of_job(deferred_, jobs[i], free, jobs[i].keys);
     job_cpu[i] = thread_cpu_seconds() - cpu;
   });
+  const auto after_jobs = std::chrono::steady_clock::now();
   // The water level and the shares (sequential: a sort of the samples).
   RoundCosts round_costs;
   if (sample) {
-    const auto ts = std::chrono::steady_clock::now();
     if (!sample_in_tasks && !master_in_tasks) {
       const double sample_start = thread_cpu_seconds();
       Simplifier master_costs(*whole_, *master_, {});
@@ -723,7 +724,6 @@ void ParallelBuilder::extract_jobs(Round& r) {
         round_costs_of(samples, rs.faces_before - rs.goal_faces, parallel_.water_level_factor);
     if (!parallel_.cost_shares) round_costs.cheap_fraction.clear();
     if (parallel_.water_level_factor > 0) rs.water_level = round_costs.ceiling;
-    sequential_extract += seconds_since(ts);
     for (double c : sample_cpu) rs.share_seconds += c;
     for (const SubsetSample& s : samples) sample_costings_ += s.costings;
   }
@@ -746,6 +746,7 @@ void ParallelBuilder::extract_jobs(Round& r) {
     subsets_cpu_ += c;  // master work, on the pool's threads
     rs.slowest_extract_cpu_seconds = std::max(rs.slowest_extract_cpu_seconds, c);
   }
+  sequential_extract += seconds_since(after_jobs);
   rs.extract_seconds = seconds_since(t);
   rs.extract_critical_seconds = sequential_extract + rs.slowest_extract_cpu_seconds;
 }
