@@ -2,10 +2,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "simplify/vec_math.h"
 
 namespace parapm {
+AreaIndex::AreaIndex(const std::vector<double>& cumulative) : cumulative_(cumulative) {
+  const double total = cumulative.empty() ? 0.0 : cumulative.back();
+  if (!std::isfinite(total) || !(total > 0)) return;  // (the whole list is searched)
+  const size_t buckets = std::max<size_t>(1, cumulative.size() / kPerBucket);
+  edge_.resize(buckets + 1);
+  first_.resize(buckets + 1);
+  for (size_t b = 0; b < buckets; ++b) edge_[b] = total * (double(b) / double(buckets));
+  edge_[buckets] = std::numeric_limits<double>::infinity();
+  size_t j = 0;
+  for (size_t b = 0; b <= buckets; ++b) {
+    while (j < cumulative.size() && cumulative[j] <= edge_[b]) ++j;
+    first_[b] = j;
+  }
+  scale_ = double(buckets) / total;
+}
+
+size_t AreaIndex::first_above(double target) const {
+  auto search = [&](size_t from, size_t to) {
+    return size_t(std::upper_bound(cumulative_.begin() + ptrdiff_t(from),
+                                   cumulative_.begin() + ptrdiff_t(to), target) -
+                  cumulative_.begin());
+  };
+  if (edge_.empty() || !(target >= 0)) return search(0, cumulative_.size());
+  const size_t buckets = edge_.size() - 1;
+  size_t b = std::min(buckets - 1, size_t(std::min(target * scale_, double(buckets))));
+  while (b > 0 && target < edge_[b]) --b;
+  while (b + 1 < buckets && target >= edge_[b + 1]) ++b;
+  return search(first_[b], first_[b + 1]);
+}
 
 std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double samples_per_face,
                                           uint64_t seed) {
@@ -54,6 +84,7 @@ std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double sampl
     cumulative_area.push_back(total);
   }
   if (faces.empty()) return samples;
+  const AreaIndex index(cumulative_area);
   const auto count = static_cast<size_t>(std::llround(samples_per_face * double(faces.size())));
   const size_t drawn_from = samples.size();
   samples.resize(drawn_from + count);
@@ -63,10 +94,7 @@ std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double sampl
     SplitMix64 random = SplitMix64::at(seed, 3 * uint64_t(begin));
     for (size_t i = begin; i < end; ++i) {
       const double target = random.uniform() * total;
-      const size_t k = std::min<size_t>(
-          std::upper_bound(cumulative_area.begin(), cumulative_area.end(), target) -
-              cumulative_area.begin(),
-          faces.size() - 1);
+      const size_t k = std::min<size_t>(index.first_above(target), faces.size() - 1);
       // Uniform on the triangle: the square-root warp of two uniforms (Turk 1990).
       const double r1 = std::sqrt(random.uniform()), r2 = random.uniform();
       const double u = 1 - r1, v = r1 * (1 - r2), w = r1 * r2;

@@ -3,6 +3,7 @@
 // lies on (distance zero).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -25,6 +26,26 @@ std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double sampl
 // The same samples, the faces' areas and the draws computed in `loops`' chunks.
 std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double samples_per_face,
                                           uint64_t seed, ChunkedLoops& loops);
+
+// upper_bound over an ascending list of cumulative areas (the draw of a face by area), narrowed
+// first by a table of buckets of equal area: bucket b holds the targets in [edge b, edge b + 1),
+// whose answers lie between the answers at its two edges (upper_bound is monotone in the
+// target), so a draw searches a few entries, not the whole list (a million draws' cache misses).
+// The same index as std::upper_bound over the whole list, for every target. Holds a reference
+// to `cumulative`, which must outlive it and not change.
+class AreaIndex {
+ public:
+  explicit AreaIndex(const std::vector<double>& cumulative);
+  // The index of the first cumulative area above `target`, or the list's size.
+  size_t first_above(double target) const;
+
+ private:
+  static constexpr size_t kPerBucket = 16;
+  const std::vector<double>& cumulative_;
+  std::vector<double> edge_;   // per bucket, its least target; then +infinity
+  std::vector<size_t> first_;  // per edge, the first cumulative area above it
+  double scale_ = 0;           // buckets per unit of area
+};
 
 // splitmix64 (Steele, Lea, Flood 2014): a tiny generator whose output is fixed by its spec.
 class SplitMix64 {

@@ -124,6 +124,38 @@ TEST(SurfaceSamples, OnePerVertexThenAreaWeightedOnTheirFaces) {
   EXPECT_NE(samples.back().position, other.back().position) << "the seed changes the draw";
 }
 
+// The bucketed search finds what a search of the whole list finds: random targets, every
+// cumulative value and its neighbours (a bucket's edges fall on them or between), ties, the
+// ends, and lists from one face to a hundred thousand.
+TEST(SurfaceSamples, AreaIndexFindsWhatUpperBoundFinds) {
+  SplitMix64 random(5);
+  for (size_t n : {size_t(1), size_t(15), size_t(16), size_t(17), size_t(1000), size_t(100000)}) {
+    std::vector<double> cumulative;
+    double total = 0;
+    for (size_t i = 0; i < n; ++i) {
+      // Areas over six orders of magnitude, some repeated (equal running sums do not occur,
+      // but equal steps do).
+      const double area = i % 7 == 3 ? 1.0 : std::pow(10.0, 6 * random.uniform() - 3);
+      total += area;
+      cumulative.push_back(total);
+    }
+    const AreaIndex index(cumulative);
+    auto check = [&](double target) {
+      const size_t expected = size_t(
+          std::upper_bound(cumulative.begin(), cumulative.end(), target) - cumulative.begin());
+      ASSERT_EQ(index.first_above(target), expected) << "n = " << n << ", target " << target;
+    };
+    for (int i = 0; i < 20000; ++i) check(random.uniform() * total);
+    for (double c : cumulative) {
+      check(c);
+      check(std::nextafter(c, 0.0));
+      check(std::nextafter(c, 2 * total));
+    }
+    for (double t : {0.0, total, 2 * total, -1.0}) check(t);
+    if (HasFatalFailure()) return;
+  }
+}
+
 TEST(SurfaceSamples, DrawnInChunksSideBySideTheSamePoints) {
   const Mesh mesh = roof();
   const CollapseMesh cm(mesh);
