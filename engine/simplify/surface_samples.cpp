@@ -7,6 +7,7 @@
 #include "simplify/vec_math.h"
 
 namespace parapm {
+
 AreaIndex::AreaIndex(const std::vector<double>& cumulative) : cumulative_(cumulative) {
   const double total = cumulative.empty() ? 0.0 : cumulative.back();
   if (!std::isfinite(total) || !(total > 0)) return;  // (the whole list is searched)
