@@ -59,6 +59,22 @@ double EnergyEvaluator::corners_moved(FaceId f) {
   return max_distance_sq_[f];
 }
 
+void EnergyEvaluator::extend(FaceId f, size_t added) {
+  if (moments_ready_.empty()) return;
+  if (!moments_ready_[f]) {
+    moments_of(f);
+    return;
+  }
+  const std::vector<FacePoint>& points = module_.face_points_[f];
+  PointMoments& m = moments_[f];
+  double& max_distance_sq = max_distance_sq_[f];
+  for (size_t i = points.size() - added; i < points.size(); ++i) {
+    m.add(points[i].position);
+    max_distance_sq = std::max(max_distance_sq, points[i].distance_sq);
+  }
+  moments_ready_[f] = 1;  // (its own error, of the corners as they were, is dropped)
+}
+
 void EnergyEvaluator::release() {
   if (released_capacity_ || moments_.empty()) return;
   released_capacity_ = moments_.size();

@@ -69,13 +69,11 @@ class EnergyEvaluator {
   void forget(FaceId f) {
     if (!moments_ready_.empty()) moments_ready_[f] = 0;
   }
-  // forget(f), then f's moments computed now rather than at its next costing (the same
-  // values): for a collapse's faces on the team's threads, one face per thread at a time.
-  void recompute(FaceId f) {
-    if (moments_ready_.empty()) return;
-    moments_ready_[f] = 0;
-    moments_of(f);
-  }
+  // Face f's list gained `added` points at its end (its other points and order unchanged):
+  // its moments made ready now rather than at its next costing, for a collapse's faces on the
+  // team's threads, one face per thread at a time. Known moments are extended by the added
+  // points only: Welford's sums over the list in order, so the same values as computed anew.
+  void extend(FaceId f, size_t added);
   double corners_moved(FaceId f);
   void release();
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <span>
 
@@ -158,6 +159,59 @@ void EnergyPriority::move_taken_points() {
   }
 }
 
+double EnergyPriority::list_on_team(std::span<const FaceId> faces,
+                                    const std::function<void(size_t, size_t)>& project) {
+  const size_t moving = moved_.count;
+  const size_t fan = faces.size();
+  const size_t ranges = team_->ranges(moving);
+  // Per range and face of the fan: how many of the range's points go to the face, then where
+  // the first of them goes in by_face, which holds the points face after face, each face's
+  // the last point first (so the last range's first).
+  std::vector<size_t>& slots = moved_.slots;
+  slots.assign(ranges * fan, 0);
+  team_->run_indexed(moving, [&](size_t r, size_t begin, size_t end) {
+    project(begin, end);
+    size_t* count = &slots[r * fan];
+    for (size_t i = begin; i < end; ++i) ++count[moved_.in_fan[i]];
+  });
+  moved_.fan_start.resize(fan + 1);
+  size_t at = 0;
+  for (size_t j = 0; j < fan; ++j) {
+    moved_.fan_start[j] = at;
+    for (size_t r = ranges; r-- > 0;) {
+      const size_t n = slots[r * fan + j];
+      slots[r * fan + j] = at;
+      at += n;
+    }
+  }
+  moved_.fan_start[fan] = at;
+  if (moved_.by_face.size() < moving) moved_.by_face.resize(moving);
+  moved_.range_max_sq.assign(ranges, 0.0);
+  team_->run_indexed(moving, [&](size_t r, size_t begin, size_t end) {
+    size_t* next = &slots[r * fan];
+    double largest_sq = 0;
+    for (size_t i = end; i-- > begin;) {
+      const FacePoint& point = moved_.points[i];
+      moved_.by_face[next[moved_.in_fan[i]]++] = point;
+      largest_sq = std::max(largest_sq, point.distance_sq);
+    }
+    moved_.range_max_sq[r] = largest_sq;
+  });
+  // By face: its new points after its own, then its moments, which the next costings of the
+  // edges around vs need (a star this rich is costed on them).
+  team_->run(fan, [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      const auto first = moved_.by_face.begin() + ptrdiff_t(moved_.fan_start[j]);
+      const auto last = moved_.by_face.begin() + ptrdiff_t(moved_.fan_start[j + 1]);
+      if (first == last) continue;
+      std::vector<FacePoint>& list = face_points_[faces[j]];
+      list.insert(list.end(), first, last);
+      evaluator_.extend(faces[j], size_t(last - first));
+    }
+  });
+  return *std::max_element(moved_.range_max_sq.begin(), moved_.range_max_sq.end());
+}
+
 // E_scalar after a performed collapse: the wedges joined for good, the star's wedges given the
 // values that fit the star's points as they now project, and the points' errors updated.
 void EnergyPriority::update_attributes(const CollapseMesh& mesh, CollapseCandidate& done,
@@ -268,27 +322,7 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   };
   // Last point first: each face then lists its points newest first (see initialize()).
   if (team_ && moving >= team_->min_items()) {
-    team_->run(moving, project);
-    // By face on the team: its points, then its moments, which the next costings of the
-    // edges around vs need (a star this rich is costed on them), and their largest distance
-    // (every point goes to a face of the fan).
-    moved_.fan_max_sq.assign(faces.size(), 0.0);
-    team_->run(faces.size(), [&](size_t begin, size_t end) {
-      for (size_t j = begin; j < end; ++j) {
-        bool gained = false;
-        double largest_sq = 0;
-        for (size_t i = moving; i-- > 0;)
-          if (moved_.in_fan[i] == int(j)) {
-            face_points_[faces[j]].push_back(moved_.points[i]);
-            largest_sq = std::max(largest_sq, moved_.points[i].distance_sq);
-            gained = true;
-          }
-        if (gained) evaluator_.recompute(faces[j]);
-        moved_.fan_max_sq[j] = largest_sq;
-      }
-    });
-    for (double largest_sq : moved_.fan_max_sq)
-      max_distance_sq = std::max(max_distance_sq, largest_sq);
+    max_distance_sq = std::max(max_distance_sq, list_on_team(faces, project));
   } else {
     project(0, moving);
     for (size_t i = moving; i-- > 0;) {

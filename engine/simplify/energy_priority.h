@@ -75,6 +75,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -269,6 +270,11 @@ class EnergyPriority : public PriorityModule {
   // The planned points into the first Reprojection::count of Reprojection::points, their
   // faces emptied: on the team when there are enough of them.
   void move_taken_points();
+  // The moved points projected by `project` (over ranges of them) and listed on their new
+  // faces of `faces` (vs's), each face's moments computed again, on the team: by ranges of
+  // points, then by face. Returns the points' largest squared distance.
+  double list_on_team(std::span<const FaceId> faces,
+                      const std::function<void(size_t, size_t)>& project);
   FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
   double diagonal_of(const CollapseMesh& mesh) const;
   void initialize_curves(const CollapseMesh& mesh, ChunkedLoops& loops);  // curves_ only
@@ -327,7 +333,13 @@ class EnergyPriority : public PriorityModule {
     std::vector<int> in_fan;                  // per point, its new face's index among vs's
     std::vector<FaceId> faces;                // and the face
     std::vector<std::array<double, 3>> bary;  // and its barycentric coordinates there
-    std::vector<double> fan_max_sq;           // per face of the fan: its points' largest distance
+    // list_on_team's: per range and face of the fan, a count, then an index in by_face; the
+    // moved points grouped by their new face, face j's from fan_start[j]; per range, its
+    // points' largest distance.
+    std::vector<size_t> slots;
+    std::vector<FacePoint> by_face;
+    std::vector<size_t> fan_start;
+    std::vector<double> range_max_sq;
   };
   Reprojection moved_;
   // check_global's marks: (generation << 10) | (subset << 1) | given. Each check writes its own

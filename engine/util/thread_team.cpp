@@ -74,7 +74,7 @@ void ThreadTeam::run_ranges(unsigned member) {
   for (size_t r = member; r < ranges_; r += threads()) {
     const auto start = std::chrono::steady_clock::now();
     try {
-      (*body_)(n_ * r / ranges_, n_ * (r + 1) / ranges_);
+      (*body_)(r, n_ * r / ranges_, n_ * (r + 1) / ranges_);
     } catch (...) {
       errors_[r] = std::current_exception();
     }
@@ -88,11 +88,15 @@ void ThreadTeam::run_ranges(unsigned member) {
 }
 
 void ThreadTeam::run(size_t n, const std::function<void(size_t, size_t)>& body) {
+  run_indexed(n, [&body](size_t, size_t begin, size_t end) { body(begin, end); });
+}
+
+void ThreadTeam::run_indexed(size_t n, const std::function<void(size_t, size_t, size_t)>& body) {
   if (n == 0) return;
   const auto start = std::chrono::steady_clock::now();
   body_ = &body;
   n_ = n;
-  ranges_ = std::min<size_t>(chunks_, n);
+  ranges_ = ranges(n);
   const unsigned helpers = unsigned(std::min<size_t>(workers_.size(), ranges_ - 1));
   if (helpers > 0) {
     // Every worker wakes (one generation for all); those without a range return at once.

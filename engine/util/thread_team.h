@@ -6,6 +6,7 @@
 // range computes does not depend on the threads. One loop at a time, from one calling thread.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -33,6 +34,11 @@ class ThreadTeam {
   // and returns when all are done. The exception of the lowest range is rethrown; the other
   // ranges still run.
   void run(size_t n, const std::function<void(size_t begin, size_t end)>& body);
+  // The same with each range's index (0 ... ranges(n) - 1, in order along [0, n)), for loops
+  // whose ranges each fill an output of their own.
+  size_t ranges(size_t n) const { return std::min<size_t>(chunks_, n); }
+  void run_indexed(size_t n,
+                   const std::function<void(size_t range, size_t begin, size_t end)>& body);
 
   // Wall seconds spent in run(), and what those loops take with a core per chunk: the sum of
   // each loop's slowest range (the parallel build's critical path).
@@ -53,7 +59,7 @@ class ThreadTeam {
   std::atomic<uint64_t> generation_{0};  // one more for each loop; the workers wait for it
   std::atomic<unsigned> busy_{0};        // workers still in the current loop
   bool stopping_ = false;                // written before the last generation
-  const std::function<void(size_t, size_t)>* body_ = nullptr;
+  const std::function<void(size_t, size_t, size_t)>* body_ = nullptr;
   size_t n_ = 0;
   size_t ranges_ = 0;
   std::vector<double> range_seconds_;

@@ -40,6 +40,20 @@ TEST(ThreadTeam, RangesCoverTheLoopOnceAndDoNotDependOnTheThreads) {
   team.run(0, [](size_t, size_t) { FAIL() << "a loop of no items has no range"; });
 }
 
+// An indexed loop's range r is the r-th of run()'s ranges, whatever thread runs it.
+TEST(ThreadTeam, IndexedRangesAreNumberedInOrderAlongTheLoop) {
+  for (const size_t n : {size_t(1), size_t(5), size_t(1000)}) {
+    ThreadTeam team(6, 3, 1);
+    const std::vector<std::pair<size_t, size_t>> expected = testing::loop_ranges(team, n);
+    ASSERT_EQ(team.ranges(n), expected.size()) << n;
+    std::vector<std::pair<size_t, size_t>> seen(expected.size());
+    team.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+      seen.at(range) = {begin, end};
+    });
+    EXPECT_EQ(seen, expected) << n;
+  }
+}
+
 // Loops of a few microseconds one after the other, as a collapse's projections come: every
 // item written by its loop, none lost between loops (the workers wait awake, then asleep).
 TEST(ThreadTeam, ThousandsOfShortLoopsEachWriteEveryItem) {
