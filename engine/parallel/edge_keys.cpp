@@ -45,19 +45,41 @@ bool KeyMemo::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, Collaps
                        Costing costing) {
   if (costing != Costing::kQueue) return inner_.evaluate(mesh, a, b, out, costing);
   const VertexId lo = std::min(a, b), hi = std::max(a, b);
-  Entry* const e = find(lo, hi);
-  if (e && e->carried && current(lo, *e)) {
-    ++reused_;
-    e->carried = false;  // answered once: the simplifier's next costing of it needs a fresh one
-    // A queue costing's caller reads only the cost (modules.h: the edge is costed again, with
-    // kPerform, before it is collapsed).
-    out.cost = e->cost;
-    return !std::isnan(e->cost);
-  }
-  const bool placed = inner_.evaluate(mesh, a, b, out, costing);
-  // (The inner module never touches the memo, so `e` still points at the entry.)
-  store(e, lo, hi, placed ? out.cost : std::numeric_limits<double>::quiet_NaN(), false);
+  bool placed = false;
+  if (answer(lo, hi, out, placed)) return placed;
+  placed = inner_.evaluate(mesh, a, b, out, costing);
+  store(find(lo, hi), lo, hi, placed ? out.cost : std::numeric_limits<double>::quiet_NaN(), false);
   return placed;
+}
+
+void KeyMemo::evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                            Costing costing) {
+  if (costing != Costing::kQueue) {
+    inner_.evaluate_each(mesh, edges, costing);
+    return;
+  }
+  const std::span<const size_t> costed = evaluate_picked(mesh, edges, costing, [&](EdgeCosting& e) {
+    return !answer(std::min(e.a, e.b), std::max(e.a, e.b), e.candidate, e.placed);
+  });
+  // (The edges are distinct: answering or storing one changes no other's entry.)
+  for (const size_t i : costed) {
+    const EdgeCosting& e = edges[i];
+    const VertexId lo = std::min(e.a, e.b), hi = std::max(e.a, e.b);
+    store(find(lo, hi), lo, hi,
+          e.placed ? e.candidate.cost : std::numeric_limits<double>::quiet_NaN(), false);
+  }
+}
+
+bool KeyMemo::answer(VertexId lo, VertexId hi, CollapseCandidate& out, bool& placed) {
+  Entry* const e = find(lo, hi);
+  if (!e || !e->carried || !current(lo, *e)) return false;
+  ++reused_;
+  e->carried = false;  // answered once: the simplifier's next costing of it needs a fresh one
+  // A queue costing's caller reads only the cost (modules.h: the edge is costed again, with
+  // kPerform, before it is collapsed).
+  out.cost = e->cost;
+  placed = !std::isnan(e->cost);
+  return true;
 }
 
 void KeyMemo::collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) {

@@ -53,6 +53,10 @@ class KeyMemo : public PriorityWrapper {
   KeyMemo(PriorityModule& inner, size_t vertex_capacity);
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override;
+  // Answers what the keys answer, costs the rest together (the inner module's evaluate_each),
+  // then remembers their keys in order.
+  void evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                     Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
 
   // Forgets every key, then carries `keys` in. Throws Error(kInvalidInput) for a key that is
@@ -82,6 +86,9 @@ class KeyMemo : public PriorityWrapper {
     return changed_at_[a] <= e.time && changed_at_[e.other] <= e.time;
   }
   Entry* find(VertexId a, VertexId b) const;
+  // A queue costing of edge (lo, hi) from its carried key, if it has one still current
+  // (answered once: then forgotten as carried).
+  bool answer(VertexId lo, VertexId hi, CollapseCandidate& out, bool& placed);
   // Overwrites `found` (find(a, b)'s answer) or lists a new entry at a.
   void store(Entry* found, VertexId a, VertexId b, double cost, bool carried) const;
 

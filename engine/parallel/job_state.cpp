@@ -27,6 +27,10 @@ class WithoutInitialize : public PriorityWrapper {
  public:
   using PriorityWrapper::PriorityWrapper;
   void initialize(const CollapseMesh&) override {}
+  void evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                     Costing costing) override {
+    inner_.evaluate_each(mesh, edges, costing);
+  }
 };
 
 }  // namespace

@@ -244,6 +244,13 @@ class BandPriority : public PriorityWrapper {
     if (!lagging_[a] && !lagging_[b]) return false;
     return inner_.evaluate(mesh, a, b, out, costing) && out.cost <= ceiling_;
   }
+  void evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                     Costing costing) override {
+    for (const size_t i : evaluate_picked(mesh, edges, costing, [&](const EdgeCosting& e) {
+           return lagging_[e.a] || lagging_[e.b];
+         }))
+      edges[i].placed = edges[i].placed && edges[i].candidate.cost <= ceiling_;
+  }
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                      CollapseCandidate& out, Costing costing) override {
     if (!lagging_[vs] && !lagging_[vt]) return false;

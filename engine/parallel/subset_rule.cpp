@@ -61,6 +61,11 @@ class SubsetPriority : public PriorityWrapper {
     if (!free_[a] || !free_[b]) return false;
     return inner_.evaluate(mesh, a, b, out, costing);
   }
+  void evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                     Costing costing) override {
+    evaluate_picked(mesh, edges, costing,
+                    [&](const EdgeCosting& e) { return free_[e.a] && free_[e.b]; });
+  }
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                      CollapseCandidate& out, Costing costing) override {
     if (!free_[vs] || !free_[vt]) return false;

@@ -136,8 +136,9 @@ bool EnergyEvaluator::evaluate_removal(const CollapseMesh& mesh, VertexId a, Ver
       points.push_back(module_.positions_[module_.parked_point_[end]]);
   for (const Vec3& x : points) sum = add(sum, x);
   const SharpCurves& curves = module_.curves_;
-  curves.gather(a, b, mesh, module_.options_.max_sampled_points);
-  before += curves.gathered_distance_sq();
+  SharpCurves::Gathered& gathered = scratch_.curve_samples;
+  curves.gather(a, b, mesh, module_.options_.max_sampled_points, gathered);
+  before += curves.distance_sq(gathered);
 
   // Each point at its squared distance to v; the samples at theirs to the segments left.
   struct Priced {
@@ -150,7 +151,7 @@ bool EnergyEvaluator::evaluate_removal(const CollapseMesh& mesh, VertexId a, Ver
       priced.energy += dot(d, d);
       priced.max_distance_sq = std::max(priced.max_distance_sq, dot(d, d));
     }
-    const SharpCurves::Fit fit = curves.gathered() ? curves.project(v) : SharpCurves::Fit{};
+    const SharpCurves::Fit fit = gathered.size() ? curves.project(gathered, v) : SharpCurves::Fit{};
     priced.energy += fit.distance_sq;
     priced.max_distance_sq = std::max(priced.max_distance_sq, fit.max_distance_sq);
     if (curve_fit) *curve_fit = fit;
@@ -181,9 +182,9 @@ bool EnergyEvaluator::evaluate_removal(const CollapseMesh& mesh, VertexId a, Ver
 
 EnergyEvaluator::Before EnergyEvaluator::energy_before(const CollapseMesh& mesh, VertexId a,
                                                        VertexId b, bool by_moments) {
-  module_.curves_.gather(a, b, mesh, module_.options_.max_sampled_points);
+  module_.curves_.gather(a, b, mesh, module_.options_.max_sampled_points, scratch_.curve_samples);
   Before before;
-  before.curves_sq = module_.curves_.gathered_distance_sq();
+  before.curves_sq = module_.curves_.distance_sq(scratch_.curve_samples);
   before.distance_sq = by_moments ? moment_distance_before(mesh) : exact_distance_sq();
   return before;
 }
@@ -266,7 +267,8 @@ void EnergyEvaluator::measure(const Placing& placing, const Vec3& v, Fit& fit) {
                              : nullptr);
   }
   SharpCurves::Fit& curve_fit = scratch_.curve_fit;
-  curve_fit = module_.curves_.gathered() ? module_.curves_.project(v) : SharpCurves::Fit{};
+  curve_fit = scratch_.curve_samples.size() ? module_.curves_.project(scratch_.curve_samples, v)
+                                            : SharpCurves::Fit{};
   double energy = fit.distance_sq + curve_fit.distance_sq;
   if (module_.star_terms_on_) energy += scratch_.terms.evaluate(sub(v, scratch_.origin));
   if (placed < placements.size()) {
@@ -567,29 +569,39 @@ void EnergyEvaluator::gather_face(const CollapseMesh& mesh, FaceId f, int home) 
   }
 }
 
-const PointMoments& EnergyEvaluator::moments_of(FaceId f) {
-  if (!moments_ready_[f]) {
-    PointMoments m;
-    double max_distance_sq = 0;
-    for (const FacePoint& p : module_.face_points_[f]) {
-      m.add(p.position);
-      max_distance_sq = std::max(max_distance_sq, p.distance_sq);
-    }
+PointMoments EnergyEvaluator::moments_of(FaceId f) {
+  const EnergyEvaluator& caches = shared_ ? *shared_ : *this;
+  if (caches.moments_ready_[f]) return caches.moments_[f];
+  PointMoments m;
+  double max_distance_sq = 0;
+  for (const FacePoint& p : module_.face_points_[f]) {
+    m.add(p.position);
+    max_distance_sq = std::max(max_distance_sq, p.distance_sq);
+  }
+  if (!shared_) {
     moments_[f] = m;
     max_distance_sq_[f] = max_distance_sq;
     moments_ready_[f] = 1;
   }
-  return moments_[f];
+  return m;
 }
 
-const EnergyEvaluator::OwnError& EnergyEvaluator::own_error_of(const CollapseMesh& mesh, FaceId f) {
-  if (moments_ready_[f] != 2) {
-    const Triangle& t = mesh.face(f);
-    const Vec3 &q0 = mesh.position(t[0]), &q1 = mesh.position(t[1]), &q2 = mesh.position(t[2]);
-    own_[f] = {plane_distance_sq(f, q0, q1, q2), rim_sq(f, q0, q1, q2, RimAround::kOwn)};
+EnergyEvaluator::OwnError EnergyEvaluator::own_error_of(const CollapseMesh& mesh, FaceId f) {
+  const EnergyEvaluator& caches = shared_ ? *shared_ : *this;
+  if (caches.moments_ready_[f] == 2) return caches.own_[f];
+  const Triangle& t = mesh.face(f);
+  const Vec3 &q0 = mesh.position(t[0]), &q1 = mesh.position(t[1]), &q2 = mesh.position(t[2]);
+  const OwnError own{plane_distance_sq(f, q0, q1, q2), rim_sq(f, q0, q1, q2, RimAround::kOwn)};
+  if (!shared_) {
+    own_[f] = own;
     moments_ready_[f] = 2;
   }
-  return own_[f];
+  return own;
+}
+
+void EnergyEvaluator::fill_for_views(const CollapseMesh& mesh, std::span<const FaceId> faces) {
+  if (released_capacity_) reset(released_capacity_);
+  for (const FaceId f : faces) own_error_of(mesh, f);
 }
 
 // The squared distances of face f's points to the plane of (q0, q1, q2); to the triangle

@@ -2,12 +2,13 @@
 // evaluator gathers the star of the edge and its points, places the surviving vertex from its
 // starts and prices the change of E.
 //
-// Ownership: one evaluator per EnergyPriority, which it reads (its points, curves, options)
-// but does not change. It owns its working memory (the star at hand) and the per-face caches
-// derived from the module's points (their moments and their errors against their own faces),
-// which the module invalidates when a collapse changes a face (forget, corners_moved). Not
-// thread-safe: a module and its evaluator serve one thread at a time (the parallel build gives
-// each job its own module).
+// Ownership: one evaluator per EnergyPriority (and views of it, one per thread of its team),
+// which it reads (its points, curves, options) but does not change. It owns its working memory (the
+// star at hand) and the per-face caches derived from the module's points (their moments and their
+// errors against their own faces), which the module invalidates when a collapse changes a face
+// (forget, corners_moved). Not thread-safe: a module and its evaluator serve one thread at a time
+// (the parallel build gives each job its own module), but for views, which cost side by side on the
+// owner's caches while the owner waits (EnergyPriority::evaluate_each).
 #pragma once
 
 #include <array>
@@ -48,6 +49,11 @@ struct EnergySeam {
 class EnergyEvaluator {
  public:
   explicit EnergyEvaluator(const EnergyPriority& module) : module_(module) {}
+  // A view of `owner` (EnergyPriority::evaluate_each): its own working memory, the owner's
+  // per-face caches, read only (what they lack it computes without keeping). Views of one
+  // owner may cost side by side while the owner and its module change nothing.
+  EnergyEvaluator(const EnergyPriority& module, const EnergyEvaluator& owner)
+      : module_(module), shared_(&owner) {}
   EnergyEvaluator(const EnergyEvaluator&) = delete;
   EnergyEvaluator& operator=(const EnergyEvaluator&) = delete;
 
@@ -74,6 +80,10 @@ class EnergyEvaluator {
   // team's threads, one face per thread at a time. Known moments are extended by the added
   // points only: Welford's sums over the list in order, so the same values as computed anew.
   void extend(FaceId f, size_t added);
+  // Before views cost side by side: the caches made whole (after a release), then those of
+  // `faces` filled (moments and own errors), which the views then read rather than compute
+  // each on its own.
+  void fill_for_views(const CollapseMesh& mesh, std::span<const FaceId> faces);
   double corners_moved(FaceId f);
   void release();
 
@@ -218,8 +228,9 @@ class EnergyEvaluator {
   // Face f's points into scratch_.points, with their distances to f as it is now (a face left
   // with its points by a rich star's collapse holds stale ones: EnergyPriority::drift_).
   void gather_face(const CollapseMesh& mesh, FaceId f, int home);
-  const PointMoments& moments_of(FaceId f);
-  const OwnError& own_error_of(const CollapseMesh& mesh, FaceId f);
+  // From the caches (the owner's, for a view), or computed (and kept, but by a view).
+  PointMoments moments_of(FaceId f);
+  OwnError own_error_of(const CollapseMesh& mesh, FaceId f);
   double plane_distance_sq(FaceId f, const Vec3& q0, const Vec3& q1, const Vec3& q2);
   // Where rim_sq tries the mean besides (q0, q1, q2): nowhere; the faces beside star face
   // `star_face` after the collapse; every face of the star after it; every face of the star
@@ -239,6 +250,7 @@ class EnergyEvaluator {
   double scalar_change();
 
   const EnergyPriority& module_;
+  const EnergyEvaluator* shared_ = nullptr;  // a view's owner, whose caches it reads
   uint64_t costings_ = 0;
 
   // The star at hand: rebuilt by each evaluate().
@@ -265,9 +277,10 @@ class EnergyEvaluator {
     int joined_count = 0;
     std::array<Placement, 16> placements;
     size_t placed = 0;
-    SharpCurves::Fit curve_fit;        // of the placement measured last
-    PlaneModel plane_model;            // of the last moment solve
-    std::vector<Projected> projected;  // per star point, at the chosen placement
+    SharpCurves::Gathered curve_samples;  // the curves' samples and segments of the star
+    SharpCurves::Fit curve_fit;           // of the placement measured last
+    PlaneModel plane_model;               // of the last moment solve
+    std::vector<Projected> projected;     // per star point, at the chosen placement
     std::array<std::vector<Projected>, 16> placement_projections;
     std::vector<PreparedTriangle> prepared;  // star with v at the projected position
     std::vector<Vec3> removal_points;        // evaluate_removal's points

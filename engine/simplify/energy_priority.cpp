@@ -115,6 +115,36 @@ double EnergyPriority::diagonal_of(const CollapseMesh& mesh) const {
                                          : bounding_box(mesh.positions()).diagonal();
 }
 
+void EnergyPriority::evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                                   Costing costing) {
+  if (!team_ || !team_awake_ || edges.size() < 2 || scalar_.enabled()) {
+    PriorityModule::evaluate_each(mesh, edges, costing);
+    return;
+  }
+  // The faces every costing reads the caches of: those around the edges' ends.
+  view_faces_.clear();
+  for (const EdgeCosting& e : edges)
+    for (const VertexId end : {e.a, e.b})
+      view_faces_.insert(view_faces_.end(), mesh.faces_of(end).begin(), mesh.faces_of(end).end());
+  std::sort(view_faces_.begin(), view_faces_.end());
+  view_faces_.erase(std::unique(view_faces_.begin(), view_faces_.end()), view_faces_.end());
+  evaluator_.fill_for_views(mesh, view_faces_);
+  while (views_.size() < team_->ranges(edges.size()))
+    views_.push_back(std::make_unique<EnergyEvaluator>(*this, evaluator_));
+  team_->run_indexed(edges.size(), [&](size_t range, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      EdgeCosting& e = edges[i];
+      e.placed = views_[range]->evaluate(mesh, e.a, e.b, e.candidate, costing);
+    }
+  });
+}
+
+uint64_t EnergyPriority::costings() const {
+  uint64_t sum = evaluator_.costings();
+  for (const auto& view : views_) sum += view->costings();
+  return sum;
+}
+
 void EnergyPriority::unpark(VertexId v) {
   const uint32_t id = parked_point_[v];
   if (id == kNoPoint) return;
@@ -163,39 +193,49 @@ double EnergyPriority::list_on_team(std::span<const FaceId> faces,
                                     const std::function<void(size_t, size_t)>& project) {
   const size_t moving = moved_.count;
   const size_t fan = faces.size();
+  // The points in blocks, each range taking every ranges-th block: the removed faces' points,
+  // listed first, cost more to project (their faces are gone) and are spread over the ranges.
   const size_t ranges = team_->ranges(moving);
-  // Per range and face of the fan: how many of the range's points go to the face, then where
+  const size_t blocks = std::min(moving, kBlocksPerRange * ranges);
+  auto block_begin = [&](size_t k) { return moving * k / blocks; };
+  auto each_block = [&](const std::function<void(size_t k)>& body) {
+    team_->run(ranges, [&](size_t begin, size_t end) {
+      for (size_t r = begin; r < end; ++r)
+        for (size_t k = r; k < blocks; k += ranges) body(k);
+    });
+  };
+  // Per block and face of the fan: how many of the block's points go to the face, then where
   // the first of them goes in by_face, which holds the points face after face, each face's
-  // the last point first (so the last range's first).
+  // the last point first (so the last block's first).
   std::vector<size_t>& slots = moved_.slots;
-  slots.assign(ranges * fan, 0);
-  team_->run_indexed(moving, [&](size_t r, size_t begin, size_t end) {
-    project(begin, end);
-    size_t* count = &slots[r * fan];
-    for (size_t i = begin; i < end; ++i) ++count[moved_.in_fan[i]];
+  slots.assign(blocks * fan, 0);
+  each_block([&](size_t k) {
+    project(block_begin(k), block_begin(k + 1));
+    size_t* count = &slots[k * fan];
+    for (size_t i = block_begin(k); i < block_begin(k + 1); ++i) ++count[moved_.in_fan[i]];
   });
   moved_.fan_start.resize(fan + 1);
   size_t at = 0;
   for (size_t j = 0; j < fan; ++j) {
     moved_.fan_start[j] = at;
-    for (size_t r = ranges; r-- > 0;) {
-      const size_t n = slots[r * fan + j];
-      slots[r * fan + j] = at;
+    for (size_t k = blocks; k-- > 0;) {
+      const size_t n = slots[k * fan + j];
+      slots[k * fan + j] = at;
       at += n;
     }
   }
   moved_.fan_start[fan] = at;
   if (moved_.by_face.size() < moving) moved_.by_face.resize(moving);
-  moved_.range_max_sq.assign(ranges, 0.0);
-  team_->run_indexed(moving, [&](size_t r, size_t begin, size_t end) {
-    size_t* next = &slots[r * fan];
+  moved_.block_max_sq.assign(blocks, 0.0);
+  each_block([&](size_t k) {
+    size_t* next = &slots[k * fan];
     double largest_sq = 0;
-    for (size_t i = end; i-- > begin;) {
+    for (size_t i = block_begin(k + 1); i-- > block_begin(k);) {
       const FacePoint& point = moved_.points[i];
       moved_.by_face[next[moved_.in_fan[i]]++] = point;
       largest_sq = std::max(largest_sq, point.distance_sq);
     }
-    moved_.range_max_sq[r] = largest_sq;
+    moved_.block_max_sq[k] = largest_sq;
   });
   // By face: its new points after its own, then its moments, which the next costings of the
   // edges around vs need (a star this rich is costed on them).
@@ -209,7 +249,7 @@ double EnergyPriority::list_on_team(std::span<const FaceId> faces,
       evaluator_.extend(faces[j], size_t(last - first));
     }
   });
-  return *std::max_element(moved_.range_max_sq.begin(), moved_.range_max_sq.end());
+  return *std::max_element(moved_.block_max_sq.begin(), moved_.block_max_sq.end());
 }
 
 // E_scalar after a performed collapse: the wedges joined for good, the star's wedges given the
@@ -251,6 +291,7 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
   // Every point of the old star goes to its closest face of the new one; so do the samples
   // of vt (removed) and of vs if it moved. A star too rich in points moves only those of the
   // removed faces and the samples (see the header).
+  team_awake_ = false;
   const auto& faces = mesh.faces_of(done.vs);
   size_t in_star = 0;
   for (FaceId f : {edge.left, edge.right})
@@ -321,7 +362,8 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
     }
   };
   // Last point first: each face then lists its points newest first (see initialize()).
-  if (team_ && moving >= team_->min_items()) {
+  team_awake_ = team_ && moving >= team_->min_items();
+  if (team_awake_) {
     max_distance_sq = std::max(max_distance_sq, list_on_team(faces, project));
   } else {
     project(0, moving);

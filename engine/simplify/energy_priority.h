@@ -76,6 +76,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <utility>
 #include <vector>
@@ -175,8 +176,13 @@ class EnergyPriority : public PriorityModule {
     return evaluator_.evaluate(mesh, std::min(vs, vt), std::max(vs, vt), out, costing,
                                EnergySeam{vs, at});
   }
+  // On the team, one edge per range, when the collapse before woke it (its projections ran
+  // there) and there are two edges or more, without E_scalar (whose costing writes the
+  // module's attribute scratch): each range costs on a view of the evaluator.
+  void evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                     Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
-  uint64_t costings() const override { return evaluator_.costings(); }
+  uint64_t costings() const override;
   void release_caches() override { evaluator_.release(); }
   // A collapse moving at least the team's min_items() points projects them, and lists them
   // and sums their moments by face, on the team.
@@ -270,6 +276,7 @@ class EnergyPriority : public PriorityModule {
   // The planned points into the first Reprojection::count of Reprojection::points, their
   // faces emptied: on the team when there are enough of them.
   void move_taken_points();
+  static constexpr size_t kBlocksPerRange = 4;  // list_on_team's blocks of points per range
   // The moved points projected by `project` (over ranges of them) and listed on their new
   // faces of `faces` (vs's), each face's moments computed again, on the team: by ranges of
   // points, then by face. Returns the points' largest squared distance.
@@ -304,6 +311,10 @@ class EnergyPriority : public PriorityModule {
   bool star_terms_on_ = false;      // either of the star's weights is non-zero
   EnergyEvaluator evaluator_{*this};
   ThreadTeam* team_ = nullptr;  // use_team
+  bool team_awake_ = false;     // the last collapse ran its projections on the team
+  // evaluate_each's: a view of evaluator_ per range, the faces around the edges' ends.
+  std::vector<std::unique_ptr<EnergyEvaluator>> views_;
+  std::vector<FaceId> view_faces_;
 
   // collapsed()'s working memory: the points it moves, where they go, the fan around vs.
   struct FanFace {
@@ -333,13 +344,13 @@ class EnergyPriority : public PriorityModule {
     std::vector<int> in_fan;                  // per point, its new face's index among vs's
     std::vector<FaceId> faces;                // and the face
     std::vector<std::array<double, 3>> bary;  // and its barycentric coordinates there
-    // list_on_team's: per range and face of the fan, a count, then an index in by_face; the
-    // moved points grouped by their new face, face j's from fan_start[j]; per range, its
+    // list_on_team's: per block and face of the fan, a count, then an index in by_face; the
+    // moved points grouped by their new face, face j's from fan_start[j]; per block, its
     // points' largest distance.
     std::vector<size_t> slots;
     std::vector<FacePoint> by_face;
     std::vector<size_t> fan_start;
-    std::vector<double> range_max_sq;
+    std::vector<double> block_max_sq;
   };
   Reprojection moved_;
   // check_global's marks: (generation << 10) | (subset << 1) | given. Each check writes its own

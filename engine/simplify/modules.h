@@ -41,6 +41,13 @@ struct CollapseCandidate {
 // near the cost kPerform would give.
 enum class Costing { kPerform, kQueue, kEstimate };
 
+// An edge to cost, and what its costing gave (PriorityModule::evaluate_each).
+struct EdgeCosting {
+  VertexId a = kNoId, b = kNoId;
+  bool placed = false;  // evaluate()'s answer
+  CollapseCandidate candidate;
+};
+
 class PriorityModule {
  public:
   virtual ~PriorityModule() = default;
@@ -58,6 +65,13 @@ class PriorityModule {
   // write the module's working memory and caches (a module serves one thread at a time).
   virtual bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                         Costing costing) = 0;
+  // evaluate() of each edge, with the answers and the module's state after as if they were
+  // costed one after the other in order (a costing changes no state but caches). A module may
+  // cost them side by side (the energy on its team, use_team). Default: one after the other.
+  virtual void evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                             Costing costing) {
+    for (EdgeCosting& e : edges) e.placed = evaluate(mesh, e.a, e.b, e.candidate, costing);
+  }
   // Costs the collapse of vt into vs, whether or not either end is locked: one collapse of a
   // seam collapse (copy_groups.h). vs goes to *at when given, else where the module places it
   // best. false: it cannot be costed (the default: a module that takes no part in seams).
@@ -131,9 +145,33 @@ class PriorityWrapper : public PriorityModule {
                  const EdgeFaces& edge) override {
     inner_.collapsed(mesh, done, edge);
   }
+  // (evaluate_each is not forwarded: a wrapper whose evaluate() changes answers costs each
+  // edge through it, unless it overrides evaluate_each too, with evaluate_picked.)
 
  protected:
+  // inner.evaluate_each of the edges `pick(edge)` is true of, in their order; `pick` may
+  // answer the others itself (each starts unplaced). Returns the indices of those costed.
+  template <typename Pick>
+  std::span<const size_t> evaluate_picked(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
+                                          Costing costing, Pick&& pick) {
+    picked_.clear();
+    picked_index_.clear();
+    for (size_t i = 0; i < edges.size(); ++i) {
+      edges[i].placed = false;
+      if (!pick(edges[i])) continue;
+      picked_.push_back(std::move(edges[i]));
+      picked_index_.push_back(i);
+    }
+    inner_.evaluate_each(mesh, picked_, costing);
+    for (size_t k = 0; k < picked_.size(); ++k) edges[picked_index_[k]] = std::move(picked_[k]);
+    return picked_index_;
+  }
+
   PriorityModule& inner_;
+
+ private:
+  std::vector<EdgeCosting> picked_;  // evaluate_picked's
+  std::vector<size_t> picked_index_;
 };
 
 class ConstraintModule {

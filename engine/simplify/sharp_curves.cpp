@@ -178,51 +178,52 @@ bool SharpCurves::changes_topology(VertexId a, VertexId b) const {
   return na.size() != 2 && nb.size() != 2;
 }
 
-void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh,
-                         size_t max_samples) const {
-  gathered_.clear();
-  gathered_weight_ = 1;
-  ends_.clear();
-  end_positions_.clear();
+void SharpCurves::gather(VertexId a, VertexId b, const CollapseMesh& mesh, size_t max_samples,
+                         Gathered& out) const {
+  std::vector<uint32_t>& gathered = out.samples;
+  gathered.clear();
+  out.weight = 1;
+  out.ends.clear();
+  out.end_positions.clear();
   if (samples_.empty()) return;
-  gathered_.insert(gathered_.end(), listed_at(a).begin(), listed_at(a).end());
+  gathered.insert(gathered.end(), listed_at(a).begin(), listed_at(a).end());
   for (uint32_t id : listed_at(b)) {
     const Sample& s = samples_[id];
-    if (s.u != a && s.w != a) gathered_.push_back(id);  // else listed at a too
+    if (s.u != a && s.w != a) gathered.push_back(id);  // else listed at a too
   }
-  if (max_samples > 0 && gathered_.size() > max_samples) {
-    const size_t n = gathered_.size(), stride = (n + max_samples - 1) / max_samples;
+  if (max_samples > 0 && gathered.size() > max_samples) {
+    const size_t n = gathered.size(), stride = (n + max_samples - 1) / max_samples;
     size_t kept = 0;
     for (size_t i = 0; i < n; ++i) {
-      const uint32_t id = gathered_[i];
+      const uint32_t id = gathered[i];
       if (kept_when_thinned(sample_id_.empty() ? id : sample_id_[id], stride))
-        gathered_[kept++] = id;
+        gathered[kept++] = id;
     }
     if (kept > 0) {
-      gathered_.resize(kept);
-      gathered_weight_ = double(n) / double(kept);
+      gathered.resize(kept);
+      out.weight = double(n) / double(kept);
     }
   }
   for (VertexId end : {a, b})
     for (VertexId x : sharp_neighbors(end))
-      if (x != a && x != b && !contains(ends_, x)) {
-        ends_.push_back(x);
-        end_positions_.push_back(mesh.position(x));
+      if (x != a && x != b && !contains(out.ends, x)) {
+        out.ends.push_back(x);
+        out.end_positions.push_back(mesh.position(x));
       }
 }
 
-SharpCurves::Fit SharpCurves::project(const Vec3& v) const {
+SharpCurves::Fit SharpCurves::project(const Gathered& gathered, const Vec3& v) const {
   Fit fit;
-  for (uint32_t id : gathered_) {
+  for (uint32_t id : gathered.samples) {
     const Vec3& x = samples_[id].position;
     double best = std::numeric_limits<double>::infinity();
     double b0 = 1;
     Vec3 rest{};
-    if (end_positions_.empty()) {
+    if (gathered.end_positions.empty()) {
       const Vec3 d = sub(x, v);
       best = dot(d, d);
     }
-    for (const Vec3& e : end_positions_) {
+    for (const Vec3& e : gathered.end_positions) {
       const SegmentProjection p = project_on_segment(x, v, e);
       if (p.distance_sq < best) best = p.distance_sq, b0 = 1 - p.t, rest = scale(e, p.t);
     }
@@ -233,19 +234,19 @@ SharpCurves::Fit SharpCurves::project(const Vec3& v) const {
     fit.b = add(fit.b, scale(offset, b0));
     fit.c += dot(offset, offset);
   }
-  if (gathered_weight_ != 1) {
-    fit.distance_sq *= gathered_weight_;
-    fit.a *= gathered_weight_;
-    fit.b = scale(fit.b, gathered_weight_);
-    fit.c *= gathered_weight_;
+  if (gathered.weight != 1) {
+    fit.distance_sq *= gathered.weight;
+    fit.a *= gathered.weight;
+    fit.b = scale(fit.b, gathered.weight);
+    fit.c *= gathered.weight;
   }
   return fit;
 }
 
-double SharpCurves::gathered_distance_sq() const {
+double SharpCurves::distance_sq(const Gathered& gathered) const {
   double sum = 0;
-  for (uint32_t id : gathered_) sum += samples_[id].distance_sq;
-  return sum * gathered_weight_;
+  for (uint32_t id : gathered.samples) sum += samples_[id].distance_sq;
+  return sum * gathered.weight;
 }
 
 void SharpCurves::unlist(VertexId v, uint32_t id) {
@@ -260,8 +261,7 @@ double SharpCurves::collapsed(VertexId vs, VertexId vt, const CollapseMesh& mesh
   // A job may hold sharp edges but none of their samples: the curves are updated anyway.
   if (neighbors_.empty()) return 0;  // no curves (and so no samples)
   if (samples_.empty() && neighbors_[vs].empty() && neighbors_[vt].empty()) return 0;
-  std::vector<uint32_t>& moved = gathered_;  // (every sample: no weights here)
-  gathered_weight_ = 1;
+  std::vector<uint32_t>& moved = moved_;  // (every sample: no weights here)
   moved.assign(listed_at_[vs].begin(), listed_at_[vs].end());
   for (uint32_t id : listed_at_[vt]) {
     const Sample& s = samples_[id];

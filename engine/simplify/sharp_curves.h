@@ -67,9 +67,18 @@ class SharpCurves {
   // The samples a collapse of {a, b} moves, and the curve segments (v, x) after it: x runs
   // over the sharp neighbours of a and b other than a and b. Late collapses move thousands of
   // samples along a long curve: beyond `max_samples`, about one in k stands for k
-  // (sample_thinning.h; project() and gathered_distance_sq() weigh them), which keeps an
-  // evaluation bounded. The performed collapse (collapsed()) moves every sample.
-  void gather(VertexId a, VertexId b, const CollapseMesh& mesh, size_t max_samples) const;
+  // (sample_thinning.h; project() and distance_sq() weigh them), which keeps an evaluation
+  // bounded. The performed collapse (collapsed()) moves every sample. A costing's own scratch:
+  // costings on several threads each gather into their own.
+  struct Gathered {
+    std::vector<uint32_t> samples;
+    double weight = 1;           // how many samples each gathered one stands for
+    std::vector<VertexId> ends;  // the x of the segments (v, x)
+    std::vector<Vec3> end_positions;
+    size_t size() const { return samples.size(); }
+  };
+  void gather(VertexId a, VertexId b, const CollapseMesh& mesh, size_t max_samples,
+              Gathered& out) const;
   struct Fit {
     double distance_sq = 0, max_distance_sq = 0, a = 0;
     Vec3 b{};      // as EnergyPriority's: sum of b0^2 and of b0 (x - (1 - b0) x_other)
@@ -78,9 +87,9 @@ class SharpCurves {
   };
   // The gathered samples projected onto the gathered segments with the moved vertex at v
   // (onto v itself when no segment is left).
-  Fit project(const Vec3& v) const;
-  double gathered_distance_sq() const;  // their distances before the collapse
-  size_t gathered() const { return gathered_.size(); }
+  Fit project(const Gathered& gathered, const Vec3& v) const;
+  // Their distances before the collapse.
+  double distance_sq(const Gathered& gathered) const;
 
   // Updates the curves and re-projects the samples after the collapse of vt into vs;
   // returns the largest distance squared among the samples it moved.
@@ -132,12 +141,7 @@ class SharpCurves {
   size_t edge_count_ = 0;
   size_t total_samples_ = 0;
   std::vector<uint32_t> sample_id_;  // a job's: per sample, the master's id (empty: identity)
-
-  // Scratch of one evaluation.
-  mutable std::vector<uint32_t> gathered_;
-  mutable double gathered_weight_ = 1;  // how many samples each gathered one stands for
-  mutable std::vector<VertexId> ends_;  // the x of the segments (v, x)
-  mutable std::vector<Vec3> end_positions_;
+  std::vector<uint32_t> moved_;      // collapsed()'s scratch: the samples it moves
 };
 
 }  // namespace parapm

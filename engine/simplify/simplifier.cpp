@@ -45,13 +45,18 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   if (a > b) std::swap(a, b);
   CollapseCandidate& candidate = queued_;
   candidate.seam = false;
-  if (!cost_edge(a, b, candidate, Costing::kQueue)) {
+  const bool placed = cost_edge(a, b, candidate, Costing::kQueue);
+  return entry_of_costing(a, b, placed, candidate.cost, entry);
+}
+
+bool Simplifier::entry_of_costing(VertexId a, VertexId b, bool placed, double cost, Entry& entry) {
+  if (!placed) {
     // Refused (a job's subset rule or cost ceiling, locked ends): once its star changes it is
     // deferred to the end of the queue, not costed at once to be refused again.
     if (defer_) remember_key(a, b, std::numeric_limits<float>::infinity());
     return false;
   }
-  entry = {key_of(candidate.cost, a, b), a, b, version_[a] + version_[b]};
+  entry = {key_of(cost, a, b), a, b, version_[a] + version_[b]};
   if (defer_) remember_key(a, b, entry.cost);
   return true;
 }
@@ -256,9 +261,61 @@ void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits
     list->clear();
   }
   const bool defer = defer_ && mesh_.live_faces() > limits.defer_above_faces;
+  if (screen_) {
+    requeue_costly(vs, defer);
+    return;
+  }
   for (VertexId n : ring_)
     if (!seam_already_queued(vs, n) && !(defer && defer_edge(vs, n))) push_edge(vs, n);
   for (const auto& [n, other] : retry_) retry_edge(n, other);
+}
+
+// The pushes in requeue_around's order, each edge's costing planned rather than done; then the
+// planned costings together; then the pushes in that order: the same queue as costing one
+// edge after the other (a costing changes no state a later one reads).
+void Simplifier::requeue_costly(VertexId vs, bool defer) {
+  planned_.clear();
+  size_t costings = 0;
+  auto plan_costing = [&](VertexId a, VertexId b) {
+    if (a > b) std::swap(a, b);
+    Entry entry{};
+    if (groups_ && groups_->is_copy(a) && groups_->is_copy(b)) {  // a seam's: costed now, alone
+      if (queue_entry(a, b, entry)) planned_.push_back({entry, kNotCosted});
+      return;
+    }
+    if (costings == costed_.size()) costed_.emplace_back();
+    costed_[costings].a = a;
+    costed_[costings].b = b;
+    costed_[costings].candidate.seam = false;
+    planned_.push_back({entry, costings++});
+    ++stats_.evaluations;
+  };
+  for (VertexId n : ring_) {
+    if (seam_already_queued(vs, n)) continue;
+    Entry entry{};
+    if (defer && deferred_entry(vs, n, entry)) {
+      planned_.push_back({entry, kNotCosted});
+      continue;
+    }
+    plan_costing(vs, n);
+  }
+  for (const auto& [n, other] : retry_) {
+    ++stats_.reevaluated;
+    if (!topologically_legal(n, other)) {  // (see retry_edge)
+      ++stats_.screened;
+      reject(n, other);
+      continue;
+    }
+    plan_costing(n, other);
+  }
+  priority_.evaluate_each(mesh_, std::span(costed_).first(costings), Costing::kQueue);
+  for (PlannedPush& push : planned_) {
+    if (push.costing != kNotCosted) {
+      const EdgeCosting& c = costed_[push.costing];
+      if (!entry_of_costing(c.a, c.b, c.placed, c.candidate.cost, push.entry)) continue;
+    }
+    queue_.push(push.entry);
+  }
 }
 
 bool Simplifier::cost_edge(VertexId a, VertexId b, CollapseCandidate& out, Costing costing) {

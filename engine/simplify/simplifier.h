@@ -221,6 +221,12 @@ class Simplifier {
   std::array<float*, 2> key_slots(VertexId a, VertexId b);
   // Costs edge {a, b}; false when the module cannot place it.
   bool queue_entry(VertexId a, VertexId b, Entry& entry);
+  // The entry of edge {a, b} (a < b) from its queue costing, its key remembered; false (and
+  // the refusal remembered) when the costing could not place it.
+  bool entry_of_costing(VertexId a, VertexId b, bool placed, double cost, Entry& entry);
+  // requeue_around's pushes with a costly module: the costings of a collapse's edges in one
+  // PriorityModule::evaluate_each.
+  void requeue_costly(VertexId vs, bool defer);
   // The queue key of edge {a, b} costing `cost`: the cost as a float, but a cost of exactly
   // zero (a flat neighbourhood, where every edge ties) goes below every positive key, shorter
   // edges first (-1 / length^2). Ties left to the ids let the smallest id absorb its flat
@@ -336,6 +342,14 @@ class Simplifier {
   // zeroing cost as much as a cheap costing.
   CollapseCandidate queued_;
   std::vector<std::pair<VertexId, VertexId>> retry_;
+  // requeue_costly's pushes in order: an entry, or the index of its costing in costed_.
+  static constexpr size_t kNotCosted = ~size_t{0};
+  struct PlannedPush {
+    Entry entry;
+    size_t costing = kNotCosted;
+  };
+  std::vector<PlannedPush> planned_;
+  std::vector<EdgeCosting> costed_;
   SimplifierStats stats_;
 };
 

@@ -116,6 +116,50 @@ TEST(EdgeKeys, ACarriedKeyAnswersOnceUntilAnEndOfItsEdgeChanges) {
   }
 }
 
+// Edges costed together (evaluate_each) take their carried keys, and leave their keys, as
+// costed one after the other: the first asking of every edge answered from its key, the
+// second costed by the module; the same current keys after.
+TEST(EdgeKeys, EdgesCostedTogetherAnswerAsOneAfterAnother) {
+  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
+  SimplifyOptions options;
+  options.metric = "energy";
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh mesh(repaired.mesh);
+  std::unique_ptr<PriorityModule> module = make_priority_module(options, repaired.mesh, locked);
+  module->initialize(mesh);
+  std::vector<EdgeCosting> edges;
+  std::vector<EdgeKey> carried;
+  size_t index = 0;
+  for (auto [a, b] : edges_of(mesh)) {
+    edges.push_back({a, b});
+    CollapseCandidate c;
+    // Keys not the module's (its cost plus one), for every other edge.
+    if (index++ % 2 == 0 && module->evaluate(mesh, a, b, c, Costing::kQueue))
+      carried.push_back({a, b, c.cost + 1});
+  }
+  KeyMemo one(*module, mesh.vertex_capacity()), together(*module, mesh.vertex_capacity());
+  one.reset(carried);
+  together.reset(carried);
+  for (int ask = 0; ask < 2; ++ask) {
+    together.evaluate_each(mesh, edges, Costing::kQueue);
+    for (const EdgeCosting& e : edges) {
+      CollapseCandidate c;
+      ASSERT_EQ(one.evaluate(mesh, e.a, e.b, c, Costing::kQueue), e.placed) << e.a << "-" << e.b;
+      if (e.placed) ASSERT_TRUE(same_cost(c.cost, e.candidate.cost)) << e.a << "-" << e.b;
+    }
+    EXPECT_EQ(together.reused(), one.reused());
+  }
+  EXPECT_EQ(one.reused(), carried.size());
+  const std::vector<EdgeKey> kept = one.current_keys(mesh),
+                             kept_together = together.current_keys(mesh);
+  ASSERT_EQ(kept.size(), kept_together.size());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    EXPECT_EQ(kept[i].a, kept_together[i].a);
+    EXPECT_EQ(kept[i].b, kept_together[i].b);
+    EXPECT_TRUE(same_cost(kept[i].cost, kept_together[i].cost));
+  }
+}
+
 // A round-0 job given its free edges' keys as the master costs them (exactly what it would
 // cost itself) makes the same collapses, the same returned state and keys, and answers its
 // first costing of every one of them from the keys.

@@ -299,10 +299,11 @@ TEST(ParallelBuild, SameBytesWhateverTheThreadCount) {
 }
 
 // The band passes' and the final pass's collapses that move many points project them, list
-// them and sum their moments on a team of threads (ParallelOptions::team_min_points), and so do
-// the jobs of a round with fewer subsets than p, each on a team of its own: the same PM whether
-// every collapse does, none, or only the rich ones, on one thread or four; and lossless. With
-// colours, the points go where their attributes fit too (E_scalar).
+// them and sum their moments on a team of threads (ParallelOptions::team_min_points), then cost
+// the edges around them there, and so do the jobs of a round with fewer subsets than p, each on
+// a team of its own: the same PM and the same costings whether every collapse does, none, or
+// only the rich ones, on one thread or four; and lossless. With colours, the points go where
+// their attributes fit too (E_scalar), and the edges are costed one after the other.
 TEST(ParallelBuild, TheTeamsChangeNoByte) {
   for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
     const RepairedMesh repaired = testing::repaired_test_mesh(name);
@@ -314,10 +315,11 @@ TEST(ParallelBuild, TheTeamsChangeNoByte) {
       parallel.min_subset_faces = 2000;  // rounds of 4 subsets, and of fewer at the tail
       return build_progressive_mesh_parallel(repaired, options, parallel, stats);
     };
-    const std::string none = testing::pm_bytes(build(0, 4));
-    ParallelStats stats;
+    ParallelStats alone, stats;
+    const std::string none = testing::pm_bytes(build(0, 4, &alone));
     EXPECT_TRUE(testing::pm_bytes(build(1, 4, &stats)) == none)
         << name << ": every collapse on the team";
+    EXPECT_EQ(stats.costings, alone.costings) << name;
     // (Rounds of fewer jobs than p: their jobs had teams.)
     EXPECT_TRUE(std::any_of(stats.round_stats.begin(), stats.round_stats.end(),
                             [](const RoundStats& r) { return r.subsets.size() < 4; }))

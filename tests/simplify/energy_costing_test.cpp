@@ -21,6 +21,7 @@
 #include "simplify/simplifier.h"
 #include "simplify/simplify.h"
 #include "test_support.h"
+#include "util/thread_team.h"
 
 namespace parapm {
 namespace {
@@ -408,6 +409,70 @@ TEST(EnergyCosting, ReleasedCachesChangeNoCosting) {
     }
   });
   EXPECT_GT(compared, 1000u);
+}
+
+// After a collapse that ran its projections on the team, the edges handed over together
+// (evaluate_each: a collapse's ring and its neighbours') are costed side by side, each on a
+// view of the module's evaluator: the answers, and the costings counted, are those of costing
+// them one after the other. Late in the simplification (stars costed on their faces' point
+// moments, read from the shared caches) and on a mesh with sharp curves (each view gathers its
+// own curve samples).
+TEST(EnergyPriority, EdgesCostedTogetherOnTheTeamCostAsOneAfterAnother) {
+  for (const double ratio : {0.5, 0.05}) {
+    Simplified s = simplified("cad-featuretype-3k.stl", EnergyOptions{}, ratio);
+    CollapseMesh& mesh = *s.mesh;
+    EnergyPriority& energy = *s.energy;
+    ThreadTeam team(4, 4, 1);
+    energy.use_team(&team);
+    const std::vector<uint8_t> locked = locked_vertices(s.repaired);
+    auto rules = standard_constraints(locked);
+    for (const auto& rule : rules) rule->initialize(mesh);
+    size_t batches = 0, compared = 0;
+    for_each_edge(mesh, [&](VertexId a, VertexId b) {
+      if (batches >= 8 || !mesh.vertex_alive(a) || !mesh.vertex_alive(b)) return;
+      CollapseCandidate c;
+      if (!energy.evaluate(mesh, a, b, c, Costing::kPerform)) return;
+      const EdgeFaces edge = mesh.edge_faces(c.vs, c.vt);
+      for (const auto& rule : rules)
+        if (!rule->allows(mesh, c, edge)) return;
+      c.vs_before = mesh.position(c.vs);
+      mesh.collapse(c.vs, c.vt, c.position, edge);
+      energy.collapsed(mesh, c, edge);
+      for (const auto& rule : rules) rule->collapsed(mesh, c);
+      // The edges around vs and around its neighbours.
+      std::vector<EdgeCosting> edges;
+      std::vector<VertexId> ring, around;
+      mesh.neighbors(c.vs, ring);
+      for (const VertexId n : ring) {
+        edges.push_back({std::min(c.vs, n), std::max(c.vs, n)});
+        mesh.neighbors(n, around);
+        for (const VertexId m : around)
+          if (m != c.vs && n < m) edges.push_back({n, m});
+      }
+      ASSERT_GE(edges.size(), 2u);
+      for (const Costing costing : {Costing::kQueue, Costing::kPerform}) {
+        const double team_seconds = team.seconds();
+        const uint64_t costings = energy.costings();
+        energy.evaluate_each(mesh, edges, costing);
+        EXPECT_GT(team.seconds(), team_seconds) << "not costed on the team";
+        EXPECT_EQ(energy.costings(), costings + edges.size());
+        for (const EdgeCosting& e : edges) {
+          CollapseCandidate alone;
+          ASSERT_EQ(energy.evaluate(mesh, e.a, e.b, alone, costing), e.placed) << e.a << "-" << e.b;
+          if (!e.placed) continue;
+          EXPECT_EQ(alone.vs, e.candidate.vs);
+          EXPECT_EQ(alone.position, e.candidate.position);
+          EXPECT_EQ(alone.cost, e.candidate.cost) << ratio << ": " << e.a << "-" << e.b;
+          EXPECT_EQ(alone.error, e.candidate.error);
+          ++compared;
+        }
+      }
+      ++batches;
+    });
+    EXPECT_EQ(batches, 8u) << ratio;
+    EXPECT_GT(compared, 200u) << ratio;
+    energy.use_team(nullptr);
+  }
 }
 
 TEST(EnergyPriority, InitializationInChunksSideBySideEqualsInitialize) {
