@@ -33,6 +33,22 @@ std::vector<std::pair<VertexId, VertexId>> edges_of(const CollapseMesh& mesh) {
   return {edges.begin(), edges.end()};
 }
 
+// A test mesh, repaired, and an energy module for it (not initialised).
+struct EnergyOnMesh {
+  static SimplifyOptions energy() {
+    SimplifyOptions options;
+    options.metric = "energy";
+    return options;
+  }
+  explicit EnergyOnMesh(const char* name)
+      : repaired(testing::repaired_test_mesh(name)),
+        locked(locked_vertices(repaired)),
+        module(make_priority_module(energy(), repaired.mesh, locked)) {}
+  RepairedMesh repaired;
+  std::vector<uint8_t> locked;
+  std::unique_ptr<PriorityModule> module;
+};
+
 TEST(EdgeKeys, ACarriedKeyAnswersOnceUntilAnEndOfItsEdgeChanges) {
   for (const char* metric : {"energy", "quadric"}) {
     const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
@@ -120,12 +136,9 @@ TEST(EdgeKeys, ACarriedKeyAnswersOnceUntilAnEndOfItsEdgeChanges) {
 // costed one after the other: the first asking of every edge answered from its key, the
 // second costed by the module; the same current keys after.
 TEST(EdgeKeys, EdgesCostedTogetherAnswerAsOneAfterAnother) {
-  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
-  SimplifyOptions options;
-  options.metric = "energy";
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  CollapseMesh mesh(repaired.mesh);
-  std::unique_ptr<PriorityModule> module = make_priority_module(options, repaired.mesh, locked);
+  const EnergyOnMesh energy("stratocaster-9k.ply");
+  CollapseMesh mesh(energy.repaired.mesh);
+  PriorityModule* module = energy.module.get();
   module->initialize(mesh);
   std::vector<EdgeCosting> edges;
   std::vector<EdgeKey> carried;
@@ -200,12 +213,10 @@ TEST(EdgeKeys, AJobGivenFreshKeysSimplifiesAsWithout) {
 // (SimplifierLimits::first_deferred), queues them deferred without costing them while it
 // defers, and holds them exactly as the first run left them; not deferring, it costs them.
 TEST(DeferredEdges, ARunGivenTheDeferredEdgesQueuesThemUncosted) {
-  const RepairedMesh repaired = testing::repaired_test_mesh("stratocaster-9k.ply");
-  SimplifyOptions options;
-  options.metric = "energy";
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  CollapseMesh mesh(repaired.mesh);
-  std::unique_ptr<PriorityModule> module = make_priority_module(options, repaired.mesh, locked);
+  const EnergyOnMesh energy("stratocaster-9k.ply");
+  const std::vector<uint8_t>& locked = energy.locked;
+  CollapseMesh mesh(energy.repaired.mesh);
+  PriorityModule* module = energy.module.get();
   Simplifier first(mesh, *module, standard_constraints(locked));
   SimplifierLimits limits;
   limits.defer_above_faces = 0;
@@ -252,7 +263,7 @@ TEST(DeferredEdges, ARunGivenTheDeferredEdgesQueuesThemUncosted) {
   EXPECT_EQ(third.stats().deferred, 0u);
   EXPECT_TRUE(third.deferred_edges().empty());
   std::printf("%zu edges after %zu faces removed: %zu left deferred, queued uncosted again\n",
-              edges, repaired.mesh.face_count() - mesh.live_faces(), deferred.size());
+              edges, energy.repaired.mesh.face_count() - mesh.live_faces(), deferred.size());
 }
 
 }  // namespace

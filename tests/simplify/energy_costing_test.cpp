@@ -82,6 +82,17 @@ bool folds_a_face(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& 
   return false;
 }
 
+// Whether the energy places the collapse of {a, b} (into c) and `rules` allow it.
+bool legal_collapse(const CollapseMesh& mesh, EnergyPriority& energy,
+                    const std::vector<std::unique_ptr<ConstraintModule>>& rules, VertexId a,
+                    VertexId b, CollapseCandidate& c) {
+  if (!energy.evaluate(mesh, a, b, c, Costing::kPerform)) return false;
+  const EdgeFaces edge = mesh.edge_faces(c.vs, c.vt);
+  for (const auto& rule : rules)
+    if (!rule->allows(mesh, c, edge)) return false;
+  return true;
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -377,10 +388,7 @@ TEST(EnergyCosting, ReleasedCachesChangeNoCosting) {
   for_each_edge(kept_mesh, [&](VertexId a, VertexId b) {
     if (collapses >= 20 || !kept_mesh.vertex_alive(a) || !kept_mesh.vertex_alive(b)) return;
     CollapseCandidate c;
-    if (!kept.evaluate(kept_mesh, a, b, c, Costing::kPerform)) return;
-    const EdgeFaces edge = kept_mesh.edge_faces(c.vs, c.vt);
-    for (const auto& rule : rules)
-      if (!rule->allows(kept_mesh, c, edge)) return;
+    if (!legal_collapse(kept_mesh, kept, rules, a, b, c)) return;
     std::vector<double> errors;  // the records' error bounds, refined by collapsed()
     for (const auto& pair : {std::pair{&kept_mesh, &kept}, std::pair{&released_mesh, &released}}) {
       CollapseCandidate done = c;
@@ -431,10 +439,8 @@ TEST(EnergyPriority, EdgesCostedTogetherOnTheTeamCostAsOneAfterAnother) {
     for_each_edge(mesh, [&](VertexId a, VertexId b) {
       if (batches >= 8 || !mesh.vertex_alive(a) || !mesh.vertex_alive(b)) return;
       CollapseCandidate c;
-      if (!energy.evaluate(mesh, a, b, c, Costing::kPerform)) return;
+      if (!legal_collapse(mesh, energy, rules, a, b, c)) return;
       const EdgeFaces edge = mesh.edge_faces(c.vs, c.vt);
-      for (const auto& rule : rules)
-        if (!rule->allows(mesh, c, edge)) return;
       c.vs_before = mesh.position(c.vs);
       mesh.collapse(c.vs, c.vt, c.position, edge);
       energy.collapsed(mesh, c, edge);
