@@ -185,7 +185,8 @@ class EnergyPriority : public PriorityModule {
   uint64_t costings() const override;
   void release_caches() override { evaluator_.release(); }
   // A collapse moving at least the team's min_items() points projects them, and lists them
-  // and sums their moments by face, on the team.
+  // and sums their moments by face, on the team; the edges around it are then costed there
+  // (evaluate_each).
   void use_team(ThreadTeam* team) override { team_ = team; }
 
   // State export/import for the parallel construction (module_state.h). export_local: the
@@ -277,9 +278,9 @@ class EnergyPriority : public PriorityModule {
   // faces emptied: on the team when there are enough of them.
   void move_taken_points();
   static constexpr size_t kBlocksPerRange = 4;  // list_on_team's blocks of points per range
-  // The moved points projected by `project` (over ranges of them) and listed on their new
-  // faces of `faces` (vs's), each face's moments computed again, on the team: by ranges of
-  // points, then by face. Returns the points' largest squared distance.
+  // The moved points projected by `project` (over a range of them) and listed on their new
+  // faces of `faces` (vs's), each face's moments extended, on the team: by blocks of points,
+  // then by face. Returns the points' largest squared distance.
   double list_on_team(std::span<const FaceId> faces,
                       const std::function<void(size_t, size_t)>& project);
   FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
