@@ -160,38 +160,37 @@ void EnergyPriority::take(FaceId f, int home, bool removed) {
   drift_[f] = 0;
 }
 
-void EnergyPriority::move_taken_points() {
+void EnergyPriority::grow_moved_buffers() {
   const size_t count = moved_.count;
   for (auto* buffer : {&moved_.homes, &moved_.in_fan})
     if (buffer->size() < count) buffer->resize(count);
   if (moved_.points.size() < count) moved_.points.resize(count);
   if (moved_.faces.size() < count) moved_.faces.resize(count);
   if (moved_.bary.size() < count) moved_.bary.resize(count);
-  auto move = [&](size_t begin, size_t end) {
-    for (size_t s = begin; s < end; ++s) {
-      const Reprojection::Source& source = moved_.sources[s];
-      if (source.face == kNoId) {
-        moved_.points[source.at] = source.sample;
-        moved_.homes[source.at] = source.home;
-        continue;
-      }
-      std::vector<FacePoint>& list = face_points_[source.face];
-      std::copy(list.begin(), list.end(), moved_.points.begin() + ptrdiff_t(source.at));
-      std::fill_n(moved_.homes.begin() + ptrdiff_t(source.at), list.size(), source.home);
-      list.clear();
-      if (source.removed) list.shrink_to_fit();
+}
+
+void EnergyPriority::move_taken_points() {
+  grow_moved_buffers();
+  for (const Reprojection::Source& source : moved_.sources) {
+    if (source.face == kNoId) {
+      moved_.points[source.at] = source.sample;
+      moved_.homes[source.at] = source.home;
+      continue;
     }
-  };
-  if (team_ && count >= team_->min_items()) {
-    team_->run(moved_.sources.size(), move);
-  } else {
-    move(0, moved_.sources.size());
+    std::vector<FacePoint>& list = face_points_[source.face];
+    std::copy(list.begin(), list.end(), moved_.points.begin() + ptrdiff_t(source.at));
+    std::fill_n(moved_.homes.begin() + ptrdiff_t(source.at), list.size(), source.home);
+    list.clear();
+    if (source.removed) list.shrink_to_fit();
   }
 }
 
-double EnergyPriority::list_on_team(std::span<const FaceId> faces,
-                                    const std::function<void(size_t, size_t)>& project) {
+double EnergyPriority::list_on_team(
+    std::span<const FaceId> faces,
+    const std::function<void(size_t i, FacePoint point, int home)>& project) {
+  grow_moved_buffers();
   const size_t moving = moved_.count;
+  const std::vector<Reprojection::Source>& sources = moved_.sources;
   const size_t fan = faces.size();
   // The points in blocks, each range taking every ranges-th block: the removed faces' points,
   // listed first, cost more to project (their faces are gone) and are spread over the ranges.
@@ -210,9 +209,19 @@ double EnergyPriority::list_on_team(std::span<const FaceId> faces,
   std::vector<size_t>& slots = moved_.slots;
   slots.assign(blocks * fan, 0);
   each_block([&](size_t k) {
-    project(block_begin(k), block_begin(k + 1));
+    const size_t begin = block_begin(k), end = block_begin(k + 1);
+    // Point i is in the last source starting at or before it (a face's list, or a sample).
+    auto source =
+        std::upper_bound(sources.begin(), sources.end(), begin,
+                         [](size_t i, const Reprojection::Source& s) { return i < s.at; });
     size_t* count = &slots[k * fan];
-    for (size_t i = block_begin(k); i < block_begin(k + 1); ++i) ++count[moved_.in_fan[i]];
+    for (size_t i = begin; i < end; ++i) {
+      while (source != sources.end() && source->at <= i) ++source;
+      const Reprojection::Source& from = *(source - 1);
+      project(i, from.face == kNoId ? from.sample : face_points_[from.face][i - from.at],
+              from.home);
+      ++count[moved_.in_fan[i]];
+    }
   });
   moved_.fan_start.resize(fan + 1);
   size_t at = 0;
@@ -237,14 +246,26 @@ double EnergyPriority::list_on_team(std::span<const FaceId> faces,
     }
     moved_.block_max_sq[k] = largest_sq;
   });
-  // By face: its new points after its own, then its moments, which the next costings of the
-  // edges around vs need (a star this rich is costed on them).
+  // The faces the points left, emptied; by face of the fan: its new points after those it
+  // kept, then its moments, which the next costings of the edges around vs need (a star this
+  // rich is costed on them).
+  moved_.fan_taken.assign(fan, 0);
+  for (const Reprojection::Source& from : sources) {
+    if (from.face == kNoId) continue;
+    if (!from.removed) {
+      moved_.fan_taken[size_t(from.home)] = 1;
+      continue;
+    }
+    face_points_[from.face].clear();
+    face_points_[from.face].shrink_to_fit();
+  }
   team_->run(fan, [&](size_t begin, size_t end) {
     for (size_t j = begin; j < end; ++j) {
+      std::vector<FacePoint>& list = face_points_[faces[j]];
+      if (moved_.fan_taken[j]) list.clear();
       const auto first = moved_.by_face.begin() + ptrdiff_t(moved_.fan_start[j]);
       const auto last = moved_.by_face.begin() + ptrdiff_t(moved_.fan_start[j + 1]);
       if (first == last) continue;
-      std::vector<FacePoint>& list = face_points_[faces[j]];
       list.insert(list.end(), first, last);
       evaluator_.extend(faces[j], size_t(last - first));
     }
@@ -346,27 +367,26 @@ void EnergyPriority::collapsed(const CollapseMesh& mesh, CollapseCandidate& done
       max_distance_sq = std::max(max_distance_sq, bound * bound);
     }
   }
-  move_taken_points();
   prepare_fan(mesh, done.vs);
   const size_t moving = moved_.count;
-  // Each point's face and projection, independent of the others': on the team when there
-  // are enough of them.
-  auto project = [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
-      FacePoint& point = moved_.points[i];
-      const auto [j, best] = closest_fan_face(mesh, faces, point, moved_.homes[i]);
-      moved_.in_fan[i] = j;
-      moved_.faces[i] = faces[j];
-      moved_.bary[i] = best.bary;
-      point.distance_sq = best.distance_sq;
-    }
+  // Point i's face and projection (independent of the others': on the team when there are
+  // enough of them), from where it was (its home: the index among vs's faces of its old
+  // face's image, -1 for an unparked sample), into the per-point buffers.
+  auto project = [&](size_t i, FacePoint point, int home) {
+    const auto [j, best] = closest_fan_face(mesh, faces, point, home);
+    moved_.in_fan[i] = j;
+    moved_.faces[i] = faces[j];
+    moved_.bary[i] = best.bary;
+    point.distance_sq = best.distance_sq;
+    moved_.points[i] = point;
   };
   // Last point first: each face then lists its points newest first (see initialize()).
   team_awake_ = team_ && moving >= team_->min_items();
   if (team_awake_) {
     max_distance_sq = std::max(max_distance_sq, list_on_team(faces, project));
   } else {
-    project(0, moving);
+    move_taken_points();
+    for (size_t i = 0; i < moving; ++i) project(i, moved_.points[i], moved_.homes[i]);
     for (size_t i = moving; i-- > 0;) {
       face_points_[moved_.faces[i]].push_back(moved_.points[i]);
       evaluator_.forget(moved_.faces[i]);

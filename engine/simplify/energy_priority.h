@@ -274,15 +274,18 @@ class EnergyPriority : public PriorityModule {
   // vs's faces, `removed` for a face the collapse removes. move_taken_points() moves them.
   void unpark(VertexId v);
   void take(FaceId f, int home, bool removed);
+  // The per-point buffers of Reprojection grown to its count (they only grow).
+  void grow_moved_buffers();
   // The planned points into the first Reprojection::count of Reprojection::points, their
-  // faces emptied: on the team when there are enough of them.
+  // faces emptied.
   void move_taken_points();
   static constexpr size_t kBlocksPerRange = 4;  // list_on_team's blocks of points per range
-  // The moved points projected by `project` (over a range of them) and listed on their new
-  // faces of `faces` (vs's), each face's moments extended, on the team: by blocks of points,
-  // then by face. Returns the points' largest squared distance.
+  // The planned points, read where they are, projected by `project` (point i, and its home)
+  // and listed on their new faces of `faces` (vs's), the faces they left emptied and each
+  // face's moments extended, on the team: by blocks of points, then by face. Returns the
+  // points' largest squared distance.
   double list_on_team(std::span<const FaceId> faces,
-                      const std::function<void(size_t, size_t)>& project);
+                      const std::function<void(size_t i, FacePoint point, int home)>& project);
   FacePoint parked(uint32_t id) const { return {positions_[id], 0.0, id}; }
   double diagonal_of(const CollapseMesh& mesh) const;
   void initialize_curves(const CollapseMesh& mesh, ChunkedLoops& loops);  // curves_ only
@@ -352,6 +355,7 @@ class EnergyPriority : public PriorityModule {
     std::vector<FacePoint> by_face;
     std::vector<size_t> fan_start;
     std::vector<double> block_max_sq;
+    std::vector<uint8_t> fan_taken;  // per face of the fan: its points were taken
   };
   Reprojection moved_;
   // check_global's marks: (generation << 10) | (subset << 1) | given. Each check writes its own
