@@ -271,7 +271,8 @@ class EnergyPriority : public PriorityModule {
   }
   // collapsed()'s plan of the points that move (Reprojection::sources): v's parked sample;
   // face f's points (its moments and drift dropped now), `home` the index of f's image among
-  // vs's faces, `removed` for a face the collapse removes. move_taken_points() moves them.
+  // vs's faces, `removed` for a face the collapse removes. move_taken_points() or list_on_team()
+  // moves them.
   void unpark(VertexId v);
   void take(FaceId f, int home, bool removed);
   // The per-point buffers of Reprojection grown to its count (they only grow).
