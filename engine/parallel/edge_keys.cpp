@@ -45,10 +45,12 @@ bool KeyMemo::evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, Collaps
                        Costing costing) {
   if (costing != Costing::kQueue) return inner_.evaluate(mesh, a, b, out, costing);
   const VertexId lo = std::min(a, b), hi = std::max(a, b);
+  Entry* const e = find(lo, hi);
   bool placed = false;
-  if (answer(lo, hi, out, placed)) return placed;
+  if (answer(lo, e, out, placed)) return placed;
   placed = inner_.evaluate(mesh, a, b, out, costing);
-  store(find(lo, hi), lo, hi, placed ? out.cost : std::numeric_limits<double>::quiet_NaN(), false);
+  // (The inner module never touches the memo, so `e` still points at the entry.)
+  store(e, lo, hi, placed ? out.cost : std::numeric_limits<double>::quiet_NaN(), false);
   return placed;
 }
 
@@ -59,7 +61,8 @@ void KeyMemo::evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edg
     return;
   }
   const std::span<const size_t> costed = evaluate_picked(mesh, edges, costing, [&](EdgeCosting& e) {
-    return !answer(std::min(e.a, e.b), std::max(e.a, e.b), e.candidate, e.placed);
+    const VertexId lo = std::min(e.a, e.b);
+    return !answer(lo, find(lo, std::max(e.a, e.b)), e.candidate, e.placed);
   });
   // (The edges are distinct: answering or storing one changes no other's entry.)
   for (const size_t i : costed) {
@@ -70,8 +73,7 @@ void KeyMemo::evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edg
   }
 }
 
-bool KeyMemo::answer(VertexId lo, VertexId hi, CollapseCandidate& out, bool& placed) {
-  Entry* const e = find(lo, hi);
+bool KeyMemo::answer(VertexId lo, Entry* e, CollapseCandidate& out, bool& placed) {
   if (!e || !e->carried || !current(lo, *e)) return false;
   ++reused_;
   e->carried = false;  // answered once: the simplifier's next costing of it needs a fresh one

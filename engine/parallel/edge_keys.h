@@ -86,9 +86,9 @@ class KeyMemo : public PriorityWrapper {
     return changed_at_[a] <= e.time && changed_at_[e.other] <= e.time;
   }
   Entry* find(VertexId a, VertexId b) const;
-  // A queue costing of edge (lo, hi) from its carried key, if it has one still current
-  // (answered once: then forgotten as carried).
-  bool answer(VertexId lo, VertexId hi, CollapseCandidate& out, bool& placed);
+  // A queue costing of edge (lo, hi) from its carried key `e` (find(lo, hi)'s answer), if it
+  // is one still current (answered once: then forgotten as carried).
+  bool answer(VertexId lo, Entry* e, CollapseCandidate& out, bool& placed);
   // Overwrites `found` (find(a, b)'s answer) or lists a new entry at a.
   void store(Entry* found, VertexId a, VertexId b, double cost, bool carried) const;
 

@@ -279,7 +279,7 @@ void Simplifier::requeue_costly(VertexId vs, bool defer) {
   auto plan_costing = [&](VertexId a, VertexId b) {
     if (a > b) std::swap(a, b);
     Entry entry{};
-    if (groups_ && groups_->is_copy(a) && groups_->is_copy(b)) {  // a seam's: costed now, alone
+    if (seam_edge(a, b)) {  // a seam's: costed now, alone
       if (queue_entry(a, b, entry)) planned_.push_back({entry, kNotCosted});
       return;
     }
@@ -319,7 +319,7 @@ void Simplifier::requeue_costly(VertexId vs, bool defer) {
 }
 
 bool Simplifier::cost_edge(VertexId a, VertexId b, CollapseCandidate& out, Costing costing) {
-  if (groups_ && groups_->is_copy(a) && groups_->is_copy(b)) return cost_seam(a, b, out, costing);
+  if (seam_edge(a, b)) return cost_seam(a, b, out, costing);
   ++stats_.evaluations;
   return priority_.evaluate(mesh_, a, b, out, costing);
 }

@@ -265,6 +265,10 @@ class Simplifier {
   void requeue_around(VertexId vs, VertexId vt, const SimplifierLimits& limits);
   // The module's costing of edge {a, b}, or the seam collapse's between their groups.
   bool cost_edge(VertexId a, VertexId b, CollapseCandidate& out, Costing costing);
+  // Whether edge {a, b} joins two copies: a seam's, costed by cost_seam.
+  bool seam_edge(VertexId a, VertexId b) const {
+    return groups_ && groups_->is_copy(a) && groups_->is_copy(b);
+  }
   struct SeamPair {
     VertexId vs, vt;
   };
