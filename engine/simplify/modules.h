@@ -94,6 +94,11 @@ class PriorityModule {
   // "Vetoed edges"). The parallel build carries only a costly module's queue keys from round
   // to round (edge_keys.h): for a cheap one, carrying costs more than costing again.
   virtual bool costly() const { return false; }
+  // Whether an edge's queue costing (kQueue) reads only its two ends' own state (their
+  // positions and what the module keeps per vertex), not their stars': then its key stays
+  // while neither end changes, however the faces around them do, and the simplifier may cost
+  // an edge's collapse when it queues it (Simplifier::queue_checked). Default: false.
+  virtual bool queue_key_of_ends_only() const { return false; }
   // The edges this module has costed itself so far (its evaluate calls; a wrapper's own
   // answers, such as a carried key or a subset rule's refusal, are not counted). Summed over a
   // build's modules it is the build's work in costings, the figure the parallel build's work
@@ -126,6 +131,7 @@ class PriorityWrapper : public PriorityModule {
   explicit PriorityWrapper(PriorityModule& inner) : inner_(inner) {}
   std::string name() const override { return inner_.name(); }
   bool costly() const override { return inner_.costly(); }
+  bool queue_key_of_ends_only() const override { return inner_.queue_key_of_ends_only(); }
   uint64_t costings() const override { return inner_.costings(); }
   void release_caches() override { inner_.release_caches(); }
   void use_team(ThreadTeam* team) override { inner_.use_team(team); }

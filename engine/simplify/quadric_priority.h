@@ -53,6 +53,9 @@ class QuadricPriority : public PriorityModule {
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                      CollapseCandidate& out, Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
+  // A queue key is the ends' summed quadric's: at its free optimum, or its least value at the
+  // edge's midpoint, or at a locked end.
+  bool queue_key_of_ends_only() const override { return true; }
   // Prefetches the quadrics (two cache lines each) and lock flags of `from` and `to`.
   void will_cost(VertexId from, std::span<const VertexId> to) const override;
   uint64_t costings() const override { return costings_; }

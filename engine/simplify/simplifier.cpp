@@ -123,18 +123,6 @@ std::vector<DeferredEdge> Simplifier::deferred_edges() {
   return out;
 }
 
-void Simplifier::retry_edge(VertexId a, VertexId b) {
-  ++stats_.reevaluated;
-  // Vetoed once, an edge is often vetoed again (near the legal minimum, thousands are, each
-  // star change around them): with a costly module, check the rules that need no costing first.
-  if (screen_ && !topologically_legal(a, b)) {
-    ++stats_.screened;
-    reject(a, b);
-    return;
-  }
-  push_edge(a, b);
-}
-
 bool Simplifier::seam_already_queued(VertexId a, VertexId b) {
   if (!queueing_seams_ || !groups_->is_copy(a) || !groups_->is_copy(b)) return false;
   const std::pair<uint32_t, uint32_t> pair = std::minmax(groups_->group[a], groups_->group[b]);
@@ -266,8 +254,43 @@ void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits
     return;
   }
   for (VertexId n : ring_)
-    if (!seam_already_queued(vs, n) && !(defer && defer_edge(vs, n))) push_edge(vs, n);
-  for (const auto& [n, other] : retry_) retry_edge(n, other);
+    if (!seam_already_queued(vs, n) && !(defer && defer_edge(vs, n))) queue_checked(vs, n, limits);
+  for (const auto& [n, other] : retry_) {
+    ++stats_.reevaluated;
+    queue_checked(n, other, limits);
+  }
+}
+
+void Simplifier::queue_checked(VertexId a, VertexId b, const SimplifierLimits& limits) {
+  Entry entry;
+  if (!queue_entry(a, b, entry)) return;
+  // (not within a seam collapse, whose survivors' versions change one after another)
+  if (check_when_queued_ && entry.cost <= last_key_ && !queueing_seams_ &&
+      !seam_edge(entry.a, entry.b) && vetoed_when_queued(entry, limits))
+    return;
+  queue_.push(entry);
+}
+
+bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits) {
+  // run()'s steps for a current entry on top, up to its rules; an edge its pop would drop
+  // without a veto (unplaced, gone, over the ceiling) is queued.
+  CollapseCandidate& candidate = checked_;
+  candidate.seam = false;
+  if (!cost_edge(entry.a, entry.b, candidate, Costing::kPerform)) return false;
+  const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
+  if ((edge.left == kNoId && edge.right == kNoId) || candidate.cost > limits.max_cost)
+    return false;
+  for (const auto& module : constraints_) {
+    if (!module->star_local() || module->allows(mesh_, candidate, edge)) continue;
+    ++stats_.rejected;
+    ++stats_.vetoed_when_queued;
+    reject(entry.a, entry.b);
+    return true;
+  }
+  entry.stamp |= kRequeued;
+  requeued_[edge_key(entry.a, entry.b)] = {mesh_.star_version(entry.a),
+                                           mesh_.star_version(entry.b), candidate};
+  return false;
 }
 
 // The pushes in requeue_around's order, each edge's costing planned rather than done; then the
@@ -301,7 +324,9 @@ void Simplifier::requeue_costly(VertexId vs, bool defer) {
   }
   for (const auto& [n, other] : retry_) {
     ++stats_.reevaluated;
-    if (!topologically_legal(n, other)) {  // (see retry_edge)
+    // Vetoed once, an edge is often vetoed again (near the legal minimum, thousands are, each
+    // star change around them): the rules that need no costing first.
+    if (!topologically_legal(n, other)) {
       ++stats_.screened;
       reject(n, other);
       continue;
@@ -541,6 +566,7 @@ void Simplifier::begin_run(const SimplifierLimits& limits) {
   face_keys_.assign(defer_ ? 3 * size_t(mesh_.face_capacity()) : 0,
                     std::numeric_limits<float>::quiet_NaN());
   screen_ = priority_.costly();
+  check_when_queued_ = !screen_ && priority_.queue_key_of_ends_only();
 }
 
 void Simplifier::build_first_queue(const SimplifierLimits& limits, const CancelToken* cancel) {
@@ -696,6 +722,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
                                                  mesh_.star_version(entry.b), std::move(candidate)};
       continue;
     }
+    last_key_ = now.cost;
     if (candidate.seam) {
       if (!perform_seam(candidate, limits, records)) {
         ++stats_.rejected;

@@ -127,6 +127,8 @@ struct SimplifierStats {
   // (retried after their star changed, or on top of the queue: those count as rejected too).
   uint64_t screened = 0;
   uint64_t deferred = 0;        // edges queued below their last key instead of costed at once
+  // Of the rejected: edges vetoed as they were queued (Simplifier::queue_checked), never popped.
+  uint64_t vetoed_when_queued = 0;
   uint64_t compactions = 0;     // passes dropping the queue's stale entries at once
   uint64_t over_ceiling = 0;    // popped edges whose cost was above SimplifierLimits::max_cost
   uint64_t seam_collapses = 0;  // performed (join_copies), each one record per copy removed
@@ -233,8 +235,17 @@ class Simplifier {
   // neighbours one after the other: a hub whose slivers veto the collapses around it.
   // (Lindstrom-Turk's shape term settles the same ties by edge length.)
   float key_of(double cost, VertexId a, VertexId b) const;
-  // Pushes an edge vetoed before, whose star has changed since.
-  void retry_edge(VertexId a, VertexId b);
+  // Queues edge {a, b} as push_edge does after a collapse. With check_when_queued_, an edge
+  // keyed at or below that collapse's key (it comes out before anything queued earlier above
+  // it, often next) is costed for its collapse now: when a rule of its star vetoes it, it
+  // waits among the vetoed edges instead of in the queue, as its pop would have left it (the
+  // same star, so the same costing and veto: its next retry comes with the next change of its
+  // star either way, and its key is the same then); when none does, its entry keeps the
+  // costing for its pop (requeued_).
+  void queue_checked(VertexId a, VertexId b, const SimplifierLimits& limits);
+  // queue_checked's costing of `entry`'s edge for its collapse: true when a rule of its star
+  // vetoes it (then rejected), false when it is to be queued (its costing kept when it passes).
+  bool vetoed_when_queued(Entry& entry, const SimplifierLimits& limits);
   void remember_rejected(VertexId v, VertexId other);
   void reject(VertexId a, VertexId b);
   bool topologically_legal(VertexId a, VertexId b) const;
@@ -301,6 +312,9 @@ class Simplifier {
   size_t compacted_size_ = 0;  // the queue's size after the last compact_queue()
   // priority_.costly(): retried and top edges meet the topological rules before any costing.
   bool screen_ = false;
+  // A cheap module whose queue keys read the edge's ends only (queue_checked).
+  bool check_when_queued_ = false;
+  float last_key_ = 0;  // the key of the collapse last made
   // Per vertex, from zeroed pages (a run over a band of a large mesh touches the band's).
   ZeroedArray<uint32_t> version_;
   // Per vertex: the edges vetoed since its last change, a list of rejected_lists_ (its index
@@ -345,6 +359,7 @@ class Simplifier {
   // queue_entry's costing, reused: a queue key reads only its cost, and a fresh candidate's
   // zeroing cost as much as a cheap costing.
   CollapseCandidate queued_;
+  CollapseCandidate checked_;  // vetoed_when_queued's
   std::vector<std::pair<VertexId, VertexId>> retry_;
   // requeue_costly's pushes in order: an entry, or the index of its costing in costed_.
   static constexpr size_t kNotCosted = ~size_t{0};

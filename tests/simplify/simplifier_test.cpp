@@ -350,6 +350,59 @@ TEST(Simplifier, ACostlyModuleIsNotAskedToCostEdgesTheTopologicalRulesVeto) {
   }
 }
 
+// The quadric with its queue keys declared to read the edges' stars: the simplifier then
+// queues every edge uncosted for its collapse, as it does for such a module.
+class KeysReadTheStar : public PriorityWrapper {
+ public:
+  using PriorityWrapper::PriorityWrapper;
+  bool queue_key_of_ends_only() const override { return false; }
+};
+
+// An edge whose queue key is at or below the last collapse's is costed for its collapse as it
+// is queued, and one its star's rules veto waits among the vetoed edges (Simplifier::
+// queue_checked). On a CAD part taken to its legal minimum (thin fans whose collapses fold:
+// tens of thousands of vetoes; seam collapses; a cost ceiling), the collapses are exactly those of the
+// run that queues every edge and vetoes it when it comes out.
+TEST(Simplifier, EdgesVetoedAsTheyAreQueuedLeaveTheSameRun) {
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const CopyGroups groups = copy_groups(repaired);
+  auto run = [&](bool keys_of_ends_only, double max_cost) {
+    CollapseMesh cm(repaired.mesh);
+    QuadricPriority quadric(locked, QuadricOptions{});
+    KeysReadTheStar star_keys(quadric);
+    PriorityModule& priority = keys_of_ends_only ? static_cast<PriorityModule&>(quadric) : star_keys;
+    Simplifier simplifier(cm, priority, standard_constraints(locked));
+    simplifier.join_copies(&groups);
+    SimplifierLimits limits;
+    limits.max_cost = max_cost;
+    std::vector<CollapseRecord> records = simplifier.run(limits, {}, nullptr);
+    return std::make_pair(std::move(records), simplifier.stats());
+  };
+  const double unlimited = std::numeric_limits<double>::infinity();
+  const auto [all, all_stats] = run(false, unlimited);
+  ASSERT_GT(all.size(), 100u);
+  for (const double ceiling : {unlimited, all[all.size() / 2].cost}) {
+    const auto [queued, queued_stats] = run(false, ceiling);
+    const auto [checked, checked_stats] = run(true, ceiling);
+    std::printf("ceiling %g: %zu collapses, %llu vetoed (%llu as queued) against %llu\n", ceiling,
+                checked.size(), (unsigned long long)checked_stats.rejected,
+                (unsigned long long)checked_stats.vetoed_when_queued,
+                (unsigned long long)queued_stats.rejected);
+    EXPECT_EQ(queued_stats.vetoed_when_queued, 0u);
+    EXPECT_GT(checked_stats.vetoed_when_queued, 1000u) << "few vetoes as queued: a weak test";
+    EXPECT_GT(checked_stats.seam_collapses, 0u);
+    EXPECT_EQ(checked_stats.stop_reason, queued_stats.stop_reason);
+    ASSERT_EQ(checked.size(), queued.size()) << "ceiling " << ceiling;
+    for (size_t i = 0; i < queued.size(); ++i) {
+      const CollapseRecord &x = queued[i], &y = checked[i];
+      ASSERT_TRUE(x.vs == y.vs && x.vt == y.vt && x.position == y.position && x.cost == y.cost &&
+                  x.error == y.error)
+          << "ceiling " << ceiling << ": collapse " << i << " differs";
+    }
+  }
+}
+
 // twin_faces() is edge_faces() of every live corner's edge, in one pass: on a real mesh with
 // boundaries and seams, before and after collapses (dead faces and emptied fans).
 TEST(Simplifier, TwinFacesAreTheEdgesFacesOfEveryCorner) {
