@@ -45,6 +45,15 @@ bool Simplifier::queue_entry(VertexId a, VertexId b, Entry& entry) {
   if (a > b) std::swap(a, b);
   CollapseCandidate& candidate = queued_;
   candidate.seam = false;
+  if (first_queue_seams_ && seam_edge(a, b)) {
+    const uint64_t groups = uint64_t(groups_->group[a]) << 32 | groups_->group[b];
+    const auto [at, first] = first_queue_seams_->try_emplace(groups);
+    if (first) {
+      at->second.placed = cost_seam(a, b, candidate, Costing::kQueue);
+      at->second.cost = candidate.cost;
+    }
+    return entry_of_costing(a, b, at->second.placed, at->second.cost, entry);
+  }
   const bool placed = cost_edge(a, b, candidate, Costing::kQueue);
   return entry_of_costing(a, b, placed, candidate.cost, entry);
 }
@@ -278,8 +287,7 @@ bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits
   candidate.seam = false;
   if (!cost_edge(entry.a, entry.b, candidate, Costing::kPerform)) return false;
   const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
-  if ((edge.left == kNoId && edge.right == kNoId) || candidate.cost > limits.max_cost)
-    return false;
+  if ((edge.left == kNoId && edge.right == kNoId) || candidate.cost > limits.max_cost) return false;
   for (const auto& module : constraints_) {
     if (!module->star_local() || module->allows(mesh_, candidate, edge)) continue;
     ++stats_.rejected;
@@ -288,8 +296,8 @@ bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits
     return true;
   }
   entry.stamp |= kRequeued;
-  requeued_[edge_key(entry.a, entry.b)] = {mesh_.star_version(entry.a),
-                                           mesh_.star_version(entry.b), candidate};
+  requeued_[edge_key(entry.a, entry.b)] = {mesh_.star_version(entry.a), mesh_.star_version(entry.b),
+                                           candidate};
   return false;
 }
 
@@ -573,6 +581,14 @@ void Simplifier::build_first_queue(const SimplifierLimits& limits, const CancelT
   // Every undirected edge once. The queue's order does not depend on the order of insertion.
   queue_.clear();
   compacted_size_ = 0;
+  // (no collapse before the queue is built: a seam's queue costing, which reads its two groups
+  // only, is the same for every edge between them)
+  SeamCostings seams;
+  first_queue_seams_ = groups_ ? &seams : nullptr;
+  struct Forget {
+    SeamCostings*& memo;
+    ~Forget() { memo = nullptr; }
+  } forget{first_queue_seams_};
   if (limits.first_queue_around) {
     queue_edges_around(*limits.first_queue_around, cancel);
   } else {

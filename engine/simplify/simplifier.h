@@ -126,7 +126,7 @@ struct SimplifierStats {
   // With a costly priority module: edges the topological rules vetoed before any costing
   // (retried after their star changed, or on top of the queue: those count as rejected too).
   uint64_t screened = 0;
-  uint64_t deferred = 0;        // edges queued below their last key instead of costed at once
+  uint64_t deferred = 0;  // edges queued below their last key instead of costed at once
   // Of the rejected: edges vetoed as they were queued (Simplifier::queue_checked), never popped.
   uint64_t vetoed_when_queued = 0;
   uint64_t compactions = 0;     // passes dropping the queue's stale entries at once
@@ -223,6 +223,15 @@ class Simplifier {
   std::array<float*, 2> key_slots(VertexId a, VertexId b);
   // Costs edge {a, b}; false when the module cannot place it.
   bool queue_entry(VertexId a, VertexId b, Entry& entry);
+  // A seam's queue costing: cost_seam's answer and cost.
+  struct SeamCosting {
+    bool placed = false;
+    double cost = 0;
+  };
+  // By the groups of an edge's ends (a < b), the first's in the high half.
+  using SeamCostings = std::unordered_map<uint64_t, SeamCosting>;
+  // While build_first_queue runs: the seams costed so far, each costed once (queue_entry).
+  SeamCostings* first_queue_seams_ = nullptr;
   // The entry of edge {a, b} (a < b) from its queue costing, its key remembered; false (and
   // the refusal remembered) when the costing could not place it.
   bool entry_of_costing(VertexId a, VertexId b, bool placed, double cost, Entry& entry);

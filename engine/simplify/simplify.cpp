@@ -140,8 +140,8 @@ ProgressiveMesh build_progressive_mesh(const RepairedMesh& repaired, const Simpl
       "screened, {} evaluations, {} deferred, {} requeued, {} seam collapses ({} split); {})",
       mesh.face_count(), pm.base.face_count(), seconds, simplifier.stats().collapses,
       simplifier.stats().rejected, simplifier.stats().vetoed_when_queued,
-      simplifier.stats().screened, simplifier.stats().evaluations,
-      simplifier.stats().deferred, simplifier.stats().requeued, simplifier.stats().seam_collapses,
+      simplifier.stats().screened, simplifier.stats().evaluations, simplifier.stats().deferred,
+      simplifier.stats().requeued, simplifier.stats().seam_collapses,
       simplifier.stats().seams_split, simplifier.stats().stop_reason);
   return pm;
 }

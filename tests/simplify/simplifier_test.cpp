@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -361,8 +362,8 @@ class KeysReadTheStar : public PriorityWrapper {
 // An edge whose queue key is at or below the last collapse's is costed for its collapse as it
 // is queued, and one its star's rules veto waits among the vetoed edges (Simplifier::
 // queue_checked). On a CAD part taken to its legal minimum (thin fans whose collapses fold:
-// tens of thousands of vetoes; seam collapses; a cost ceiling), the collapses are exactly those of the
-// run that queues every edge and vetoes it when it comes out.
+// tens of thousands of vetoes; seam collapses; a cost ceiling), the collapses are exactly those of
+// the run that queues every edge and vetoes it when it comes out.
 TEST(Simplifier, EdgesVetoedAsTheyAreQueuedLeaveTheSameRun) {
   const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")));
   const std::vector<uint8_t> locked = locked_vertices(repaired);
@@ -371,7 +372,8 @@ TEST(Simplifier, EdgesVetoedAsTheyAreQueuedLeaveTheSameRun) {
     CollapseMesh cm(repaired.mesh);
     QuadricPriority quadric(locked, QuadricOptions{});
     KeysReadTheStar star_keys(quadric);
-    PriorityModule& priority = keys_of_ends_only ? static_cast<PriorityModule&>(quadric) : star_keys;
+    PriorityModule& priority =
+        keys_of_ends_only ? static_cast<PriorityModule&>(quadric) : star_keys;
     Simplifier simplifier(cm, priority, standard_constraints(locked));
     simplifier.join_copies(&groups);
     SimplifierLimits limits;
@@ -574,6 +576,51 @@ TEST(Simplifier, ACostCeilingTakesTheCollapsesBelowItInOrder) {
     }
     if (std::string(metric) == "quadric") {  // nothing deferred: every cheaper collapse taken
       EXPECT_GE(limited.size(), first_above);
+    }
+  }
+}
+
+// A seam's queue costing reads its two groups only, not the copies it is queued on: the first
+// queue costs each seam once for all the edges between its groups (Simplifier::queue_entry).
+// Every edge between the copies of two groups costs the same, before any collapse and midway,
+// with either metric.
+TEST(Simplifier, ASeamCostsTheSameFromEveryEdgeBetweenItsGroups) {
+  const RepairedMesh repaired = repair_mesh(testing::plane_with_fin(16, 3, 12, 3));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  const CopyGroups groups = copy_groups(repaired);
+  for (const char* metric : {"quadric", "energy"}) {
+    for (const size_t target : {repaired.mesh.face_count(), repaired.mesh.face_count() / 2}) {
+      SimplifyOptions options;
+      options.metric = metric;
+      CollapseMesh cm(repaired.mesh);
+      const std::unique_ptr<PriorityModule> priority =
+          make_priority_module(options, repaired.mesh, locked);
+      Simplifier simplifier(cm, *priority, standard_constraints(locked));
+      simplifier.join_copies(&groups);
+      simplifier.run({target}, {}, nullptr);
+      struct Seen {
+        bool placed;
+        double cost;
+      };
+      std::map<std::pair<uint32_t, uint32_t>, Seen> seams;
+      size_t shared = 0;
+      std::vector<VertexId> ring;
+      for (VertexId a = 0; a < cm.vertex_capacity(); ++a) {
+        if (!cm.vertex_alive(a) || !groups.is_copy(a)) continue;
+        cm.neighbors(a, ring);
+        for (const VertexId b : ring) {
+          if (b < a || !groups.is_copy(b)) continue;
+          CollapseCandidate c;
+          const bool placed = simplifier.cost_now(a, b, Costing::kQueue, c);
+          const auto [at, first] =
+              seams.try_emplace({groups.group[a], groups.group[b]}, Seen{placed, c.cost});
+          if (first) continue;
+          ++shared;
+          ASSERT_EQ(placed, at->second.placed) << metric << " edge " << a << "-" << b;
+          if (placed) ASSERT_EQ(c.cost, at->second.cost) << metric << " edge " << a << "-" << b;
+        }
+      }
+      EXPECT_GT(shared, 10u) << metric << ": few seams with two edges, a weak test";
     }
   }
 }
