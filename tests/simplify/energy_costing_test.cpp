@@ -450,10 +450,10 @@ TEST(EnergyPriority, EdgesCostedTogetherOnTheTeamCostAsOneAfterAnother) {
       std::vector<VertexId> ring, around;
       mesh.neighbors(c.vs, ring);
       for (const VertexId n : ring) {
-        edges.push_back({std::min(c.vs, n), std::max(c.vs, n)});
+        edges.push_back({std::min(c.vs, n), std::max(c.vs, n), false, {}});
         mesh.neighbors(n, around);
         for (const VertexId m : around)
-          if (m != c.vs && n < m) edges.push_back({n, m});
+          if (m != c.vs && n < m) edges.push_back({n, m, false, {}});
       }
       ASSERT_GE(edges.size(), 2u);
       for (const Costing costing : {Costing::kQueue, Costing::kPerform}) {

@@ -617,7 +617,9 @@ TEST(Simplifier, ASeamCostsTheSameFromEveryEdgeBetweenItsGroups) {
           if (first) continue;
           ++shared;
           ASSERT_EQ(placed, at->second.placed) << metric << " edge " << a << "-" << b;
-          if (placed) ASSERT_EQ(c.cost, at->second.cost) << metric << " edge " << a << "-" << b;
+          if (placed) {
+            ASSERT_EQ(c.cost, at->second.cost) << metric << " edge " << a << "-" << b;
+          }
         }
       }
       EXPECT_GT(shared, 10u) << metric << ": few seams with two edges, a weak test";
