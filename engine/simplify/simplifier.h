@@ -122,7 +122,9 @@ struct SimplifierStats {
   uint64_t evaluations = 0;  // calls to the priority module's evaluate
   // Popped edges whose cost, costed afresh, was above the next key: queued again with it.
   uint64_t requeued = 0;
-  uint64_t requeue_reused = 0;  // of those, taken out again with their star unchanged
+  // Of those, and of the edges checked as they were queued (queue_checked), taken out again
+  // with their star unchanged: their costing kept.
+  uint64_t requeue_reused = 0;
   // With a costly priority module: edges the topological rules vetoed before any costing
   // (retried after their star changed, or on top of the queue: those count as rejected too).
   uint64_t screened = 0;
