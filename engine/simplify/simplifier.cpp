@@ -575,6 +575,7 @@ void Simplifier::begin_run(const SimplifierLimits& limits) {
                     std::numeric_limits<float>::quiet_NaN());
   screen_ = priority_.costly();
   check_when_queued_ = !screen_ && priority_.queue_key_of_ends_only();
+  last_key_ = 0;
 }
 
 void Simplifier::build_first_queue(const SimplifierLimits& limits, const CancelToken* cancel) {
