@@ -580,6 +580,26 @@ TEST(Simplifier, ACostCeilingTakesTheCollapsesBelowItInOrder) {
   }
 }
 
+// A simplifier over a repaired mesh with `metric`'s module and the standard rules, the repair's
+// copies joined (seam collapses).
+struct JoinedCopies {
+  JoinedCopies(const RepairedMesh& repaired, const char* metric, const std::vector<uint8_t>& locked,
+               const CopyGroups& groups)
+      : mesh(repaired.mesh),
+        priority(make_priority_module(metric_options(metric), repaired.mesh, locked)),
+        simplifier(mesh, *priority, standard_constraints(locked)) {
+    simplifier.join_copies(&groups);
+  }
+  static SimplifyOptions metric_options(const char* metric) {
+    SimplifyOptions options;
+    options.metric = metric;
+    return options;
+  }
+  CollapseMesh mesh;
+  std::unique_ptr<PriorityModule> priority;
+  Simplifier simplifier;
+};
+
 // A seam's queue costing reads its two groups only, not the copies it is queued on: the first
 // queue costs each seam once for all the edges between its groups (Simplifier::queue_entry).
 // Every edge between the copies of two groups costs the same, before any collapse and midway,
@@ -590,13 +610,9 @@ TEST(Simplifier, ASeamCostsTheSameFromEveryEdgeBetweenItsGroups) {
   const CopyGroups groups = copy_groups(repaired);
   for (const char* metric : {"quadric", "energy"}) {
     for (const size_t target : {repaired.mesh.face_count(), repaired.mesh.face_count() / 2}) {
-      SimplifyOptions options;
-      options.metric = metric;
-      CollapseMesh cm(repaired.mesh);
-      const std::unique_ptr<PriorityModule> priority =
-          make_priority_module(options, repaired.mesh, locked);
-      Simplifier simplifier(cm, *priority, standard_constraints(locked));
-      simplifier.join_copies(&groups);
+      JoinedCopies run(repaired, metric, locked, groups);
+      const CollapseMesh& cm = run.mesh;
+      Simplifier& simplifier = run.simplifier;
       simplifier.run({target}, {}, nullptr);
       struct Seen {
         bool placed;
@@ -637,13 +653,9 @@ TEST(Simplifier, SeamCollapsesWithOverlappingRingsAreTriedInTurn) {
   const std::vector<uint8_t> locked = locked_vertices(repaired);
   const CopyGroups groups = copy_groups(repaired);
   for (const char* metric : {"quadric", "energy"}) {
-    SimplifyOptions options;
-    options.metric = metric;
-    CollapseMesh cm(repaired.mesh);
-    const std::unique_ptr<PriorityModule> priority =
-        make_priority_module(options, repaired.mesh, locked);
-    Simplifier simplifier(cm, *priority, standard_constraints(locked));
-    simplifier.join_copies(&groups);
+    JoinedCopies run(repaired, metric, locked, groups);
+    const CollapseMesh& cm = run.mesh;
+    Simplifier& simplifier = run.simplifier;
     SimplifierLimits limits;
     limits.target_faces = 40;
     simplifier.run(limits, {}, nullptr);
