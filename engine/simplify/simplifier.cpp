@@ -362,11 +362,15 @@ bool Simplifier::pair_seam(uint32_t from, uint32_t into) {
   for (VertexId copy : groups_->of(from)) {
     if (!mesh_.vertex_alive(copy)) continue;
     if (seam_pairs_.size() == kMaxSeamCopies) return false;
-    // The smallest neighbour in `into`, read off the faces around the copy.
+    // The smallest neighbour in `into`, read off the faces around the copy (by selects, not
+    // branches: which corners are in `into` cannot be predicted).
+    const uint32_t* group = groups_->group.data();
     VertexId partner = kNoId;
     for (FaceId f : mesh_.faces_of(copy))
-      for (VertexId n : mesh_.face(f))
-        if (n != copy && groups_->group[n] == into) partner = std::min(partner, n);
+      for (VertexId n : mesh_.face(f)) {
+        const bool nearer = (n != copy) & (group[n] == into) & (n < partner);
+        partner = nearer ? n : partner;
+      }
     if (partner == kNoId) return false;
     seam_pairs_.push_back({partner, copy});
   }
