@@ -380,15 +380,18 @@ bool pair_faces_beside_their_reverses(const std::vector<Triangle>& faces,
                                       std::vector<uint32_t>& twin) {
   if (edges.empty()) return false;
   bool sides_paired = false;
-  // Each face on a non-manifold edge and its vertex set: reverses share a set.
+  // Each face on a non-manifold edge (once, though it may hold three) and its vertex set:
+  // reverses share a set.
   std::vector<std::pair<std::array<VertexId, 3>, uint32_t>> by_vertices;  // (sorted, face)
+  std::vector<uint8_t> listed(faces.size(), 0);
   for (uint32_t h : edges) {
+    if (listed[h / 3]) continue;
+    listed[h / 3] = 1;
     std::array<VertexId, 3> sorted = faces[h / 3];
     std::sort(sorted.begin(), sorted.end());
     by_vertices.emplace_back(sorted, h / 3);
   }
   std::sort(by_vertices.begin(), by_vertices.end());
-  by_vertices.erase(std::unique(by_vertices.begin(), by_vertices.end()), by_vertices.end());
   // Per face on a non-manifold edge, its reverse: the first other face of its vertex set.
   std::vector<uint32_t> reverse(faces.size(), kNoId);
   for (size_t i = 0, end = 0; i < by_vertices.size(); i = end) {
@@ -641,23 +644,6 @@ void split_fans(const std::vector<uint32_t>& twin, RepairedMesh* out, ChunkedLoo
   }
 }
 
-// The faces that share a halfedge with another face (none in a manifold).
-std::vector<FaceId> faces_sharing_a_halfedge(const std::vector<Triangle>& faces) {
-  std::vector<std::pair<uint64_t, FaceId>> halfedges;
-  halfedges.reserve(3 * faces.size());
-  for (FaceId f = 0; f < faces.size(); ++f)
-    for (int k = 0; k < 3; ++k)
-      halfedges.emplace_back(uint64_t(faces[f][k]) << 32 | faces[f][(k + 1) % 3], f);
-  std::sort(halfedges.begin(), halfedges.end());
-  std::vector<FaceId> shared;
-  for (size_t i = 0; i + 1 < halfedges.size(); ++i)
-    if (halfedges[i].first == halfedges[i + 1].first) {
-      shared.push_back(halfedges[i].second);
-      shared.push_back(halfedges[i + 1].second);
-    }
-  return shared;
-}
-
 // Step 4. Pairing each side of a double-sided surface with itself can bring a side round to
 // the other through a fold (two double-sided triangles on one edge), which leaves two faces
 // on one halfedge after the split: then the edges of those faces keep their sides apart and
@@ -680,7 +666,8 @@ void split_keeping_sides_apart_where_needed(RepairedMesh* out, ChunkedLoops& loo
     }
     RepairedMesh split = *out;
     split_fans(twin, &split, loops);
-    const std::vector<FaceId> shared = faces_sharing_a_halfedge(split.mesh.faces);
+    const std::vector<FaceId> shared =
+        faces_sharing_a_halfedge(split.mesh.faces, split.mesh.vertex_count());
     if (shared.empty()) {
       *out = std::move(split);
       return;
@@ -693,6 +680,40 @@ void split_keeping_sides_apart_where_needed(RepairedMesh* out, ChunkedLoops& loo
 }
 
 }  // namespace
+
+std::vector<FaceId> faces_sharing_a_halfedge(const std::vector<Triangle>& faces,
+                                             size_t vertex_count) {
+  std::vector<uint32_t> begin(vertex_count + 1, 0);
+  for (const Triangle& t : faces)
+    for (VertexId v : t) ++begin[v + 1];
+  for (size_t v = 0; v < vertex_count; ++v) begin[v + 1] += begin[v];
+  struct Outgoing {
+    VertexId to;
+    FaceId face;
+  };
+  std::vector<Outgoing> outgoing(begin.back());
+  std::vector<uint32_t> next(begin.begin(), begin.end() - 1);
+  for (FaceId f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) outgoing[next[faces[f][k]]++] = {faces[f][(k + 1) % 3], f};
+  std::vector<uint8_t> shares(faces.size(), 0);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    Outgoing* first = outgoing.data() + begin[v];
+    Outgoing* last = outgoing.data() + begin[v + 1];
+    if (last - first > 16) {  // a hub: sorted, so that a fan of any size costs n log n
+      std::sort(first, last, [](const Outgoing& x, const Outgoing& y) { return x.to < y.to; });
+      for (Outgoing* o = first; o + 1 < last; ++o)
+        if (o[0].to == o[1].to) shares[o[0].face] = shares[o[1].face] = 1;
+      continue;
+    }
+    for (Outgoing* o = first; o < last; ++o)
+      for (Outgoing* p = o + 1; p < last; ++p)
+        if (o->to == p->to) shares[o->face] = shares[p->face] = 1;
+  }
+  std::vector<FaceId> shared;
+  for (FaceId f = 0; f < faces.size(); ++f)
+    if (shares[f]) shared.push_back(f);
+  return shared;
+}
 
 RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options) {
   // 1. Refuse what cannot be repaired: nothing below has to check a value or an index.

@@ -95,4 +95,11 @@ struct RepairedMesh {
 
 RepairedMesh repair_mesh(const Mesh& input, const RepairOptions& options = {});
 
+// The faces that share a halfedge (a corner's edge in the face's direction) with another face,
+// each once, increasing; none in an oriented manifold. Linear in the faces (each vertex's
+// outgoing halfedges gathered, those of a vertex with many sorted): the repair's check that a
+// split it made is a manifold.
+std::vector<FaceId> faces_sharing_a_halfedge(const std::vector<Triangle>& faces,
+                                             size_t vertex_count);
+
 }  // namespace parapm

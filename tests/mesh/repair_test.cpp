@@ -508,6 +508,46 @@ TEST(RepairManifold, TwoSidesJoinedThroughAFoldAreKeptApart) {
   expect_faithful_repair(mesh, repaired);
 }
 
+TEST(RepairManifold, ManyDoubleSidedTrianglesOnOneEdgeStayClosedPillows) {
+  // Twelve double-sided triangles on edge 0-1, their apexes around the edge: each a closed
+  // pillow, apart from the others.
+  constexpr int kPillows = 12;
+  std::vector<Vec3> positions = {{0, 0, 0}, {1, 0, 0}};
+  std::vector<Triangle> faces;
+  for (int i = 0; i < kPillows; ++i) {
+    const double angle = 2 * M_PI * i / kPillows;
+    const VertexId apex = VertexId(positions.size());
+    positions.push_back({0.5, std::cos(angle), std::sin(angle)});
+    faces.push_back({0, 1, apex});
+    faces.push_back({apex, 1, 0});
+  }
+  const Mesh mesh = make_mesh(positions, faces);
+  const RepairedMesh repaired = repair_in_input_order(mesh);
+  EXPECT_EQ(repaired.report.nonmanifold_edges, 1u);
+  const TopologyStats stats = topology_stats(repaired.mesh);
+  EXPECT_EQ(stats.components, size_t(kPillows));
+  EXPECT_EQ(stats.boundary_edges, 0u);
+  expect_faithful_repair(mesh, repaired);
+}
+
+// The repair's check of a split: the faces on a halfedge another face holds too, at a vertex of
+// a few faces and at a hub of many (whose halfedges are sorted rather than compared in pairs).
+TEST(RepairManifold, FacesSharingAHalfedgeAreFoundAtSmallVerticesAndHubs) {
+  constexpr VertexId kRim = 30;  // a closed fan of 30 triangles around vertex 0
+  std::vector<Triangle> faces;
+  for (VertexId i = 0; i < kRim; ++i) faces.push_back({0, 1 + i, 1 + (i + 1) % kRim});
+  const size_t vertices = 2 + kRim;
+  EXPECT_TRUE(faces_sharing_a_halfedge(faces, vertices).empty());
+  // Face 30 holds 0 -> 5 as face 4 does (at the hub); face 31 holds 11 -> 12 as face 10 does
+  // and 12 -> 31 alone (at a vertex of three faces).
+  faces.push_back({0, 5, 31});
+  faces.push_back({11, 12, 31});
+  EXPECT_EQ(faces_sharing_a_halfedge(faces, vertices), (std::vector<FaceId>{4, 10, 30, 31}));
+  // Three faces on one halfedge: all three.
+  faces.push_back({5, 31, 0});
+  EXPECT_EQ(faces_sharing_a_halfedge(faces, vertices), (std::vector<FaceId>{4, 10, 30, 31, 32}));
+}
+
 TEST(RepairManifold, MobiusStripBecomesAnOrientableStrip) {
   // A Möbius strip of k = 4 quads, top row t_i = i, bottom row b_i = 4 + i; the last quad
   // joins column 3 to column 0 with a half twist, so its face (t3, t0, b0) uses edge t0 -> b0
