@@ -515,7 +515,7 @@ TEST(RepairManifold, ManyDoubleSidedTrianglesOnOneEdgeStayClosedPillows) {
   std::vector<Vec3> positions = {{0, 0, 0}, {1, 0, 0}};
   std::vector<Triangle> faces;
   for (int i = 0; i < kPillows; ++i) {
-    const double angle = 2 * M_PI * i / kPillows;
+    const double angle = 2 * std::numbers::pi * i / kPillows;
     const VertexId apex = VertexId(positions.size());
     positions.push_back({0.5, std::cos(angle), std::sin(angle)});
     faces.push_back({0, 1, apex});
