@@ -50,6 +50,7 @@
 #include <string>
 #include <tuple>
 
+#include "mesh/outgoing_halfedges.h"
 #include "mesh/spatial_order.h"
 #include "util/error.h"
 
@@ -683,31 +684,22 @@ void split_keeping_sides_apart_where_needed(RepairedMesh* out, ChunkedLoops& loo
 
 std::vector<FaceId> faces_sharing_a_halfedge(const std::vector<Triangle>& faces,
                                              size_t vertex_count) {
-  std::vector<uint32_t> begin(vertex_count + 1, 0);
-  for (const Triangle& t : faces)
-    for (VertexId v : t) ++begin[v + 1];
-  for (size_t v = 0; v < vertex_count; ++v) begin[v + 1] += begin[v];
-  struct Outgoing {
-    VertexId to;
-    FaceId face;
-  };
-  std::vector<Outgoing> outgoing(begin.back());
-  std::vector<uint32_t> next(begin.begin(), begin.end() - 1);
-  for (FaceId f = 0; f < faces.size(); ++f)
-    for (int k = 0; k < 3; ++k) outgoing[next[faces[f][k]]++] = {faces[f][(k + 1) % 3], f};
+  OutgoingHalfedges outgoing = outgoing_halfedges(faces, vertex_count);
+  using Halfedge = OutgoingHalfedges::Halfedge;
   std::vector<uint8_t> shares(faces.size(), 0);
-  for (size_t v = 0; v < vertex_count; ++v) {
-    Outgoing* first = outgoing.data() + begin[v];
-    Outgoing* last = outgoing.data() + begin[v + 1];
-    if (last - first > 16) {  // a hub: sorted, so that a fan of any size costs n log n
-      std::sort(first, last, [](const Outgoing& x, const Outgoing& y) { return x.to < y.to; });
-      for (Outgoing* o = first; o + 1 < last; ++o)
-        if (o[0].to == o[1].to) shares[o[0].face] = shares[o[1].face] = 1;
+  for (VertexId v = 0; v < vertex_count; ++v) {
+    const std::span<Halfedge> around = outgoing.of(v);
+    if (around.size() > 16) {  // a hub: sorted, so that a fan of any size costs n log n
+      std::sort(around.begin(), around.end(),
+                [](const Halfedge& x, const Halfedge& y) { return x.to < y.to; });
+      for (size_t i = 0; i + 1 < around.size(); ++i)
+        if (around[i].to == around[i + 1].to)
+          shares[around[i].face] = shares[around[i + 1].face] = 1;
       continue;
     }
-    for (Outgoing* o = first; o < last; ++o)
-      for (Outgoing* p = o + 1; p < last; ++p)
-        if (o->to == p->to) shares[o->face] = shares[p->face] = 1;
+    for (size_t i = 0; i < around.size(); ++i)
+      for (size_t j = i + 1; j < around.size(); ++j)
+        if (around[i].to == around[j].to) shares[around[i].face] = shares[around[j].face] = 1;
   }
   std::vector<FaceId> shared;
   for (FaceId f = 0; f < faces.size(); ++f)

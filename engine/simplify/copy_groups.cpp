@@ -5,6 +5,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "mesh/outgoing_halfedges.h"
 #include "util/union_find.h"
 
 namespace parapm {
@@ -25,20 +26,13 @@ std::vector<uint32_t> component_roots(const Mesh& mesh) {
 
 // The boundary edges of `mesh` (a manifold: an edge without the opposite half-edge), each as
 // its face's (from, to), in face order. The opposite half-edge is looked up among the
-// outgoing half-edges of its tail, listed per vertex.
+// outgoing half-edges of its tail.
 std::vector<std::pair<VertexId, VertexId>> boundary_edges(const Mesh& mesh) {
-  // Vertex v's outgoing half-edges' heads: heads[first[v] .. first[v + 1]).
-  std::vector<uint32_t> first(mesh.vertex_count() + 1, 0);
-  for (const Triangle& t : mesh.faces)
-    for (VertexId v : t) ++first[v + 1];
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) first[v + 1] += first[v];
-  std::vector<VertexId> heads(first.back());
-  std::vector<uint32_t> filled(first.begin(), first.end() - 1);
-  for (const Triangle& t : mesh.faces)
-    for (int k = 0; k < 3; ++k) heads[filled[t[k]]++] = t[(k + 1) % 3];
+  const OutgoingHalfedges outgoing = outgoing_halfedges(mesh.faces, mesh.vertex_count());
   const auto has_half_edge = [&](VertexId from, VertexId to) {
-    return std::find(heads.begin() + first[from], heads.begin() + first[from + 1], to) !=
-           heads.begin() + first[from + 1];
+    for (const OutgoingHalfedges::Halfedge& h : outgoing.of(from))
+      if (h.to == to) return true;
+    return false;
   };
   std::vector<std::pair<VertexId, VertexId>> boundary;
   for (const Triangle& t : mesh.faces)
