@@ -17,8 +17,11 @@ std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
     team.threads = std::max<unsigned>(1, pool_threads(threads_, cores_) / unsigned(jobs.size()));
     team.min_items = team_min_items_;
   }
+  std::vector<PreparedSubset> prepared = std::move(prepared_);
+  prepared.resize(jobs.size());
   run_jobs(jobs.size(), threads_, [&](size_t i) {
-    results[i] = simplify_subset(std::move(jobs[i]), {}, cancel, nullptr, team);
+    results[i] =
+        simplify_subset(std::move(jobs[i]), {}, cancel, nullptr, team, std::move(prepared[i]));
     jobs[i] = SubsetJob{};  // its memory is not needed any more
   });
   return results;

@@ -209,8 +209,12 @@ class ThreadPoolRunner : public SubsetRunner {
   explicit ThreadPoolRunner(unsigned threads, unsigned cores = 0, size_t team_min_items = 0)
       : threads_(threads), cores_(cores), team_min_items_(team_min_items) {}
   std::vector<SubsetResult> run(std::vector<SubsetJob>& jobs, const CancelToken* cancel) override;
+  // The next run's jobs' meshes and metrics, made by their round's samples (empty where none):
+  // the jobs take them instead of importing their states again.
+  void take_prepared(std::vector<PreparedSubset> prepared) { prepared_ = std::move(prepared); }
 
  private:
+  std::vector<PreparedSubset> prepared_;
   unsigned threads_;
   unsigned cores_;
   size_t team_min_items_;

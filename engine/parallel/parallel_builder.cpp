@@ -677,6 +677,10 @@ void ParallelBuilder::extract_jobs(Round& r) {
   const bool master_in_tasks =
       sample && !sample_in_tasks && copy_groups_.empty() && master_->costing_view() != nullptr;
   std::vector<SampledEdges> sampled(sample && !sample_in_tasks && !master_in_tasks ? subsets : 0);
+  // A job run in this process takes the mesh and metric its sample was costed on (the job's
+  // state then goes: the metric holds it).
+  const bool jobs_here = runner_ == &pool_;
+  std::vector<PreparedSubset> prepared(sample_in_tasks && jobs_here ? subsets : 0);
   // Per face, the subset whose job owns its three corners: the only state that may list it.
   face_subset_.assign(whole.face_capacity(), kNoId);
   // The master's own steps, before the jobs' extraction and after it, are on the critical path.
@@ -701,7 +705,9 @@ void ParallelBuilder::extract_jobs(Round& r) {
     if (sample) {
       const double sample_start = thread_cpu_seconds();
       if (sample_in_tasks) {
-        samples[i] = sample_subset(jobs[i], free, carry_keys_, jobs[i].keys);
+        samples[i] = sample_subset(jobs[i], free, carry_keys_, jobs[i].keys,
+                                   prepared.empty() ? nullptr : &prepared[i]);
+        if (!prepared.empty() && prepared[i].metric) jobs[i].state = MetricState{};
       } else if (master_in_tasks) {
         const std::unique_ptr<PriorityModule> view = master_->costing_view();
         Simplifier master_costs(*whole_, *view, {});
@@ -756,6 +762,7 @@ void ParallelBuilder::extract_jobs(Round& r) {
   sequential_extract += seconds_since(after_jobs);
   rs.extract_seconds = seconds_since(t);
   rs.extract_critical_seconds = sequential_extract + rs.slowest_extract_cpu_seconds;
+  if (!prepared.empty()) pool_.take_prepared(std::move(prepared));
 }
 
 // Round 1's partition, on round 0's graph (the mesh as round 0 finds it: the whole mesh changes

@@ -36,14 +36,15 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 }
 
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
-                           std::vector<EdgeKey>& keys) {
+                           std::vector<EdgeKey>& keys, PreparedSubset* prepared) {
   if (job.state.empty()) throw_internal("sample_subset: a job without the master's state");
   const SampledEdges sampled = sampled_edges(job, free);
   SubsetSample out;
   out.inner_edges = sampled.inner_edges;
   if (sampled.edges.empty()) return out;
-  CollapseMesh local(job.mesh);
-  std::unique_ptr<PriorityModule> module = job_module(job, local);
+  PreparedSubset made = prepare_subset(job);
+  CollapseMesh& local = *made.mesh;
+  PriorityModule* module = made.metric.get();
   std::optional<KeyMemo> memo;
   if (carry_keys) {
     memo.emplace(*module, local.vertex_capacity());
@@ -67,6 +68,8 @@ SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& fre
   out.costings = module->costings();
   // Carried keys answered the edges they cover: those came back the same.
   if (keys.size() > carried) sort_unique_edges(keys);
+  // (The memo and `seams` read the module and mesh where they stay: on the heap.)
+  if (prepared) *prepared = std::move(made);
   return out;
 }
 

@@ -14,6 +14,8 @@
 
 namespace parapm {
 
+struct PreparedSubset;  // simplify_subset.h
+
 // What a sample of a round's edges says about its costs: the live inner edges (both ends in
 // one subset), represented by those with two free ends (every stride-th of them, about
 // kSampledEdgesPerSubset per subset).
@@ -68,8 +70,10 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 // ids, sorted), which answer the edges they cover; the sampled edges join them, so that the
 // job does not cost them again (its module costs them alike: same state). Costed as
 // Costing::kEstimate, or with carry_keys as kQueue: those costs become the job's queue keys.
+// `prepared` (may be null): given the job's mesh and metric the sample was costed on, for a job
+// run in the same process (simplify_subset takes them); left as it was when no edge is sampled.
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
-                           std::vector<EdgeKey>& keys);
+                           std::vector<EdgeKey>& keys, PreparedSubset* prepared = nullptr);
 
 // The same sample costed on the whole mesh by `master_costs`, a Simplifier over it with the
 // master's module and the build's copy groups (`edges` from sampled_edges(job, ...),

@@ -11,6 +11,7 @@
 #include "simplify/quadric_priority.h"
 #include "simplify/simplify.h"
 #include "util/clock.h"
+#include "util/error.h"
 #include "util/thread_team.h"
 
 namespace parapm {
@@ -58,13 +59,21 @@ std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseM
   return module;
 }
 
+PreparedSubset prepare_subset(const SubsetJob& job) {
+  PreparedSubset prepared;
+  prepared.mesh = std::make_unique<CollapseMesh>(job.mesh);
+  prepared.metric = job_module(job, *prepared.mesh);
+  prepared.imported = !job.state.empty();
+  return prepared;
+}
+
 namespace {
 
 // `release` (null, or `job` itself when the caller gives it up): its mesh, state and keys are
 // released once the working mesh, the module and the memo hold them.
 SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCallback& progress,
                       const CancelToken* cancel, QuadricState* free_quadrics,
-                      const JobTeam& job_team) {
+                      const JobTeam& job_team, PreparedSubset prepared) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
   validate_subset_job(job);
@@ -84,16 +93,20 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
         if (free_vertex[v]) free_quadrics->vertices.push_back(v);
   }
 
-  CollapseMesh working(job.mesh);
   std::optional<ThreadTeam> team;  // outlives the metric, which uses it
-  std::unique_ptr<PriorityModule> metric = job_module(job, working);
+  PreparedSubset ready = prepared.metric ? std::move(prepared) : prepare_subset(job);
+  if (ready.mesh->vertex_capacity() != job.mesh.vertex_count())
+    throw_internal("simplify_subset: a prepared mesh of another job");
+  CollapseMesh& working = *ready.mesh;
+  const std::unique_ptr<PriorityModule>& metric = ready.metric;
+  const uint64_t costings_before = metric->costings();  // (a sample's, if prepared)
   if (job_team.chunks > 1 && job_team.min_items > 0 && metric->costly()) {
     team.emplace(job_team.chunks, job_team.threads, job_team.min_items);
     metric->use_team(&*team);
   }
   // With a state, the metric is the master's over the job: imported, not initialised.
   std::unique_ptr<PriorityModule> imported;
-  const bool had_state = !job.state.empty();
+  const bool had_state = ready.imported;
   if (had_state) imported = without_initialize(*metric);
   PriorityModule& module = imported ? *imported : *metric;
   std::optional<KeyMemo> memo;  // only for a metric whose keys are worth carrying (costly())
@@ -149,7 +162,7 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
     }
   }
   for (CollapseRecord& r : result.records) globalise(r, job);
-  result.costings = metric->costings();
+  result.costings = metric->costings() - costings_before;
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   if (team) {
@@ -171,13 +184,13 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
 
 SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progress,
                              const CancelToken* cancel, QuadricState* free_quadrics) {
-  return simplify(job, nullptr, progress, cancel, free_quadrics, {});
+  return simplify(job, nullptr, progress, cancel, free_quadrics, {}, {});
 }
 
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress,
                              const CancelToken* cancel, QuadricState* free_quadrics,
-                             const JobTeam& team) {
-  return simplify(job, &job, progress, cancel, free_quadrics, team);
+                             const JobTeam& team, PreparedSubset prepared) {
+  return simplify(job, &job, progress, cancel, free_quadrics, team, std::move(prepared));
 }
 
 }  // namespace parapm

@@ -56,6 +56,18 @@ struct JobTeam {
   size_t min_items = 0;
 };
 
+// A job's working mesh and its metric, the job's state imported (job_module), made before the
+// job runs: the round's sample (round_shares.h, sample_subset) costs edges on them, and
+// simplify_subset(SubsetJob&&) in the same process takes them instead of importing the state a
+// second time. Costings on the metric leave it as it was but for its caches. Never sent: a
+// worker imports its own.
+struct PreparedSubset {
+  std::unique_ptr<CollapseMesh> mesh;  // (on the heap: the metric may hold its address)
+  std::unique_ptr<PriorityModule> metric;
+  bool imported = false;  // the metric holds the job's state
+};
+PreparedSubset prepare_subset(const SubsetJob& job);
+
 // Throws Error(kInvalidInput) for an invalid job or options, Error(kCancelled /
 // kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing. With
 // `free_quadrics` and a quadric job: its free vertices' quadrics at its end, in global ids
@@ -65,10 +77,12 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
                              QuadricState* free_quadrics = nullptr);
 // The same, releasing the job's mesh, state and keys as soon as its working mesh and metric
 // hold them (a job's peak memory holds them once, not twice); `job` keeps its ids, owned and
-// locked flags and options.
+// locked flags and options. `prepared` (null or empty: none): prepare_subset(job)'s, taken as
+// the job's working mesh and metric (the job's state may then be gone: the metric holds it).
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr,
-                             QuadricState* free_quadrics = nullptr, const JobTeam& team = {});
+                             QuadricState* free_quadrics = nullptr, const JobTeam& team = {},
+                             PreparedSubset prepared = {});
 
 // The options a job's metric is made with (Error(kInvalidInput) for invalid ones).
 SimplifyOptions simplify_options_of(const SubsetOptions& subset);

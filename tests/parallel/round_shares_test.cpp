@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "drawn_meshes.h"
+#include "parallel/job_codec.h"
 #include "parallel/round_shares.h"
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_rule.h"
@@ -71,6 +72,45 @@ TEST(RoundShares, SampledKeysGiveTheJobsOwnRun) {
       const SubsetResult without = simplify_subset(job);
       expect_same_records(with_sample.records, without.records, what);
       EXPECT_GT(with_sample.keys_reused, without.keys_reused) << what;
+    }
+  }
+}
+
+// A job given the mesh and metric its sample was costed on (PreparedSubset), its state dropped
+// as the build drops it, makes the run it makes importing its state itself: the same records,
+// keys, deferred edges, state and costings.
+TEST(RoundShares, TheSamplesMetricRunsTheJobAsItsOwnImport) {
+  for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
+    SimplifyOptions options;
+    options.metric = "energy";
+    testing::RoundZero round(name, options, 3);
+    for (SubsetJob& job : round.jobs) {
+      const std::string what = std::string(name) + " subset " + std::to_string(job.subset);
+      job.options.target_faces = job.mesh.face_count() * 2 / 5;
+      const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+      SubsetJob imports = job;
+      sample_subset(imports, free, true, imports.keys);
+      SubsetJob takes = job;
+      PreparedSubset prepared;
+      sample_subset(takes, free, true, takes.keys, &prepared);
+      ASSERT_TRUE(prepared.metric && prepared.imported) << what;
+      takes.state = MetricState{};
+      SubsetResult own = simplify_subset(std::move(imports));
+      SubsetResult taken =
+          simplify_subset(std::move(takes), {}, nullptr, nullptr, {}, std::move(prepared));
+      expect_same_records(taken.records, own.records, what);
+      ASSERT_EQ(taken.keys.size(), own.keys.size()) << what;
+      for (size_t i = 0; i < own.keys.size(); ++i) {
+        ASSERT_EQ(taken.keys[i].a, own.keys[i].a) << what;
+        ASSERT_EQ(taken.keys[i].b, own.keys[i].b) << what;
+        ASSERT_EQ(std::memcmp(&taken.keys[i].cost, &own.keys[i].cost, sizeof(double)), 0) << what;
+      }
+      ASSERT_EQ(taken.deferred.size(), own.deferred.size()) << what;
+      EXPECT_EQ(taken.costings, own.costings) << what;
+      EXPECT_FALSE(own.state.empty()) << what;
+      for (SubsetResult* r : {&own, &taken})
+        r->wall_seconds = r->cpu_seconds = r->team_saved_seconds = r->team_cpu_seconds = 0;
+      EXPECT_EQ(encode_subset_summary(taken), encode_subset_summary(own)) << what;
     }
   }
 }
