@@ -2,7 +2,9 @@
 //
 // What the decoded state must look like, and why (the imports index arrays with its ids):
 //  - QuadricPriority::import_local/global: vertices in range (ids+ below the bound).
-//  - EnergyPriority::import_local: point faces and parked vertices in range. import_global
+//  - EnergyPriority::import_local: point faces and parked vertices in range, each face's
+//    points in one run and each vertex's parked sample once (checked there: its chunks fill
+//    one list each, guaranteed here by writing points under their faces). import_global
 //    (the master, from a summary) checks the state's face and vertex lists, and relinks each
 //    point under its face: a point must name a listed face or vertex (guaranteed here by
 //    writing points under them), and point ids must be distinct (a repeated id links a point

@@ -45,35 +45,41 @@ std::string returned_state_metric(const SubsetJob& job) {
   return job.state.empty() || !metric_returns_state(job.state.metric) ? "" : job.state.metric;
 }
 
-MetricState export_job_state(const PriorityModule& master, const SubsetJob& job) {
+MetricState export_job_state(const PriorityModule& master, const SubsetJob& job,
+                             ChunkedLoops* loops) {
+  ChunkedLoops plain;
   MetricState state;
   state.metric = master.name();
   if (const auto* q = dynamic_cast<const QuadricPriority*>(&master)) {
     const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
     state.quadric = q->export_local(maps_of(job), &free);
   } else if (const auto* e = dynamic_cast<const EnergyPriority*>(&master)) {
-    state.energy = e->export_local(maps_of(job));
+    state.energy = e->export_local(maps_of(job), loops ? *loops : plain);
   } else {
     throw_internal("export_job_state: no state export for metric " + master.name());
   }
   return state;
 }
 
-void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job) {
+void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job,
+                      ChunkedLoops* loops) {
+  ChunkedLoops plain;
   if (job.state.metric != module.name())
     throw_invalid("subset job " + std::to_string(job.subset) + ": its state is of metric '" +
                   job.state.metric + "', the job's metric is " + module.name());
   if (auto* q = dynamic_cast<QuadricPriority*>(&module)) {
     q->import_local(mesh, job.state.quadric);
   } else if (auto* e = dynamic_cast<EnergyPriority*>(&module)) {
-    e->import_local(mesh, job.state.energy);
+    e->import_local(mesh, job.state.energy, loops ? *loops : plain);
   } else {
     throw_internal("import_job_state: no state import for metric " + module.name());
   }
 }
 
 MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
-                                const SubsetJob& job, const std::vector<CollapseRecord>& records) {
+                                const SubsetJob& job, const std::vector<CollapseRecord>& records,
+                                ChunkedLoops* loops) {
+  ChunkedLoops plain;
   if (!returns_state(module)) return {};
   std::vector<uint8_t> changed(mesh.vertex_capacity(), 0);
   for (const CollapseRecord& r : records) {
@@ -84,7 +90,7 @@ MetricState export_result_state(const PriorityModule& module, const CollapseMesh
   MetricState state;
   state.metric = module.name();
   if (const auto* e = dynamic_cast<const EnergyPriority*>(&module)) {
-    state.energy = e->export_global(mesh, maps_of(job), changed);
+    state.energy = e->export_global(mesh, maps_of(job), changed, loops ? *loops : plain);
   } else {
     throw_internal("export_result_state: no state export for metric " + module.name());
   }
@@ -136,7 +142,8 @@ ImportTimes import_result_states(PriorityModule& master,
                                  const std::vector<const MetricState*>& states,
                                  const std::vector<uint32_t>& vertex_subset,
                                  const std::vector<uint32_t>& face_subset, unsigned threads,
-                                 const std::vector<const std::vector<CollapseRecord>*>& records) {
+                                 const std::vector<const std::vector<CollapseRecord>*>& records,
+                                 unsigned cores) {
   const auto start = std::chrono::steady_clock::now();
   ImportTimes times;
   auto* quadric = dynamic_cast<QuadricPriority*>(&master);
@@ -150,12 +157,24 @@ ImportTimes import_result_states(PriorityModule& master,
     throw_internal("import_result_states: " + std::to_string(records.size()) +
                    " record lists for " + std::to_string(states.size()) + " states");
   std::vector<double> check_cpu(states.size(), 0), apply_cpu(states.size(), 0);
-  // Each step on the pool, each state's CPU timed; a state's check ends with its coverage.
+  // Per state, its passes' chunks on the cores fewer states leave.
+  const size_t n = std::max<size_t>(1, states.size());
+  const unsigned chunks = cores > n ? unsigned(cores / n) : 1;
+  const unsigned chunk_threads =
+      std::max(1u, pool_threads(threads, std::max<size_t>(cores, n)) / unsigned(n));
+  std::vector<ChunkedLoops> loops;
+  for (size_t k = 0; k < states.size(); ++k)
+    loops.push_back(chunks > 1 ? ChunkedLoops(chunks, chunk_threads, kStateChunkItems)
+                               : ChunkedLoops());
+  // Each step on the pool, each state's CPU timed (its chunks at their slowest); a state's
+  // check ends with its coverage.
   auto side_by_side = [&](std::vector<double>& cpu, const std::function<void(size_t)>& step) {
     run_jobs(states.size(), threads, [&](size_t k) {
       const double t = thread_cpu_seconds();
+      const double saved = loops[k].seconds() - loops[k].critical_seconds();
       step(k);
-      cpu[k] = thread_cpu_seconds() - t;
+      cpu[k] =
+          thread_cpu_seconds() - t - (loops[k].seconds() - loops[k].critical_seconds() - saved);
     });
   };
   auto covers = [&](size_t k) {
@@ -174,10 +193,11 @@ ImportTimes import_result_states(PriorityModule& master,
     const EnergyPriority::GlobalOwners owners{&vertex_subset, &face_subset};
     std::vector<EnergyPriority::GlobalImport> imports(states.size());
     side_by_side(check_cpu, [&](size_t k) {
-      imports[k] = e->check_global(states[k]->energy, uint32_t(k), owners);
+      imports[k] = e->check_global(states[k]->energy, uint32_t(k), owners, loops[k]);
       covers(k);
     });
-    side_by_side(apply_cpu, [&](size_t k) { e->apply_global(states[k]->energy, imports[k]); });
+    side_by_side(apply_cpu,
+                 [&](size_t k) { e->apply_global(states[k]->energy, imports[k], loops[k]); });
     const auto wedges = std::chrono::steady_clock::now();
     for (const MetricState* state : states) e->apply_global_wedges(state->energy);
     sequential += seconds_since(wedges);

@@ -32,18 +32,24 @@ std::string returned_state_metric(const SubsetJob& job);
 
 // The master's state of the job's faces, vertices and wedges, in the job's local ids.
 // `master` is the module make_priority_module made for the job's metric, initialised on the
-// whole mesh. Const: jobs may be exported concurrently.
-MetricState export_job_state(const PriorityModule& master, const SubsetJob& job);
+// whole mesh. Const: jobs may be exported concurrently. `loops` (null: one thread): the energy's
+// points written in its chunks (the same state).
+MetricState export_job_state(const PriorityModule& master, const SubsetJob& job,
+                             ChunkedLoops* loops = nullptr);
 
 // Builds the job's module state from job.state (instead of initialize()). Throws
-// Error(kInvalidInput) when the state does not fit the module or the job's mesh.
-void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job);
+// Error(kInvalidInput) when the state does not fit the module or the job's mesh. `loops` (null:
+// one thread): the energy's points listed in its chunks (the same module).
+void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job,
+                      ChunkedLoops* loops = nullptr);
 
 // The job's module state at its end, in global ids: what its collapses `records` (in local
 // ids) changed, the rest being as the master has it (the energy's faces around them, their
 // corners and wedges); for a metric that returns none (returns_state), an empty state.
+// `loops` (null: one thread): the energy's points written in its chunks (the same state).
 MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
-                                const SubsetJob& job, const std::vector<CollapseRecord>& records);
+                                const SubsetJob& job, const std::vector<CollapseRecord>& records,
+                                ChunkedLoops* loops = nullptr);
 
 // The master takes a job's returned state, or follows its `records` (global ids) where the
 // metric returns none. The jobs of a round own disjoint faces, vertices and wedges, and mixed
@@ -63,7 +69,8 @@ void import_result_state(PriorityModule& master, const MetricState& state,
 // (records[k]: the records of state k's job, in global ids): each state must also cover what
 // they changed (check_state_covers); a metric that returns no state (returns_state) follows
 // them instead, each list checked first as a state is, and the states must be empty. May be
-// left out for a metric that returns states.
+// left out for a metric that returns states. With fewer states than `cores` (the build's p; 0:
+// as many as states), each energy state's check and take run in cores / states chunks.
 struct ImportTimes {
   double seconds = 0;                // wall
   double critical_seconds = 0;       // with a core per state: the steps' slowest ones, in turn
@@ -73,7 +80,8 @@ struct ImportTimes {
 ImportTimes import_result_states(
     PriorityModule& master, const std::vector<const MetricState*>& states,
     const std::vector<uint32_t>& vertex_subset, const std::vector<uint32_t>& face_subset,
-    unsigned threads, const std::vector<const std::vector<CollapseRecord>*>& records = {});
+    unsigned threads, const std::vector<const std::vector<CollapseRecord>*>& records = {},
+    unsigned cores = 0);
 
 // Throws Error(kInvalidInput) unless `state`, a job's returned state, covers what its job's
 // `records` (global ids) changed: the two ends of every collapse and, for the energy, the two

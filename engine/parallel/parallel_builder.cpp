@@ -686,14 +686,23 @@ void ParallelBuilder::extract_jobs(Round& r) {
   // The master's own steps, before the jobs' extraction and after it, are on the critical path.
   double sequential_extract = owned_clock.critical_seconds();
   std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
+  // A round of fewer jobs than p: each task writes and imports its job's state on the cores the
+  // round leaves, as its job's team will (ThreadPoolRunner).
+  const unsigned task_chunks = subsets < parallel_.subsets ? parallel_.subsets / subsets : 1;
+  const unsigned task_threads =
+      std::max(1u, pool_threads(parallel_.threads, parallel_.subsets) / subsets);
   run_jobs(jobs.size(), parallel_.threads, [&](size_t i) {
     const double cpu = thread_cpu_seconds();
+    ChunkedLoops state_loops = task_chunks > 1
+                                   ? ChunkedLoops(task_chunks, task_threads, kStateChunkItems)
+                                   : ChunkedLoops();
     // The jobs' meshes carry the input's wedge values; the metric's current ones
     // (E_scalar) travel in the state.
     jobs[i] = extract_subset(whole, mesh_.layout, mesh_.wedge_values, mesh_.positions_are_float,
                              locked_, r.vertex_subset, owned[i], uint32_t(i), rs.round,
                              subset_options_, &copy_groups_);
-    if (job_state_needed(*master_, rs.round)) jobs[i].state = export_job_state(*master_, jobs[i]);
+    if (job_state_needed(*master_, rs.round))
+      jobs[i].state = export_job_state(*master_, jobs[i], &state_loops);
     for (FaceId f = 0; f < jobs[i].mesh.face_count(); ++f) {
       const Triangle& c = jobs[i].mesh.faces[f];
       if (jobs[i].owned[c[0]] && jobs[i].owned[c[1]] && jobs[i].owned[c[2]])
@@ -706,7 +715,7 @@ void ParallelBuilder::extract_jobs(Round& r) {
       const double sample_start = thread_cpu_seconds();
       if (sample_in_tasks) {
         samples[i] = sample_subset(jobs[i], free, carry_keys_, jobs[i].keys,
-                                   prepared.empty() ? nullptr : &prepared[i]);
+                                   prepared.empty() ? nullptr : &prepared[i], &state_loops);
         if (!prepared.empty() && prepared[i].metric) jobs[i].state = MetricState{};
       } else if (master_in_tasks) {
         const std::unique_ptr<PriorityModule> view = master_->costing_view();
@@ -718,7 +727,9 @@ void ParallelBuilder::extract_jobs(Round& r) {
       sample_cpu[i] = thread_cpu_seconds() - sample_start;
     }
     if (carry_deferred_) jobs[i].deferred = deferred_of_job(deferred_, jobs[i], free, jobs[i].keys);
-    job_cpu[i] = thread_cpu_seconds() - cpu;
+    // (its state's loops at their slowest chunk, as with a core per chunk)
+    job_cpu[i] =
+        thread_cpu_seconds() - cpu - (state_loops.seconds() - state_loops.critical_seconds());
   });
   const auto after_jobs = std::chrono::steady_clock::now();
   // The water level and the shares (sequential: a sort of the samples).
@@ -891,7 +902,7 @@ double ParallelBuilder::take_results(Round& r) {
     std::vector<const MetricState*> states;
     for (const SubsetResult& result : r.results) states.push_back(&result.state);
     const ImportTimes import = import_result_states(*master_, states, r.vertex_subset, face_subset_,
-                                                    parallel_.threads, changes);
+                                                    parallel_.threads, changes, parallel_.subsets);
     import_saved = std::max(0.0, import.seconds - import.critical_seconds);
   }
   std::vector<double> costs;

@@ -72,8 +72,10 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 // Costing::kEstimate, or with carry_keys as kQueue: those costs become the job's queue keys.
 // `prepared` (may be null): given the job's mesh and metric the sample was costed on, for a job
 // run in the same process (simplify_subset takes them); left as it was when no edge is sampled.
+// `loops` (null: one thread): the state's import in its chunks.
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
-                           std::vector<EdgeKey>& keys, PreparedSubset* prepared = nullptr);
+                           std::vector<EdgeKey>& keys, PreparedSubset* prepared = nullptr,
+                           ChunkedLoops* loops = nullptr);
 
 // The same sample costed on the whole mesh by `master_costs`, a Simplifier over it with the
 // master's module and the build's copy groups (`edges` from sampled_edges(job, ...),

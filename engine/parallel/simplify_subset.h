@@ -47,7 +47,10 @@ struct SubsetResult {
 
 // The cores a job may use beside its own thread: its metric's point projections (the energy's,
 // PriorityModule::use_team) cut into `chunks` on `threads` threads (the caller's among them),
-// loops of at least `min_items` points. The same records whatever the team.
+// loops of at least `min_items` points; and its state's passes (job_state.h: import, export) in
+// as many chunks of at least kStateChunkItems faces or points. The same records and state
+// whatever the team.
+constexpr size_t kStateChunkItems = 256;
 struct JobTeam {
   // The smallest loop worth a team: fewer points take less time than waking it does.
   static constexpr size_t kDefaultMinItems = 512;
@@ -66,7 +69,7 @@ struct PreparedSubset {
   std::unique_ptr<PriorityModule> metric;
   bool imported = false;  // the metric holds the job's state
 };
-PreparedSubset prepare_subset(const SubsetJob& job);
+PreparedSubset prepare_subset(const SubsetJob& job, ChunkedLoops* loops = nullptr);
 
 // Throws Error(kInvalidInput) for an invalid job or options, Error(kCancelled /
 // kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing. With
@@ -88,7 +91,9 @@ SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress =
 SimplifyOptions simplify_options_of(const SubsetOptions& subset);
 
 // The job's metric module over `working` (a CollapseMesh of job.mesh), as simplify_subset
-// makes it: with a job state, the master's state imported (not yet initialised otherwise).
-std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseMesh& working);
+// makes it: with a job state, the master's state imported (not yet initialised otherwise), in
+// `loops`' chunks (null: one thread).
+std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseMesh& working,
+                                           ChunkedLoops* loops = nullptr);
 
 }  // namespace parapm

@@ -201,10 +201,25 @@ class EnergyPriority : public PriorityModule {
   // changed, not every point of the job), without positions (EnergyState::positions).
   // import_global: the master overwrites the state's faces, vertices and wedges, the points
   // and curve samples at the positions it holds for their ids.
-  EnergyState export_local(const IdMaps& maps) const;
-  void import_local(const CollapseMesh& mesh, const EnergyState& state);
+  // `loops`: the points' passes in its chunks (a tail round's few jobs, on the cores the round
+  // leaves idle); the same state and module whatever the chunking.
+  EnergyState export_local(const IdMaps& maps, ChunkedLoops& loops) const;
+  EnergyState export_local(const IdMaps& maps) const {
+    ChunkedLoops plain;
+    return export_local(maps, plain);
+  }
+  void import_local(const CollapseMesh& mesh, const EnergyState& state, ChunkedLoops& loops);
+  void import_local(const CollapseMesh& mesh, const EnergyState& state) {
+    ChunkedLoops plain;
+    import_local(mesh, state, plain);
+  }
   EnergyState export_global(const CollapseMesh& mesh, const IdMaps& maps,
-                            const std::vector<uint8_t>& changed) const;
+                            const std::vector<uint8_t>& changed, ChunkedLoops& loops) const;
+  EnergyState export_global(const CollapseMesh& mesh, const IdMaps& maps,
+                            const std::vector<uint8_t>& changed) const {
+    ChunkedLoops plain;
+    return export_global(mesh, maps, changed, plain);
+  }
   void import_global(const EnergyState& state);  // checks the state first (kInvalidInput)
 
   // Several jobs' states at once (job_state.h, import_result_states), side by side:
@@ -221,10 +236,23 @@ class EnergyPriority : public PriorityModule {
   struct GlobalImport {
     std::vector<uint32_t> samples;  // indices into state.samples that this state writes
   };
+  // `loops`: a state's passes over its faces, vertices and points in its chunks (a tail round's
+  // few states, on the cores the round leaves); the same checks and master whatever the
+  // chunking. check_global also refuses a face or vertex listed twice and a face whose points
+  // are not listed together, in one run (apply_global's chunks each fill whole lists).
   void begin_global_imports();
+  GlobalImport check_global(const EnergyState& state, uint32_t subset, const GlobalOwners& owners,
+                            ChunkedLoops& loops) const;
   GlobalImport check_global(const EnergyState& state, uint32_t subset,
-                            const GlobalOwners& owners) const;
-  void apply_global(const EnergyState& state, const GlobalImport& import);
+                            const GlobalOwners& owners) const {
+    ChunkedLoops plain;
+    return check_global(state, subset, owners, plain);
+  }
+  void apply_global(const EnergyState& state, const GlobalImport& import, ChunkedLoops& loops);
+  void apply_global(const EnergyState& state, const GlobalImport& import) {
+    ChunkedLoops plain;
+    apply_global(state, import, plain);
+  }
   void apply_global_wedges(const EnergyState& state);
 
   // Observers, for tests and reports.
@@ -296,7 +324,7 @@ class EnergyPriority : public PriorityModule {
   void reset_point_lists(const CollapseMesh& mesh);
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
-                    EnergyState& out) const;
+                    EnergyState& out, ChunkedLoops& loops) const;
 
   std::vector<uint8_t> locked_;
   EnergyOptions options_;
@@ -359,8 +387,9 @@ class EnergyPriority : public PriorityModule {
     std::vector<uint8_t> fan_taken;  // per face of the fan: its points were taken
   };
   Reprojection moved_;
-  // check_global's marks: (generation << 10) | (subset << 1) | given. Each check writes its own
-  // subset's faces, vertices and the points on them; the points' marks through atomic_ref.
+  // check_global's marks: (generation << 10) | (subset << 1) | given (a point: named by the
+  // state; a face: its run of points begun; a vertex: listed). Each check writes its own
+  // subset's faces, vertices and the points on them, all through atomic_ref (its chunks too).
   mutable std::vector<uint32_t> face_tag_, vertex_tag_, point_tag_;
   uint32_t import_generation_ = 0;
 };

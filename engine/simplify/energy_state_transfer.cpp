@@ -4,6 +4,7 @@
 // from the metric itself (energy_priority.cpp), which prices and performs collapses.
 #include <algorithm>
 #include <atomic>
+#include <string>
 
 #include "simplify/energy_priority.h"
 #include "util/error.h"
@@ -12,17 +13,10 @@ namespace parapm {
 
 namespace {
 
-// Reserves each face's list for the run of `points` naming it (a state lists its points
-// grouped by face): a list grown point by point would leave the blocks it outgrew behind.
-// Faces out of range are left to the caller's checks.
-void reserve_face_lists(const std::vector<EnergyState::Point>& points,
-                        std::vector<std::vector<EnergyFacePoint>>& lists) {
-  for (size_t i = 0, run = 0; i < points.size(); i += run) {
-    const FaceId f = points[i].face;
-    run = 1;
-    while (i + run < points.size() && points[i + run].face == f) ++run;
-    if (f < lists.size()) lists[f].reserve(lists[f].size() + run);
-  }
+// Whether point i continues the run of points of one face before it (a state lists each
+// face's points together: each run fills its face's list, reserved once for the run).
+bool continues_run(const std::vector<EnergyState::Point>& points, size_t i) {
+  return i > 0 && points[i].face != kNoId && points[i].face == points[i - 1].face;
 }
 
 }  // namespace
@@ -30,58 +24,75 @@ void reserve_face_lists(const std::vector<EnergyState::Point>& points,
 void EnergyPriority::export_state(const std::vector<FaceId>& faces,
                                   const std::vector<VertexId>& vertices,
                                   const std::vector<WedgeId>& wedges, const IdMaps& maps,
-                                  bool to_local, EnergyState& out) const {
+                                  bool to_local, EnergyState& out, ChunkedLoops& loops) const {
   const IdTranslation to_face{maps.face, to_local}, to_vertex{maps.vertex, to_local};
   const int floats = scalar_.enabled() ? scalar_.floats() : 0;
+  const bool values = floats && to_local;
   // A job's returned state (to global ids) leaves out what never changes (EnergyState::positions).
   out.positions = to_local;
   // A face's drift goes into its points' distances: the state holds bounds, and no drift.
-  auto add_point = [&](const FacePoint& p, FaceId face, VertexId vertex, double distance_sq) {
+  auto write_point = [&](size_t at, const FacePoint& p, FaceId face, VertexId vertex,
+                         double distance_sq) {
     const uint32_t id = p.id;
-    out.points.push_back({point_id_.empty() ? id : point_id_[id], face, vertex,
-                          to_local ? p.position : Vec3{}, distance_sq,
-                          floats ? scalar_.residual(id) : 0.0});
-    if (floats && to_local)
-      out.point_values.insert(out.point_values.end(), scalar_.point_values(id),
-                              scalar_.point_values(id) + floats);
+    EnergyState::Point& written = out.points[at];
+    written.id = point_id_.empty() ? id : point_id_[id];
+    written.face = face;
+    written.vertex = vertex;
+    if (to_local) written.position = p.position;
+    written.distance_sq = distance_sq;
+    if (floats) written.residual = scalar_.residual(id);
+    if (values)
+      std::copy_n(scalar_.point_values(id), floats,
+                  out.point_values.begin() + ptrdiff_t(at * size_t(floats)));
   };
-  // Sized once: grown by doubling, a state of a million points would leave up to twice its
-  // size behind in freed blocks.
+  // Where each face's points go (its list's run starts there), so that the faces are written
+  // side by side; sized once, exactly.
+  std::vector<size_t> first_point(faces.size() + 1);
   size_t points = 0;
-  for (const FaceId f : faces) points += face_points_[f].size();
+  for (size_t i = 0; i < faces.size(); ++i) {
+    first_point[i] = points;
+    points += face_points_[faces[i]].size();
+  }
+  first_point[faces.size()] = points;
   for (const VertexId v : vertices) points += parked_point_[v] != kNoPoint ? 1 : 0;
-  out.points.reserve(points);
-  if (floats && to_local) out.point_values.reserve(points * size_t(floats));
-  out.faces.reserve(faces.size());
-  out.vertices.reserve(vertices.size());
+  out.points.resize(points);
+  if (values) out.point_values.resize(points * size_t(floats));
+  out.faces.resize(faces.size());
   // (Each id translated near its own position in the list: exact when the list is the map
   // itself, a job's export_local.)
-  for (size_t i = 0; i < faces.size(); ++i) {
-    const FaceId f = faces[i];
-    const FaceId written = to_face.near(f, i);
-    out.faces.push_back(written);
-    for (const FacePoint& p : face_points_[f])
-      add_point(p, written, kNoId, bounded_distance_sq(f, p));
-  }
+  loops.run(faces.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const FaceId f = faces[i];
+      const FaceId written = to_face.near(f, i);
+      out.faces[i] = written;
+      size_t at = first_point[i];
+      for (const FacePoint& p : face_points_[f])
+        write_point(at++, p, written, kNoId, bounded_distance_sq(f, p));
+    }
+  });
+  out.vertices.reserve(vertices.size());
+  size_t at = first_point[faces.size()];
   for (size_t i = 0; i < vertices.size(); ++i) {
     const VertexId v = vertices[i];
     const VertexId written = to_vertex.near(v, i);
     out.vertices.push_back(written);
-    if (parked_point_[v] != kNoPoint) add_point(parked(parked_point_[v]), kNoId, written, 0.0);
+    if (parked_point_[v] != kNoPoint)
+      write_point(at++, parked(parked_point_[v]), kNoId, written, 0.0);
   }
   curves_.export_state(vertices, to_vertex, out);
   if (floats) scalar_.export_wedges(wedges, IdTranslation{maps.wedge, to_local}, out);
 }
 
-EnergyState EnergyPriority::export_local(const IdMaps& maps) const {
+EnergyState EnergyPriority::export_local(const IdMaps& maps, ChunkedLoops& loops) const {
   EnergyState state;
   const std::vector<WedgeId> none;
-  export_state(*maps.face, *maps.vertex, maps.wedge ? *maps.wedge : none, maps, true, state);
+  export_state(*maps.face, *maps.vertex, maps.wedge ? *maps.wedge : none, maps, true, state, loops);
   return state;
 }
 
 EnergyState EnergyPriority::export_global(const CollapseMesh& mesh, const IdMaps& maps,
-                                          const std::vector<uint8_t>& changed) const {
+                                          const std::vector<uint8_t>& changed,
+                                          ChunkedLoops& loops) const {
   // The faces around a changed vertex, alive or not: a collapse changes the points, corners and
   // drift of the faces around vs (its star, which stay around vs or the vertex vs later
   // collapses into) and removes two faces around vt. Their corners: a collapse renames vt in
@@ -103,11 +114,12 @@ EnergyState EnergyPriority::export_global(const CollapseMesh& mesh, const IdMaps
   std::sort(wedges.begin(), wedges.end());
   wedges.erase(std::unique(wedges.begin(), wedges.end()), wedges.end());
   EnergyState state;
-  export_state(faces, vertices, wedges, maps, false, state);
+  export_state(faces, vertices, wedges, maps, false, state, loops);
   return state;
 }
 
-void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& state) {
+void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& state,
+                                  ChunkedLoops& loops) {
   if (!state.positions) throw_invalid("energy state: a job's state without its points' positions");
   const double diagonal = diagonal_of(mesh);
   topology_price_ = topology_price(diagonal);
@@ -120,25 +132,47 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
     curves_ = SharpCurves{};
     curves_.initialize_empty(mesh);
   }
-  const size_t n = state.points.size();
+  const std::vector<EnergyState::Point>& points = state.points;
+  const size_t n = points.size();
   positions_.resize(n);
   point_id_.resize(n);
   reset_point_lists(mesh);
-  reserve_face_lists(state.points, face_points_);
-  // The faces keep the written order.
-  for (size_t i = 0; i < n; ++i) {
-    const EnergyState::Point& p = state.points[i];
-    const auto id = uint32_t(i);
-    point_id_[i] = p.id;
-    positions_[i] = p.position;
-    if (p.face != kNoId) {
-      if (p.face >= mesh.face_capacity()) throw_invalid("energy state: face out of range");
-      face_points_[p.face].push_back({p.position, p.distance_sq, id});
-    } else {
-      if (p.vertex >= mesh.vertex_capacity()) throw_invalid("energy state: vertex out of range");
-      parked_point_[p.vertex] = id;
+  // Each face's points come as one run (the state lists them grouped by face), which fills
+  // its list in the written order; the runs side by side in `loops`' chunks, each chunk taking
+  // the runs that start in its range. A face named by two runs, or a vertex parked at twice,
+  // is refused: two chunks would fill one list.
+  std::vector<std::atomic<uint8_t>> face_taken(mesh.face_capacity());
+  std::vector<std::atomic<uint8_t>> vertex_taken(mesh.vertex_capacity());
+  loops.run(n, [&](size_t begin, size_t end) {
+    size_t i = begin;
+    while (i < end && continues_run(points, i)) ++i;
+    while (i < end) {
+      const EnergyState::Point& first = points[i];
+      size_t run_end = i + 1;
+      if (first.face != kNoId) {
+        while (run_end < n && continues_run(points, run_end)) ++run_end;
+        if (first.face >= mesh.face_capacity()) throw_invalid("energy state: face out of range");
+        if (face_taken[first.face].exchange(1))
+          throw_invalid("energy state: the points of face " + std::to_string(first.face) +
+                        " are not listed together");
+        face_points_[first.face].reserve(run_end - i);
+      } else {
+        if (first.vertex >= mesh.vertex_capacity())
+          throw_invalid("energy state: vertex out of range");
+        if (vertex_taken[first.vertex].exchange(1))
+          throw_invalid("energy state: two points parked at vertex " +
+                        std::to_string(first.vertex));
+        parked_point_[first.vertex] = uint32_t(i);
+      }
+      for (; i < run_end; ++i) {
+        const EnergyState::Point& p = points[i];
+        point_id_[i] = p.id;
+        positions_[i] = p.position;
+        if (p.face != kNoId)
+          face_points_[p.face].push_back({p.position, p.distance_sq, uint32_t(i)});
+      }
     }
-  }
+  });
 }
 
 void EnergyPriority::import_global(const EnergyState& state) {
@@ -172,10 +206,13 @@ void EnergyPriority::begin_global_imports() {
 // the points on them; a point of another subset's (named by a dishonest state) is read while
 // its check may be marking it, hence the relaxed atomics: the tag read is never this state's.
 EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& state, uint32_t subset,
-                                                          const GlobalOwners& owners) const {
+                                                          const GlobalOwners& owners,
+                                                          ChunkedLoops& loops) const {
   if (subset >= 512) throw_internal("energy state import: subset " + std::to_string(subset));
   const uint32_t tag = (import_generation_ << 10) | (subset << 1), given = tag | 1;
-  auto point_tag = [&](uint32_t id) { return std::atomic_ref<uint32_t>(point_tag_[id]); };
+  auto mark = [](std::vector<uint32_t>& tags, uint32_t i) {
+    return std::atomic_ref<uint32_t>(tags[i]);
+  };
   auto fail = [](const std::string& problem) { throw_invalid("energy state: " + problem); };
   auto face_ours = [&](FaceId f) {
     return f < face_points_.size() && (!owners.face_subset || (*owners.face_subset)[f] == subset);
@@ -184,33 +221,58 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
     return v < parked_point_.size() &&
            (!owners.vertex_subset || (*owners.vertex_subset)[v] == subset);
   };
-  for (FaceId f : state.faces) {
-    if (f >= face_points_.size()) fail("face " + std::to_string(f) + " out of range");
-    if (!face_ours(f)) fail("face " + std::to_string(f) + " is another subset's");
-    face_tag_[f] = tag;
-    for (const FacePoint& p : face_points_[f])
-      point_tag(p.id).store(tag, std::memory_order_relaxed);
-  }
-  for (VertexId v : state.vertices) {
-    if (v >= parked_point_.size()) fail("vertex " + std::to_string(v) + " out of range");
-    if (!vertex_ours(v)) fail("vertex " + std::to_string(v) + " is another subset's");
-    vertex_tag_[v] = tag;
-    if (parked_point_[v] != kNoPoint)
-      point_tag(parked_point_[v]).store(tag, std::memory_order_relaxed);
-  }
-  for (const EnergyState::Point& p : state.points) {
-    const char* why = nullptr;
-    if (p.id >= positions_.size()) {
-      why = " out of range";
-    } else if (const uint32_t t = point_tag(p.id).load(std::memory_order_relaxed); t != tag) {
-      why = t == given ? " given twice" : " is not the job's";
-    } else if (p.face != kNoId ? !face_ours(p.face) || face_tag_[p.face] != tag
-                               : !vertex_ours(p.vertex) || vertex_tag_[p.vertex] != tag) {
-      why = " is on a face or vertex the state does not list";
+  loops.run(state.faces.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const FaceId f = state.faces[i];
+      if (f >= face_points_.size()) fail("face " + std::to_string(f) + " out of range");
+      if (!face_ours(f)) fail("face " + std::to_string(f) + " is another subset's");
+      if (mark(face_tag_, f).exchange(tag, std::memory_order_relaxed) == tag)
+        fail("face " + std::to_string(f) + " listed twice");
+      for (const FacePoint& p : face_points_[f])
+        mark(point_tag_, p.id).store(tag, std::memory_order_relaxed);
     }
-    if (why) fail("point " + std::to_string(p.id) + why);
-    point_tag(p.id).store(given, std::memory_order_relaxed);
-  }
+  });
+  loops.run(state.vertices.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const VertexId v = state.vertices[i];
+      if (v >= parked_point_.size()) fail("vertex " + std::to_string(v) + " out of range");
+      if (!vertex_ours(v)) fail("vertex " + std::to_string(v) + " is another subset's");
+      if (mark(vertex_tag_, v).exchange(tag, std::memory_order_relaxed) == tag)
+        fail("vertex " + std::to_string(v) + " listed twice");
+      if (parked_point_[v] != kNoPoint)
+        mark(point_tag_, parked_point_[v]).store(tag, std::memory_order_relaxed);
+    }
+  });
+  // Each point once; a face's points in one run, which begins by marking the face given, a
+  // parked point by marking its vertex given. A chunk checks the runs that begin in its range.
+  const std::vector<EnergyState::Point>& points = state.points;
+  loops.run(points.size(), [&](size_t begin, size_t end) {
+    size_t i = begin;
+    while (i < end && continues_run(points, i)) ++i;
+    for (; i < end || (i < points.size() && continues_run(points, i)); ++i) {
+      const EnergyState::Point& p = points[i];
+      const char* why = nullptr;
+      uint32_t was = tag;
+      if (p.id >= positions_.size()) {
+        why = " out of range";
+      } else if (!mark(point_tag_, p.id)
+                      .compare_exchange_strong(was, given, std::memory_order_relaxed)) {
+        why = was == given ? " given twice" : " is not the job's";
+      } else if (continues_run(points, i)) {
+        // (its face checked with the run's first point)
+      } else if (p.face != kNoId ? !face_ours(p.face) : !vertex_ours(p.vertex)) {
+        why = " is on a face or vertex the state does not list";
+      } else if (uint32_t listed = tag;
+                 !mark(p.face != kNoId ? face_tag_ : vertex_tag_,
+                       p.face != kNoId ? p.face : p.vertex)
+                      .compare_exchange_strong(listed, given, std::memory_order_relaxed)) {
+        why = listed != given   ? " is on a face or vertex the state does not list"
+              : p.face != kNoId ? " is on a face whose points are not listed together"
+                                : " is parked at a vertex with another point parked there";
+      }
+      if (why) fail("point " + std::to_string(p.id) + why);
+    }
+  });
   if (options_.discontinuities) curves_.check_global(state);
   scalar_.check_global(state);
   // The curve samples it writes: those on an edge whose first end is the subset's now. A
@@ -225,26 +287,46 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
   return import;
 }
 
-void EnergyPriority::apply_global(const EnergyState& state, const GlobalImport& import) {
-  for (FaceId f : state.faces) {
-    face_points_[f].clear();
-    evaluator_.forget(f);
-    drift_[f] = 0;
-  }
-  for (VertexId v : state.vertices) parked_point_[v] = kNoPoint;
-  reserve_face_lists(state.points, face_points_);
-  // The faces keep the written order.
-  for (const EnergyState::Point& p : state.points) {
-    if (p.face != kNoId) {
-      face_points_[p.face].push_back({positions_[p.id], p.distance_sq, p.id});
-    } else {
-      parked_point_[p.vertex] = p.id;
+void EnergyPriority::apply_global(const EnergyState& state, const GlobalImport& import,
+                                  ChunkedLoops& loops) {
+  loops.run(state.faces.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const FaceId f = state.faces[i];
+      face_points_[f].clear();
+      evaluator_.forget(f);
+      drift_[f] = 0;
     }
-    if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
-  }
+  });
+  for (VertexId v : state.vertices) parked_point_[v] = kNoPoint;
+  // The faces keep the written order: each run of a face's points (check_global: one per
+  // face) fills its list, in the chunk where it begins.
+  const std::vector<EnergyState::Point>& points = state.points;
+  loops.run(points.size(), [&](size_t begin, size_t end) {
+    size_t i = begin;
+    while (i < end && continues_run(points, i)) ++i;
+    while (i < end) {
+      size_t run_end = i + 1;
+      if (points[i].face != kNoId) {
+        while (run_end < points.size() && continues_run(points, run_end)) ++run_end;
+        std::vector<FacePoint>& list = face_points_[points[i].face];
+        list.reserve(list.size() + (run_end - i));
+      }
+      for (; i < run_end; ++i) {
+        const EnergyState::Point& p = points[i];
+        if (p.face != kNoId) {
+          face_points_[p.face].push_back({positions_[p.id], p.distance_sq, p.id});
+        } else {
+          parked_point_[p.vertex] = p.id;
+        }
+        if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
+      }
+    }
+  });
   // A face left without points (most were removed by the job) gives its list's memory back.
-  for (FaceId f : state.faces)
-    if (face_points_[f].empty()) face_points_[f].shrink_to_fit();
+  loops.run(state.faces.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i)
+      if (face_points_[state.faces[i]].empty()) face_points_[state.faces[i]].shrink_to_fit();
+  });
   if (options_.discontinuities) curves_.import_global(state, &import.samples);
 }
 

@@ -10,6 +10,7 @@
 
 #include "drawn_meshes.h"
 #include "parallel/collapse_merge.h"
+#include "parallel/job_codec.h"
 #include "parallel/job_state.h"
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
@@ -397,6 +398,89 @@ TEST(JobState, ATamperedEnergyStateIsRefusedAndChangesNothing) {
   EXPECT_NO_THROW(import_result_state(*master, result.state, result.records));
 }
 
+// A tail round's job writes and imports its state on several cores (ChunkedLoops): the same
+// state as one thread writes, and the job given a team (its import and returned state in
+// chunks) makes the run one thread makes. Half way down, so that faces hold runs of points;
+// with attributes (E_scalar's values travel with the points) and without.
+TEST(JobState, AStateInChunksIsTheStateOfOneThread) {
+  for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
+    const RepairedMesh repaired = testing::repaired_test_mesh(name);
+    const Mesh& mesh = repaired.mesh;
+    const SimplifyOptions options = options_of("energy");
+    const std::vector<uint8_t> locked = locked_vertices(repaired);
+    CollapseMesh whole(mesh);
+    std::unique_ptr<PriorityModule> master = make_priority_module(options, mesh, locked);
+    master->initialize(whole);
+    std::unique_ptr<PriorityModule> continued = without_initialize(*master);
+    Simplifier simplifier(whole, *continued, standard_constraints(locked));
+    SimplifierLimits limits;
+    limits.target_faces = whole.live_faces() / 3;
+    simplifier.run(limits, {}, nullptr);
+    std::vector<uint32_t> vertex_subset(whole.vertex_capacity(), 0);
+    for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+      vertex_subset[v] = whole.position(v)[0] < 0 ? 0 : 1;
+    std::vector<SubsetJob> jobs =
+        extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
+                        vertex_subset, 2, 1, subset_options_of(options, mesh));
+    for (SubsetJob& job : jobs) {
+      const std::string what = std::string(name) + " subset " + std::to_string(job.subset);
+      job.options.target_faces = job.mesh.face_count() / 2;
+      job.state = export_job_state(*master, job);
+      ChunkedLoops chunks(5, 2, 1);
+      SubsetJob chunked = job;
+      chunked.state = export_job_state(*master, job, &chunks);
+      ASSERT_GT(job.state.energy.points.size(), 2 * job.state.energy.faces.size()) << what;
+      EXPECT_EQ(encode_subset_job(chunked), encode_subset_job(job)) << what;
+      SubsetResult one = simplify_subset(job);
+      JobTeam team;
+      team.chunks = 4;
+      team.threads = 2;
+      team.min_items = JobTeam::kDefaultMinItems;
+      SubsetResult teamed = simplify_subset(std::move(chunked), {}, nullptr, nullptr, team);
+      ASSERT_EQ(teamed.records.size(), one.records.size()) << what;
+      ASSERT_FALSE(one.state.empty()) << what;
+      for (SubsetResult* r : {&one, &teamed})
+        r->wall_seconds = r->cpu_seconds = r->team_saved_seconds = r->team_cpu_seconds = 0;
+      EXPECT_EQ(encode_subset_summary(teamed), encode_subset_summary(one)) << what;
+      EXPECT_EQ(encode_collapse_records(teamed.records.data(), teamed.records.size()),
+                encode_collapse_records(one.records.data(), one.records.size()))
+          << what;
+    }
+  }
+}
+
+// A face's points come as one run: a state that lists a face's points apart (the import would
+// fill one list from two chunks) is refused, in chunks or not.
+TEST(JobState, AStateListingAFacesPointsApartIsRefused) {
+  TwoHalves halves;
+  SubsetJob job = halves.jobs.at(0);
+  std::vector<EnergyState::Point>& points = job.state.energy.points;
+  // A point of a later face's run put on the first face, after another face's run: the first
+  // face is named by two runs.
+  const FaceId first = points.front().face;
+  ASSERT_NE(first, kNoId);
+  size_t k = 1;
+  while (k < points.size() && points[k].face == first) ++k;  // the second run's start
+  ++k;
+  while (k < points.size() && points[k].face == points[k - 1].face) ++k;  // the third's
+  ASSERT_LT(k, points.size());
+  ASSERT_NE(points[k].face, kNoId);
+  points[k].face = first;
+  for (const unsigned chunks : {1u, 4u}) {
+    ChunkedLoops loops(chunks, 2, 1);
+    CollapseMesh local(job.mesh);
+    std::unique_ptr<PriorityModule> module =
+        make_priority_module(halves.options, job.mesh, job.locked, job.options.reference_diagonal);
+    try {
+      import_job_state(*module, local, job, &loops);
+      ADD_FAILURE() << chunks << " chunks: imported";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
+      EXPECT_NE(std::string(e.what()).find("not listed together"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // A mesh without sharp edges (a closed sphere, no attributes, no crease curves) keeps no
 // per-vertex curve lists: its jobs' states carry no curves and go back as usual, and a state
 // that brings curves to such a master (from a worker: a collapse never makes a sharp edge) is
@@ -496,19 +580,38 @@ TEST(JobState, StatesSideBySideTakeOnlyTheirOwnSubsets) {
        [&](std::vector<MetricState>& s) {
          std::swap(s[0].energy.faces.front(), s[0].energy.faces.back());
        }},
+      {"listed twice",
+       [&](std::vector<MetricState>& s) {
+         std::vector<FaceId>& faces = s[0].energy.faces;
+         faces.insert(faces.begin() + 1, faces.front());
+       }},
+      // A point moved onto the face of the first run, after another face's run.
+      {"not listed together",
+       [&](std::vector<MetricState>& s) {
+         std::vector<EnergyState::Point>& points = s[0].energy.points;
+         size_t k = 1;
+         while (k < points.size() && points[k].face == points[0].face) ++k;
+         ++k;
+         while (k < points.size() && points[k].face == points[k - 1].face) ++k;
+         points.at(k).face = points[0].face;
+       }},
   };
-  for (const Tamper& tamper : tampers) {
-    std::vector<MetricState> states = honest;
-    tamper.change(states);
-    expect_refused_and_unchanged(
-        [&] {
-          import_result_states(*master, {&states[0], &states[1]}, vertex_subset, face_subset, 2,
-                               changes);
-        },
-        tamper.what, *energy, before);
-  }
+  // As one thread checks them, and in chunks (cores = 8: four per state).
+  for (const unsigned cores : {0u, 8u})
+    for (const Tamper& tamper : tampers) {
+      std::vector<MetricState> states = honest;
+      tamper.change(states);
+      expect_refused_and_unchanged(
+          [&] {
+            import_result_states(*master, {&states[0], &states[1]}, vertex_subset, face_subset, 2,
+                                 changes, cores);
+          },
+          tamper.what, *energy, before);
+    }
 
-  import_result_states(*master, {&honest[0], &honest[1]}, vertex_subset, face_subset, 2, changes);
+  // Taken in chunks, as one_by_one takes them on one thread.
+  import_result_states(*master, {&honest[0], &honest[1]}, vertex_subset, face_subset, 2, changes,
+                       8);
   for (size_t k = 0; k < honest.size(); ++k)
     import_result_state(*one_by_one, honest[k], records[k]);
   const auto* other = dynamic_cast<EnergyPriority*>(one_by_one.get());
