@@ -221,28 +221,33 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
     return v < parked_point_.size() &&
            (!owners.vertex_subset || (*owners.vertex_subset)[v] == subset);
   };
-  loops.run(state.faces.size(), [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
-      const FaceId f = state.faces[i];
-      if (f >= face_points_.size()) fail("face " + std::to_string(f) + " out of range");
-      if (!face_ours(f)) fail("face " + std::to_string(f) + " is another subset's");
-      if (mark(face_tag_, f).exchange(tag, std::memory_order_relaxed) == tag)
-        fail("face " + std::to_string(f) + " listed twice");
-      for (const FacePoint& p : face_points_[f])
-        mark(point_tag_, p.id).store(tag, std::memory_order_relaxed);
-    }
-  });
-  loops.run(state.vertices.size(), [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
-      const VertexId v = state.vertices[i];
-      if (v >= parked_point_.size()) fail("vertex " + std::to_string(v) + " out of range");
-      if (!vertex_ours(v)) fail("vertex " + std::to_string(v) + " is another subset's");
-      if (mark(vertex_tag_, v).exchange(tag, std::memory_order_relaxed) == tag)
-        fail("vertex " + std::to_string(v) + " listed twice");
-      if (parked_point_[v] != kNoPoint)
-        mark(point_tag_, parked_point_[v]).store(tag, std::memory_order_relaxed);
-    }
-  });
+  // Each listed face and vertex checked and marked once (in range, the subset's, not listed
+  // before), and the points on it marked as the state's to name.
+  auto mark_listed = [&](const std::vector<uint32_t>& listed, const char* kind, size_t count,
+                         const auto& ours, std::vector<uint32_t>& tags, const auto& points_on) {
+    loops.run(listed.size(), [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        const uint32_t id = listed[i];
+        const char* why = id >= count ? " out of range"
+                          : !ours(id) ? " is another subset's"
+                          : mark(tags, id).exchange(tag, std::memory_order_relaxed) == tag
+                              ? " listed twice"
+                              : nullptr;
+        if (why) fail(kind + std::to_string(id) + why);
+        points_on(id, [&](uint32_t point) {
+          mark(point_tag_, point).store(tag, std::memory_order_relaxed);
+        });
+      }
+    });
+  };
+  mark_listed(state.faces, "face ", face_points_.size(), face_ours, face_tag_,
+              [&](FaceId f, const auto& mark_point) {
+                for (const FacePoint& p : face_points_[f]) mark_point(p.id);
+              });
+  mark_listed(state.vertices, "vertex ", parked_point_.size(), vertex_ours, vertex_tag_,
+              [&](VertexId v, const auto& mark_point) {
+                if (parked_point_[v] != kNoPoint) mark_point(parked_point_[v]);
+              });
   // Each point once; a face's points in one run, which begins by marking the face given, a
   // parked point by marking its vertex given. A chunk checks the runs that begin in its range.
   const std::vector<EnergyState::Point>& points = state.points;

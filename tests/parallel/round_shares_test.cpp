@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -32,87 +33,88 @@ void expect_same_records(const std::vector<CollapseRecord>& a, const std::vector
   }
 }
 
-// The sampled edges with two free ends join the job's keys. They are the job's own costs (its
-// module is imported from the same state), so the job given them makes the run it makes without
-// them, answering those costings from the keys. Half the fresh keys are carried in, so that the
-// sample answers some edges from them too.
-TEST(RoundShares, SampledKeysGiveTheJobsOwnRun) {
+// Each job of the energy's round 0 in three subsets, on two meshes, asked for 60% of its
+// faces; `what` names it.
+void each_energy_job(
+    const std::function<void(testing::RoundZero&, SubsetJob&, const std::string& what)>& body) {
   for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
     SimplifyOptions options;
     options.metric = "energy";
     testing::RoundZero round(name, options, 3);
     for (SubsetJob& job : round.jobs) {
-      const std::string what = std::string(name) + " subset " + std::to_string(job.subset);
       job.options.target_faces = job.mesh.face_count() * 2 / 5;
-      const std::vector<EdgeKey> fresh = testing::fresh_keys(*round.master, round.whole, job);
-      std::vector<EdgeKey> half;
-      for (size_t i = 0; i < fresh.size(); i += 2) half.push_back(fresh[i]);
-      job.keys = half;
-      SubsetJob sampled = job;
-      const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
-      const SubsetSample sample = sample_subset(sampled, free, true, sampled.keys);
-      EXPECT_GT(sample.inner_edges, sample.costs.size()) << what;
-      EXPECT_GE(sample.costs.size(), std::min<uint64_t>(sample.inner_edges, 1000)) << what;
-      ASSERT_GT(sampled.keys.size(), half.size()) << what;
-      // Every key once, sorted, each an edge with two free ends costed as the master costs it.
-      for (size_t i = 0; i < sampled.keys.size(); ++i) {
-        const EdgeKey& k = sampled.keys[i];
-        ASSERT_TRUE(free[k.a] && free[k.b]) << what;
-        if (i > 0) {
-          const EdgeKey& before = sampled.keys[i - 1];
-          ASSERT_TRUE(before.a < k.a || (before.a == k.a && before.b < k.b)) << what;
-        }
-        const auto it = std::lower_bound(
-            fresh.begin(), fresh.end(), k,
-            [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
-        ASSERT_TRUE(it != fresh.end() && it->a == k.a && it->b == k.b) << what;
-        ASSERT_TRUE(it->cost == k.cost || (std::isnan(it->cost) && std::isnan(k.cost))) << what;
-      }
-      const SubsetResult with_sample = simplify_subset(sampled);
-      const SubsetResult without = simplify_subset(job);
-      expect_same_records(with_sample.records, without.records, what);
-      EXPECT_GT(with_sample.keys_reused, without.keys_reused) << what;
+      body(round, job, std::string(name) + " subset " + std::to_string(job.subset));
     }
   }
+}
+
+// The sampled edges with two free ends join the job's keys. They are the job's own costs (its
+// module is imported from the same state), so the job given them makes the run it makes without
+// them, answering those costings from the keys. Half the fresh keys are carried in, so that the
+// sample answers some edges from them too.
+TEST(RoundShares, SampledKeysGiveTheJobsOwnRun) {
+  each_energy_job([](testing::RoundZero& round, SubsetJob& job, const std::string& what) {
+    const std::vector<EdgeKey> fresh = testing::fresh_keys(*round.master, round.whole, job);
+    std::vector<EdgeKey> half;
+    for (size_t i = 0; i < fresh.size(); i += 2) half.push_back(fresh[i]);
+    job.keys = half;
+    SubsetJob sampled = job;
+    const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+    const SubsetSample sample = sample_subset(sampled, free, true, sampled.keys);
+    EXPECT_GT(sample.inner_edges, sample.costs.size()) << what;
+    EXPECT_GE(sample.costs.size(), std::min<uint64_t>(sample.inner_edges, 1000)) << what;
+    ASSERT_GT(sampled.keys.size(), half.size()) << what;
+    // Every key once, sorted, each an edge with two free ends costed as the master costs it.
+    for (size_t i = 0; i < sampled.keys.size(); ++i) {
+      const EdgeKey& k = sampled.keys[i];
+      ASSERT_TRUE(free[k.a] && free[k.b]) << what;
+      if (i > 0) {
+        const EdgeKey& before = sampled.keys[i - 1];
+        ASSERT_TRUE(before.a < k.a || (before.a == k.a && before.b < k.b)) << what;
+      }
+      const auto it = std::lower_bound(
+          fresh.begin(), fresh.end(), k,
+          [](const EdgeKey& x, const EdgeKey& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+      ASSERT_TRUE(it != fresh.end() && it->a == k.a && it->b == k.b) << what;
+      ASSERT_TRUE(it->cost == k.cost || (std::isnan(it->cost) && std::isnan(k.cost))) << what;
+    }
+    const SubsetResult with_sample = simplify_subset(sampled);
+    const SubsetResult without = simplify_subset(job);
+    expect_same_records(with_sample.records, without.records, what);
+    EXPECT_GT(with_sample.keys_reused, without.keys_reused) << what;
+  });
 }
 
 // A job given the mesh and metric its sample was costed on (PreparedSubset), its state dropped
 // as the build drops it, makes the run it makes importing its state itself: the same records,
 // keys, deferred edges, state and costings.
 TEST(RoundShares, TheSamplesMetricRunsTheJobAsItsOwnImport) {
-  for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"}) {
-    SimplifyOptions options;
-    options.metric = "energy";
-    testing::RoundZero round(name, options, 3);
-    for (SubsetJob& job : round.jobs) {
-      const std::string what = std::string(name) + " subset " + std::to_string(job.subset);
-      job.options.target_faces = job.mesh.face_count() * 2 / 5;
-      const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
-      SubsetJob imports = job;
-      sample_subset(imports, free, true, imports.keys);
-      SubsetJob takes = job;
-      PreparedSubset prepared;
-      sample_subset(takes, free, true, takes.keys, &prepared);
-      ASSERT_TRUE(prepared.metric && prepared.imported) << what;
-      takes.state = MetricState{};
-      SubsetResult own = simplify_subset(std::move(imports));
-      SubsetResult taken =
-          simplify_subset(std::move(takes), {}, nullptr, nullptr, {}, std::move(prepared));
-      expect_same_records(taken.records, own.records, what);
-      ASSERT_EQ(taken.keys.size(), own.keys.size()) << what;
-      for (size_t i = 0; i < own.keys.size(); ++i) {
-        ASSERT_EQ(taken.keys[i].a, own.keys[i].a) << what;
-        ASSERT_EQ(taken.keys[i].b, own.keys[i].b) << what;
-        ASSERT_EQ(std::memcmp(&taken.keys[i].cost, &own.keys[i].cost, sizeof(double)), 0) << what;
-      }
-      ASSERT_EQ(taken.deferred.size(), own.deferred.size()) << what;
-      EXPECT_EQ(taken.costings, own.costings) << what;
-      EXPECT_FALSE(own.state.empty()) << what;
-      for (SubsetResult* r : {&own, &taken})
-        r->wall_seconds = r->cpu_seconds = r->team_saved_seconds = r->team_cpu_seconds = 0;
-      EXPECT_EQ(encode_subset_summary(taken), encode_subset_summary(own)) << what;
+  each_energy_job([](testing::RoundZero&, SubsetJob& job, const std::string& what) {
+    const std::vector<uint8_t> free = free_vertices(job.mesh, job.owned);
+    SubsetJob imports = job;
+    sample_subset(imports, free, true, imports.keys);
+    SubsetJob takes = job;
+    PreparedSubset prepared;
+    sample_subset(takes, free, true, takes.keys, &prepared);
+    ASSERT_TRUE(prepared.metric && prepared.imported) << what;
+    takes.state = MetricState{};
+    SubsetResult own = simplify_subset(std::move(imports));
+    SubsetResult taken =
+        simplify_subset(std::move(takes), {}, nullptr, nullptr, {}, std::move(prepared));
+    expect_same_records(taken.records, own.records, what);
+    ASSERT_EQ(taken.keys.size(), own.keys.size()) << what;
+    for (size_t i = 0; i < own.keys.size(); ++i) {
+      ASSERT_EQ(taken.keys[i].a, own.keys[i].a) << what;
+      ASSERT_EQ(taken.keys[i].b, own.keys[i].b) << what;
+      ASSERT_EQ(std::memcmp(&taken.keys[i].cost, &own.keys[i].cost, sizeof(double)), 0) << what;
     }
-  }
+    ASSERT_EQ(taken.deferred.size(), own.deferred.size()) << what;
+    EXPECT_EQ(taken.costings, own.costings) << what;
+    EXPECT_FALSE(own.state.empty()) << what;
+    for (SubsetResult* r : {&own, &taken})
+      r->wall_seconds = r->cpu_seconds = r->team_saved_seconds = r->team_cpu_seconds = 0;
+    EXPECT_EQ(encode_subset_summary(taken), encode_subset_summary(own)) << what;
+  });
 }
 
 // Without carried keys (a metric cheaper to cost than to remember: the quadric), the sample
