@@ -80,7 +80,7 @@ SubsetResult simplify_subset(const SubsetJob& job, const ProgressCallback& progr
                              QuadricState* free_quadrics = nullptr);
 // The same, releasing the job's mesh, state and keys as soon as its working mesh and metric
 // hold them (a job's peak memory holds them once, not twice); `job` keeps its ids, owned and
-// locked flags and options. `prepared` (null or empty: none): prepare_subset(job)'s, taken as
+// locked flags and options. `prepared` (empty: none): prepare_subset(job)'s, taken as
 // the job's working mesh and metric (the job's state may then be gone: the metric holds it).
 SubsetResult simplify_subset(SubsetJob&& job, const ProgressCallback& progress = {},
                              const CancelToken* cancel = nullptr,

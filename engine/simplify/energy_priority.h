@@ -202,7 +202,9 @@ class EnergyPriority : public PriorityModule {
   // import_global: the master overwrites the state's faces, vertices and wedges, the points
   // and curve samples at the positions it holds for their ids.
   // `loops`: the points' passes in its chunks (a tail round's few jobs, on the cores the round
-  // leaves idle); the same state and module whatever the chunking.
+  // leaves idle); the same state and module whatever the chunking. import_local refuses a
+  // state that lists a face's points apart or parks two points at a vertex (kInvalidInput:
+  // its chunks each fill whole lists).
   EnergyState export_local(const IdMaps& maps, ChunkedLoops& loops) const;
   EnergyState export_local(const IdMaps& maps) const {
     ChunkedLoops plain;
