@@ -158,14 +158,8 @@ ImportTimes import_result_states(PriorityModule& master,
                    " record lists for " + std::to_string(states.size()) + " states");
   std::vector<double> check_cpu(states.size(), 0), apply_cpu(states.size(), 0);
   // Per state, its passes' chunks on the cores fewer states leave.
-  const size_t n = std::max<size_t>(1, states.size());
-  const unsigned chunks = cores > n ? unsigned(cores / n) : 1;
-  const unsigned chunk_threads =
-      std::max(1u, pool_threads(threads, std::max<size_t>(cores, n)) / unsigned(n));
-  std::vector<ChunkedLoops> loops;
-  for (size_t k = 0; k < states.size(); ++k)
-    loops.push_back(chunks > 1 ? ChunkedLoops(chunks, chunk_threads, kStateChunkItems)
-                               : ChunkedLoops());
+  std::vector<ChunkedLoops> loops(states.size(),
+                                  state_loops_of(team_of_round(states.size(), cores, threads, 0)));
   // Each step on the pool, each state's CPU timed (its chunks at their slowest); a state's
   // check ends with its coverage.
   auto side_by_side = [&](std::vector<double>& cpu, const std::function<void(size_t)>& step) {

@@ -11,12 +11,9 @@ namespace parapm {
 std::vector<SubsetResult> ThreadPoolRunner::run(std::vector<SubsetJob>& jobs,
                                                 const CancelToken* cancel) {
   std::vector<SubsetResult> results(jobs.size());
-  JobTeam team;
-  if (!jobs.empty() && team_min_items_ > 0 && jobs.size() < cores_) {
-    team.chunks = unsigned(cores_ / jobs.size());
-    team.threads = std::max<unsigned>(1, pool_threads(threads_, cores_) / unsigned(jobs.size()));
-    team.min_items = team_min_items_;
-  }
+  const JobTeam team = team_min_items_ > 0
+                           ? team_of_round(jobs.size(), cores_, threads_, team_min_items_)
+                           : JobTeam{};
   std::vector<PreparedSubset> prepared = std::move(prepared_);
   prepared.resize(jobs.size());
   run_jobs(jobs.size(), threads_, [&](size_t i) {

@@ -688,14 +688,10 @@ void ParallelBuilder::extract_jobs(Round& r) {
   std::vector<double> job_cpu(jobs.size(), 0), sample_cpu(samples.size(), 0);
   // A round of fewer jobs than p: each task writes and imports its job's state on the cores the
   // round leaves, as its job's team will (ThreadPoolRunner).
-  const unsigned task_chunks = subsets < parallel_.subsets ? parallel_.subsets / subsets : 1;
-  const unsigned task_threads =
-      std::max(1u, pool_threads(parallel_.threads, parallel_.subsets) / subsets);
+  const JobTeam task_team = team_of_round(subsets, parallel_.subsets, parallel_.threads, 0);
   run_jobs(jobs.size(), parallel_.threads, [&](size_t i) {
     const double cpu = thread_cpu_seconds();
-    ChunkedLoops state_loops = task_chunks > 1
-                                   ? ChunkedLoops(task_chunks, task_threads, kStateChunkItems)
-                                   : ChunkedLoops();
+    ChunkedLoops state_loops = state_loops_of(task_team);
     // The jobs' meshes carry the input's wedge values; the metric's current ones
     // (E_scalar) travel in the state.
     jobs[i] = extract_subset(whole, mesh_.layout, mesh_.wedge_values, mesh_.positions_are_float,

@@ -1,5 +1,6 @@
 #include "parallel/simplify_subset.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -12,6 +13,7 @@
 #include "simplify/simplify.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/job_pool.h"
 #include "util/thread_team.h"
 
 namespace parapm {
@@ -60,6 +62,20 @@ std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseM
   return module;
 }
 
+JobTeam team_of_round(size_t jobs, unsigned cores, unsigned threads, size_t min_items) {
+  JobTeam team;
+  if (jobs == 0 || jobs >= cores) return team;
+  team.chunks = unsigned(cores / jobs);
+  team.threads = std::max<unsigned>(1, pool_threads(threads, cores) / unsigned(jobs));
+  team.min_items = min_items;
+  return team;
+}
+
+ChunkedLoops state_loops_of(const JobTeam& team) {
+  return team.chunks > 1 ? ChunkedLoops(team.chunks, team.threads, kStateChunkItems)
+                         : ChunkedLoops();
+}
+
 PreparedSubset prepare_subset(const SubsetJob& job, ChunkedLoops* loops) {
   PreparedSubset prepared;
   prepared.mesh = std::make_unique<CollapseMesh>(job.mesh);
@@ -96,9 +112,7 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
 
   std::optional<ThreadTeam> team;  // outlives the metric, which uses it
   // The state's passes over the points on the team's cores, in chunks of their own.
-  ChunkedLoops state_loops = job_team.chunks > 1
-                                 ? ChunkedLoops(job_team.chunks, job_team.threads, kStateChunkItems)
-                                 : ChunkedLoops();
+  ChunkedLoops state_loops = state_loops_of(job_team);
   PreparedSubset ready = prepared.metric ? std::move(prepared) : prepare_subset(job, &state_loops);
   if (ready.mesh->vertex_capacity() != job.mesh.vertex_count())
     throw_internal("simplify_subset: a prepared mesh of another job");

@@ -58,6 +58,12 @@ struct JobTeam {
   unsigned threads = 1;
   size_t min_items = 0;
 };
+// A job's team in a round of `jobs` jobs on `cores` cores (the build's p) and `threads` threads:
+// cores / jobs chunks on its share of the threads; no team (one chunk) when the jobs are as many
+// as the cores or more.
+JobTeam team_of_round(size_t jobs, unsigned cores, unsigned threads, size_t min_items);
+// The chunks a job's state passes (job_state.h) run in with `team`.
+ChunkedLoops state_loops_of(const JobTeam& team);
 
 // A job's working mesh and its metric, the job's state imported (job_module), made before the
 // job runs: the round's sample (round_shares.h, sample_subset) costs edges on them, and

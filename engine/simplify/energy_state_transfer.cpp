@@ -19,6 +19,24 @@ bool continues_run(const std::vector<EnergyState::Point>& points, size_t i) {
   return i > 0 && points[i].face != kNoId && points[i].face == points[i - 1].face;
 }
 
+// Calls body(first, end) for each run [first, end) of `points` (a face's points, or one parked
+// point), side by side in `loops`' chunks: a chunk takes the runs that begin in its range, so
+// that each face's list is filled by one chunk, in the written order.
+template <class Body>
+void for_each_run(ChunkedLoops& loops, const std::vector<EnergyState::Point>& points,
+                  const Body& body) {
+  loops.run(points.size(), [&](size_t begin, size_t end) {
+    size_t first = begin;
+    while (first < end && continues_run(points, first)) ++first;
+    while (first < end) {
+      size_t run_end = first + 1;
+      while (run_end < points.size() && continues_run(points, run_end)) ++run_end;
+      body(first, run_end);
+      first = run_end;
+    }
+  });
+}
+
 }  // namespace
 
 void EnergyPriority::export_state(const std::vector<FaceId>& faces,
@@ -143,34 +161,25 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   // is refused: two chunks would fill one list.
   std::vector<std::atomic<uint8_t>> face_taken(mesh.face_capacity());
   std::vector<std::atomic<uint8_t>> vertex_taken(mesh.vertex_capacity());
-  loops.run(n, [&](size_t begin, size_t end) {
-    size_t i = begin;
-    while (i < end && continues_run(points, i)) ++i;
-    while (i < end) {
-      const EnergyState::Point& first = points[i];
-      size_t run_end = i + 1;
-      if (first.face != kNoId) {
-        while (run_end < n && continues_run(points, run_end)) ++run_end;
-        if (first.face >= mesh.face_capacity()) throw_invalid("energy state: face out of range");
-        if (face_taken[first.face].exchange(1))
-          throw_invalid("energy state: the points of face " + std::to_string(first.face) +
-                        " are not listed together");
-        face_points_[first.face].reserve(run_end - i);
-      } else {
-        if (first.vertex >= mesh.vertex_capacity())
-          throw_invalid("energy state: vertex out of range");
-        if (vertex_taken[first.vertex].exchange(1))
-          throw_invalid("energy state: two points parked at vertex " +
-                        std::to_string(first.vertex));
-        parked_point_[first.vertex] = uint32_t(i);
-      }
-      for (; i < run_end; ++i) {
-        const EnergyState::Point& p = points[i];
-        point_id_[i] = p.id;
-        positions_[i] = p.position;
-        if (p.face != kNoId)
-          face_points_[p.face].push_back({p.position, p.distance_sq, uint32_t(i)});
-      }
+  for_each_run(loops, points, [&](size_t first, size_t end) {
+    const EnergyState::Point& p = points[first];
+    if (p.face != kNoId) {
+      if (p.face >= mesh.face_capacity()) throw_invalid("energy state: face out of range");
+      if (face_taken[p.face].exchange(1))
+        throw_invalid("energy state: the points of face " + std::to_string(p.face) +
+                      " are not listed together");
+      face_points_[p.face].reserve(end - first);
+    } else {
+      if (p.vertex >= mesh.vertex_capacity()) throw_invalid("energy state: vertex out of range");
+      if (vertex_taken[p.vertex].exchange(1))
+        throw_invalid("energy state: two points parked at vertex " + std::to_string(p.vertex));
+      parked_point_[p.vertex] = uint32_t(first);
+    }
+    for (size_t i = first; i < end; ++i) {
+      point_id_[i] = points[i].id;
+      positions_[i] = points[i].position;
+      if (p.face != kNoId)
+        face_points_[p.face].push_back({points[i].position, points[i].distance_sq, uint32_t(i)});
     }
   });
 }
@@ -251,10 +260,8 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
   // Each point once; a face's points in one run, which begins by marking the face given, a
   // parked point by marking its vertex given. A chunk checks the runs that begin in its range.
   const std::vector<EnergyState::Point>& points = state.points;
-  loops.run(points.size(), [&](size_t begin, size_t end) {
-    size_t i = begin;
-    while (i < end && continues_run(points, i)) ++i;
-    for (; i < end || (i < points.size() && continues_run(points, i)); ++i) {
+  for_each_run(loops, points, [&](size_t first, size_t end) {
+    for (size_t i = first; i < end; ++i) {
       const EnergyState::Point& p = points[i];
       const char* why = nullptr;
       uint32_t was = tag;
@@ -263,7 +270,7 @@ EnergyPriority::GlobalImport EnergyPriority::check_global(const EnergyState& sta
       } else if (!mark(point_tag_, p.id)
                       .compare_exchange_strong(was, given, std::memory_order_relaxed)) {
         why = was == given ? " given twice" : " is not the job's";
-      } else if (continues_run(points, i)) {
+      } else if (i > first) {
         // (its face checked with the run's first point)
       } else if (p.face != kNoId ? !face_ours(p.face) : !vertex_ours(p.vertex)) {
         why = " is on a face or vertex the state does not list";
@@ -306,25 +313,19 @@ void EnergyPriority::apply_global(const EnergyState& state, const GlobalImport& 
   // The faces keep the written order: each run of a face's points (check_global: one per
   // face) fills its list, in the chunk where it begins.
   const std::vector<EnergyState::Point>& points = state.points;
-  loops.run(points.size(), [&](size_t begin, size_t end) {
-    size_t i = begin;
-    while (i < end && continues_run(points, i)) ++i;
-    while (i < end) {
-      size_t run_end = i + 1;
-      if (points[i].face != kNoId) {
-        while (run_end < points.size() && continues_run(points, run_end)) ++run_end;
-        std::vector<FacePoint>& list = face_points_[points[i].face];
-        list.reserve(list.size() + (run_end - i));
+  for_each_run(loops, points, [&](size_t first, size_t end) {
+    if (points[first].face != kNoId) {
+      std::vector<FacePoint>& list = face_points_[points[first].face];
+      list.reserve(list.size() + (end - first));
+    }
+    for (size_t i = first; i < end; ++i) {
+      const EnergyState::Point& p = points[i];
+      if (p.face != kNoId) {
+        face_points_[p.face].push_back({positions_[p.id], p.distance_sq, p.id});
+      } else {
+        parked_point_[p.vertex] = p.id;
       }
-      for (; i < run_end; ++i) {
-        const EnergyState::Point& p = points[i];
-        if (p.face != kNoId) {
-          face_points_[p.face].push_back({positions_[p.id], p.distance_sq, p.id});
-        } else {
-          parked_point_[p.vertex] = p.id;
-        }
-        if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
-      }
+      if (scalar_.enabled()) scalar_.set_residual(p.id, p.residual);
     }
   });
   // A face left without points (most were removed by the job) gives its list's memory back.
