@@ -18,7 +18,8 @@ set(PARAPM_ENGINE_HEADERS io/gltf_writer.h io/mesh_io.h mesh/mesh.h mesh/repair.
   simplify/module_state.h
   simplify/copy_groups.h simplify/modules.h simplify/quad_heap.h simplify/quadric.h
   simplify/simplifier.h simplify/tiered_queue.h
-  simplify/simplify.h util/chunked_loops.h util/error.h util/progress.h util/zeroed_array.h)
+  simplify/simplify.h util/chunked_loops.h util/error.h util/fresh_pages.h util/progress.h
+  util/zeroed_array.h)
 
 install(TARGETS ${PARAPM_ENGINE_LIBRARIES} parapm_openmesh EXPORT ParaPMTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})

@@ -10,8 +10,10 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "util/error.h"
+#include "util/fresh_pages.h"
 
 namespace parapm::io {
 namespace {
@@ -25,7 +27,7 @@ constexpr uint64_t kZlibSlice = uint64_t(1) << 30;
 
 }  // namespace
 
-std::string read_file_bytes(const std::string& path, uint64_t max_bytes) {
+std::string read_file_bytes(const std::string& path, uint64_t max_bytes, ChunkedLoops* loops) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     const int err = errno;
@@ -44,7 +46,10 @@ std::string read_file_bytes(const std::string& path, uint64_t max_bytes) {
     throw Error(ErrorCode::kResourceExhausted, path + ": the file has " + std::to_string(size) +
                                                    " bytes, more than the limit of " +
                                                    std::to_string(max_bytes));
-  std::string bytes(size, '\0');
+  std::string bytes;
+  bytes.reserve(size);
+  if (loops) touch_pages(bytes.data(), size, *loops);
+  bytes.resize(size);
   size_t got = size ? std::fread(bytes.data(), 1, size, file.get()) : 0;
   if (got != size) {
     if (std::ferror(file.get()))
@@ -189,10 +194,14 @@ std::optional<std::string> inflated_start(std::string_view compressed) {
 // libdeflate in one call, into a buffer of the size the trailer declares: about three times
 // as fast as zlib's stream. Empty when it does not apply: a declared size above the limit,
 // several members, data that does not inflate to exactly the declared size, corrupt data.
-std::optional<std::string> gunzip_whole(std::string_view compressed, uint64_t max_bytes) {
+std::optional<std::string> gunzip_whole(std::string_view compressed, uint64_t max_bytes,
+                                        ChunkedLoops* loops) {
   const uint64_t declared = declared_size(compressed);
   if (compressed.size() < 18 || declared > max_bytes) return std::nullopt;
-  std::string out(size_t(declared), '\0');
+  std::string out;
+  out.reserve(size_t(declared));
+  if (loops) touch_pages(out.data(), size_t(declared), *loops);
+  out.resize(size_t(declared));
   libdeflate_decompressor* decompressor = libdeflate_alloc_decompressor();
   if (!decompressor) return std::nullopt;
   size_t in_bytes = 0, out_bytes = 0;
@@ -206,14 +215,16 @@ std::optional<std::string> gunzip_whole(std::string_view compressed, uint64_t ma
 }
 
 std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes,
-                   const StartCheck& check_start) {
+                   const StartCheck& check_start, ChunkedLoops* loops) {
   if (max_bytes < kStartCheckBytes) return gunzip_stream(compressed, name, max_bytes, check_start);
   if (check_start) {
     const std::optional<std::string> start = inflated_start(compressed);
     if (!start) return gunzip_stream(compressed, name, max_bytes, check_start);
     check_start(*start);
   }
-  if (std::optional<std::string> whole = gunzip_whole(compressed, max_bytes)) return *whole;
+  // (moved out: the inflated bytes are the read's largest block)
+  if (std::optional<std::string> whole = gunzip_whole(compressed, max_bytes, loops))
+    return std::move(*whole);
   return gunzip_stream(compressed, name, max_bytes, {});
 }
 

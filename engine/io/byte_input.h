@@ -7,11 +7,17 @@
 #include <string>
 #include <string_view>
 
+namespace parapm {
+class ChunkedLoops;
+}
+
 namespace parapm::io {
 
 // Reads the whole file. kNotFound when it does not exist, kIo when it cannot be read (or is a
-// directory), kResourceExhausted when it is larger than max_bytes.
-std::string read_file_bytes(const std::string& path, uint64_t max_bytes);
+// directory), kResourceExhausted when it is larger than max_bytes. With `loops`, the pages of
+// the block it is read into are touched in its chunks first (fresh_pages.h).
+std::string read_file_bytes(const std::string& path, uint64_t max_bytes,
+                            ChunkedLoops* loops = nullptr);
 
 // True when the bytes start with the gzip magic (1f 8b).
 bool is_gzip(std::string_view bytes);
@@ -28,7 +34,8 @@ bool is_gzip(std::string_view bytes);
 // that is not a mesh costs only that much, however large it would inflate.
 using StartCheck = std::function<void(std::string_view start)>;
 constexpr uint64_t kStartCheckBytes = uint64_t(1) << 16;
+// With `loops`, the pages of the inflated block are touched in its chunks first (fresh_pages.h).
 std::string gunzip(std::string_view compressed, const std::string& name, uint64_t max_bytes,
-                   const StartCheck& check_start = {});
+                   const StartCheck& check_start = {}, ChunkedLoops* loops = nullptr);
 
 }  // namespace parapm::io

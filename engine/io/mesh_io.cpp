@@ -14,7 +14,7 @@ namespace parapm {
 
 Mesh read_mesh(const std::string& path, ReadReport* report, const ReadLimits& limits,
                ChunkedLoops* loops) {
-  const std::string bytes = io::read_file_bytes(path, limits.max_bytes);
+  const std::string bytes = io::read_file_bytes(path, limits.max_bytes, loops);
   return read_mesh_from_memory(bytes, path, report, limits, loops);
 }
 
@@ -33,9 +33,12 @@ Mesh read_mesh_from_memory(const std::string& bytes, const std::string& name, Re
   MeshFormat format = format_from_name(name);
   if (io::is_gzip(bytes)) {
     ctx.gzip = r.gzip = true;
-    inflated = io::gunzip(bytes, name, limits.max_bytes, [&](std::string_view start) {
-      if (!start.empty()) io::check_mesh_start(ctx, format, start);
-    });
+    inflated = io::gunzip(
+        bytes, name, limits.max_bytes,
+        [&](std::string_view start) {
+          if (!start.empty()) io::check_mesh_start(ctx, format, start);
+        },
+        loops);
     ctx.bytes = inflated;
   } else {
     if (bytes.size() > limits.max_bytes)

@@ -62,6 +62,7 @@ struct ReadReport {
   uint64_t corners_without_normal = 0;    // OBJ: corners without vn in a file that has vn
   uint64_t vertices_without_color = 0;    // OBJ: v without colour in a file that has some
   std::vector<std::string> ignored;       // e.g. "ply vertex property 'confidence'", "obj groups"
+  bool read_in_chunks = false;            // a PLY body read in chunks side by side (its `loops`)
 };
 
 MeshFormat format_from_name(const std::string& path);  // by extension, ".gz" ignored

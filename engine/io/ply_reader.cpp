@@ -30,6 +30,7 @@
 #include "io/ply_format.h"
 #include "io/text_scanner.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 
 namespace parapm::io {
 namespace {
@@ -168,6 +169,9 @@ class BinarySource {
         base_(ctx.bytes.data()),
         p_(base_ + header.body_offset),
         end_(base_ + ctx.bytes.size()) {}
+  // The bytes [begin, end) of ctx.bytes (a chunk of records; offsets in messages stay the file's).
+  BinarySource(const ReadContext& ctx, const char* begin, const char* end)
+      : ctx_(ctx), base_(ctx.bytes.data()), p_(begin), end_(end) {}
 
   void begin_record(const PlyElement& e, uint64_t index) {
     element_ = &e;
@@ -620,24 +624,86 @@ Mesh read_body(const ReadContext& ctx, const PlyHeader& header) {
   return PlyBody<Source>(ctx, header, src, vertex_count).read();
 }
 
+// The face element's index list where a body may be read in chunks side by side: `loops` of
+// more than one chunk, and a vertex element of scalars then a face element of one integer
+// index list; null otherwise. Checked without failing: what the one-pass reader refuses, it
+// refuses with its message.
+const PlyProperty* chunkable_index_list(const ReadContext& ctx, const PlyHeader& header) {
+  if (!ctx.loops || ctx.loops->chunks() < 2 || header.elements.size() != 2) return nullptr;
+  const PlyElement& vertices = header.elements[0];
+  const PlyElement& faces = header.elements[1];
+  if (vertices.name != "vertex" || faces.name != "face" || faces.properties.size() != 1)
+    return nullptr;
+  const PlyProperty& indices = faces.properties[0];
+  if (!indices.is_list || (indices.name != "vertex_indices" && indices.name != "vertex_index") ||
+      !ply_type_is_integer(indices.type) || !ply_type_is_integer(indices.count_type))
+    return nullptr;
+  for (const PlyProperty& p : vertices.properties)
+    if (p.is_list) return nullptr;
+  return &indices;
+}
+
+// What a chunk of a body read side by side holds: its records' mesh, and its report.
+struct ChunkPart {
+  Mesh mesh;
+  ReadReport report;
+};
+
+// The parts' arrays `member`, one after the other, into `out`, in `loops`' chunks (each copies
+// its range of `out` from the parts that hold it).
+template <class T>
+void join_arrays(std::vector<ChunkPart>& parts, std::vector<T> Mesh::*member, std::vector<T>& out,
+                 ChunkedLoops& loops) {
+  std::vector<size_t> at(parts.size() + 1, 0);  // where each part's elements begin in `out`
+  for (size_t c = 0; c < parts.size(); ++c) at[c + 1] = at[c] + (parts[c].mesh.*member).size();
+  resize_touched(out, at.back(), loops);
+  loops.run(at.back(), [&](size_t begin, size_t end) {
+    size_t c = size_t(std::upper_bound(at.begin(), at.end(), begin) - at.begin()) - 1;
+    for (size_t i = begin; i < end; ++c) {
+      const std::vector<T>& from = parts[c].mesh.*member;
+      const size_t stop = std::min(end, at[c + 1]);
+      std::copy(from.begin() + ptrdiff_t(i - at[c]), from.begin() + ptrdiff_t(stop - at[c]),
+                out.begin() + ptrdiff_t(i));
+      i = stop;
+    }
+  });
+}
+
+// The chunks' meshes one after the other into `mesh`, with their reports; false where the
+// faces pass the limit.
+bool join_parts(const ReadContext& ctx, std::vector<ChunkPart>& parts, Mesh& mesh) {
+  size_t triangles = 0;
+  for (const ChunkPart& part : parts) triangles += part.mesh.faces.size();
+  if (triangles > ctx.max_faces()) return false;
+  ChunkedLoops& loops = *ctx.loops;
+  mesh = Mesh{};
+  mesh.layout = parts[0].mesh.layout;
+  join_arrays(parts, &Mesh::positions, mesh.positions, loops);
+  join_arrays(parts, &Mesh::wedge_values, mesh.wedge_values, loops);
+  join_arrays(parts, &Mesh::faces, mesh.faces, loops);
+  ReadReport& report = *ctx.report;
+  for (ChunkPart& part : parts) part.mesh = Mesh{};
+  for (const ChunkPart& part : parts) {
+    report.polygons += part.report.polygons;
+    report.triangulated_polygons += part.report.triangulated_polygons;
+    for (const std::string& what : part.report.ignored) note_ignored(ctx, what);
+  }
+  report.read_in_chunks = true;
+  PlyBody<AsciiSource>::finish_per_vertex_attributes(mesh);
+  return true;
+}
+
 // An ascii body of a vertex element then a face element of one index list, one record per line
 // (as writers put them), read in chunks of lines side by side (ReadContext::loops): the same
 // mesh as the one-pass reader. False, with nothing read, where the file is otherwise or a
 // chunk finds anything amiss (a record off its line, a bad value, a limit): the one-pass
 // reader then reads it and names the first problem.
 bool read_ascii_in_chunks(const ReadContext& ctx, const PlyHeader& header, Mesh& mesh) {
-  if (!ctx.loops || ctx.loops->chunks() < 2 || header.elements.size() != 2) return false;
+  const PlyProperty* list = chunkable_index_list(ctx, header);
+  if (!list) return false;
+  const PlyProperty& indices = *list;
   const PlyElement& vertices = header.elements[0];
   const PlyElement& faces = header.elements[1];
-  // Checked without failing: what the one-pass reader refuses, it refuses with its message.
-  if (vertices.name != "vertex" || faces.name != "face" || faces.properties.size() != 1)
-    return false;
-  const PlyProperty& indices = faces.properties[0];
-  if (!indices.is_list || (indices.name != "vertex_indices" && indices.name != "vertex_index") ||
-      !ply_type_is_integer(indices.type))
-    return false;
-  for (const PlyProperty& p : vertices.properties)
-    if (p.is_list) return false;
   const char* body = ctx.bytes.data() + header.body_offset;
   const size_t size = ctx.bytes.size() - header.body_offset;
   ChunkedLoops& loops = *ctx.loops;
@@ -671,14 +737,10 @@ bool read_ascii_in_chunks(const ReadContext& ctx, const PlyHeader& header, Mesh&
   const uint64_t records = vertices.count + faces.count;
   if (first_line[chunks] < records) return false;
 
-  struct Part {
-    Mesh mesh;
-    ReadReport report;
-  };
-  std::vector<Part> parts(chunks);
+  std::vector<ChunkPart> parts(chunks);
   std::vector<uint8_t> ok(chunks, 0);
   loops.run_indexed(size, [&](size_t chunk, size_t, size_t) {
-    Part& part = parts[chunk];
+    ChunkPart& part = parts[chunk];
     ReadContext local = ctx;
     local.report = &part.report;
     try {
@@ -713,29 +775,71 @@ bool read_ascii_in_chunks(const ReadContext& ctx, const PlyHeader& header, Mesh&
     }
   });
   if (std::find(ok.begin(), ok.end(), 0) != ok.end()) return false;
-  size_t triangles = 0;
-  for (const Part& part : parts) triangles += part.mesh.faces.size();
-  if (triangles > ctx.max_faces()) return false;
+  return join_parts(ctx, parts, mesh);
+}
 
-  mesh = Mesh{};
-  mesh.layout = parts[0].mesh.layout;
-  mesh.positions.reserve(size_t(vertices.count));
-  mesh.wedge_values.reserve(size_t(vertices.count) * size_t(mesh.layout.floats_per_wedge()));
-  mesh.faces.reserve(triangles);
-  ReadReport& report = *ctx.report;
-  for (Part& part : parts) {
-    mesh.positions.insert(mesh.positions.end(), part.mesh.positions.begin(),
-                          part.mesh.positions.end());
-    mesh.wedge_values.insert(mesh.wedge_values.end(), part.mesh.wedge_values.begin(),
-                             part.mesh.wedge_values.end());
-    mesh.faces.insert(mesh.faces.end(), part.mesh.faces.begin(), part.mesh.faces.end());
-    report.polygons += part.report.polygons;
-    report.triangulated_polygons += part.report.triangulated_polygons;
-    for (const std::string& what : part.report.ignored) note_ignored(ctx, what);
-    part.mesh = Mesh{};
-  }
-  PlyBody<AsciiSource>::finish_per_vertex_attributes(mesh);
-  return true;
+// A binary body of a vertex element of scalars then a face element of one index list of three
+// indices in every record (as scanners and writers put them), its records at fixed strides,
+// read in chunks of records side by side (ReadContext::loops): the same mesh as the one-pass
+// reader. False, with nothing read, where the file is otherwise (a polygon, other properties
+// of the faces, bytes after the faces) or a chunk finds anything amiss: the one-pass reader then
+// reads it and names the first problem.
+template <class Source>
+bool read_binary_in_chunks(const ReadContext& ctx, const PlyHeader& header, Mesh& mesh) {
+  const PlyProperty* list = chunkable_index_list(ctx, header);
+  if (!list) return false;
+  const PlyProperty& indices = *list;
+  const PlyElement& vertices = header.elements[0];
+  const PlyElement& faces = header.elements[1];
+  const uint64_t vertex_bytes = vertices.fixed_record_bytes();
+  const uint64_t count_bytes = ply_type_size(indices.count_type);
+  const uint64_t face_bytes = count_bytes + 3 * uint64_t(ply_type_size(indices.type));
+  const char* body = ctx.bytes.data() + header.body_offset;
+  const uint64_t size = ctx.bytes.size() - header.body_offset;
+  // (check_declared_counts bounds both counts by the body's size: no overflow)
+  const uint64_t faces_at = vertices.count * vertex_bytes;
+  if (faces_at + faces.count * face_bytes != size) return false;
+
+  ChunkedLoops& loops = *ctx.loops;
+  const uint64_t records = vertices.count + faces.count;
+  auto record_at = [&](uint64_t record) {
+    return body + (record < vertices.count ? record * vertex_bytes
+                                           : faces_at + (record - vertices.count) * face_bytes);
+  };
+  const size_t chunks = loops.ranges(records);
+  std::vector<ChunkPart> parts(chunks);
+  std::vector<uint8_t> ok(chunks, 0);
+  loops.run_indexed(records, [&](size_t chunk, size_t begin, size_t end) {
+    ChunkPart& part = parts[chunk];
+    ReadContext local = ctx;
+    local.report = &part.report;
+    try {
+      Source src(local, record_at(begin), record_at(end));
+      PlyBody<Source> reader(local, header, src, vertices.count);
+      const uint64_t vertex_end = std::min<uint64_t>(end, vertices.count);
+      if (begin < vertex_end) {
+        const VertexPlan plan = reader.start_vertices(vertices, vertex_end - begin);
+        for (uint64_t i = begin; i < vertex_end; ++i) reader.read_vertex(vertices, plan, i);
+      } else {
+        reader.mesh().layout = plan_vertices(local, vertices).layout;
+      }
+      for (uint64_t record = std::max<uint64_t>(begin, vertices.count); record < end; ++record) {
+        const uint64_t face = record - vertices.count;
+        Source count(local, record_at(record), record_at(record) + count_bytes);
+        count.begin_record(faces, face);
+        if (count.integer(indices.count_type) != 3) return;  // a polygon: strides do not hold
+        src.begin_record(faces, face);
+        reader.read_face(faces, indices, face);
+      }
+      if (src.remaining() > 0) return;
+      part.mesh = std::move(reader.mesh());
+      ok[chunk] = 1;
+    } catch (const Error&) {
+      // The one-pass reader names it.
+    }
+  });
+  if (std::find(ok.begin(), ok.end(), 0) != ok.end()) return false;
+  return join_parts(ctx, parts, mesh);
 }
 
 }  // namespace
@@ -753,12 +857,18 @@ Mesh read_ply(const ReadContext& ctx) {
       if (read_ascii_in_chunks(ctx, header, mesh)) return mesh;
       return read_body<AsciiSource>(ctx, header);
     }
-    case PlyEncoding::kBinaryLittleEndian:
+    case PlyEncoding::kBinaryLittleEndian: {
       report.encoding = "binary_little_endian";
+      Mesh mesh;
+      if (read_binary_in_chunks<BinarySource<!kLittleHost>>(ctx, header, mesh)) return mesh;
       return read_body<BinarySource<!kLittleHost>>(ctx, header);
-    case PlyEncoding::kBinaryBigEndian:
+    }
+    case PlyEncoding::kBinaryBigEndian: {
       report.encoding = "binary_big_endian";
+      Mesh mesh;
+      if (read_binary_in_chunks<BinarySource<kLittleHost>>(ctx, header, mesh)) return mesh;
       return read_body<BinarySource<kLittleHost>>(ctx, header);
+    }
   }
   fail(ctx, "unknown PLY encoding");
 }

@@ -53,6 +53,7 @@
 #include "mesh/outgoing_halfedges.h"
 #include "mesh/spatial_order.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 
 namespace parapm {
 namespace {
@@ -224,7 +225,7 @@ FaceFilter filter_faces(const std::vector<Triangle>& faces, size_t vertices, Chu
   // Rotate each face so that its lowest vertex comes first: two faces are duplicates exactly
   // when their rotated triples are equal. Degenerate faces get kNoId, which keeps them out of
   // the buckets.
-  std::vector<Triangle> rotated(faces.size());
+  std::vector<Triangle> rotated = filled_touched(faces.size(), Triangle{}, loops);
   loops.run(faces.size(), [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       const Triangle& t = faces[f];
@@ -240,7 +241,7 @@ FaceFilter filter_faces(const std::vector<Triangle>& faces, size_t vertices, Chu
   // Per range of vertices, its faces bucketed by their lowest vertex, holding (second vertex,
   // third vertex, face). Inside a bucket equal triples become adjacent once sorted; the lowest
   // face id of each run is kept.
-  std::vector<uint8_t> removed(faces.size(), 0);
+  std::vector<uint8_t> removed = filled_touched<uint8_t>(faces.size(), 0, loops);
   std::vector<uint64_t> duplicates(loops.ranges(vertices), 0);
   const auto faces_of_range =
       items_of_ranges(loops, faces.size(), vertices, [&](size_t f) { return rotated[f][0]; });
@@ -293,7 +294,8 @@ void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOpt
              RepairedMesh* out, ChunkedLoops& loops) {
   const size_t n = input.vertex_count();
   // Marked from the kept faces' corners, chunks side by side (relaxed stores of the same 1).
-  std::vector<uint8_t> referenced(n, options.keep_unreferenced ? 1 : 0);
+  std::vector<uint8_t> referenced =
+      filled_touched<uint8_t>(n, options.keep_unreferenced ? 1 : 0, loops);
   if (!options.keep_unreferenced)
     loops.run(kept.size(), [&](size_t begin, size_t end) {
       for (size_t j = begin; j < end; ++j)
@@ -303,12 +305,12 @@ void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOpt
   KeptItems vertices = number_kept(loops, n, [&](size_t v) { return referenced[v] != 0; });
   out->report.unreferenced_vertices_removed = n - vertices.old_id.size();
   Mesh& mesh = out->mesh;
-  mesh.positions.resize(vertices.old_id.size());
+  resize_touched(mesh.positions, vertices.old_id.size(), loops);
   loops.run(vertices.old_id.size(), [&](size_t begin, size_t end) {
     for (size_t v = begin; v < end; ++v) mesh.positions[v] = input.positions[vertices.old_id[v]];
   });
   const std::vector<VertexId>& new_vertex = vertices.new_id;
-  mesh.faces.resize(kept.size());
+  resize_touched(mesh.faces, kept.size(), loops);
   loops.run(kept.size(), [&](size_t begin, size_t end) {
     for (size_t j = begin; j < end; ++j) {
       const Triangle& t = input.faces[kept[j]];
@@ -327,8 +329,8 @@ void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOpt
     return new_vertex[input.wedge_vertex[w]] != kNoId;
   });
   const size_t floats = size_t(input.layout.floats_per_wedge());
-  mesh.wedge_vertex.resize(wedges.old_id.size());
-  mesh.wedge_values.resize(wedges.old_id.size() * floats);
+  resize_touched(mesh.wedge_vertex, wedges.old_id.size(), loops);
+  resize_touched(mesh.wedge_values, wedges.old_id.size() * floats, loops);
   loops.run(wedges.old_id.size(), [&](size_t begin, size_t end) {
     for (size_t w = begin; w < end; ++w) {
       const WedgeId old = wedges.old_id[w];
@@ -338,7 +340,7 @@ void compact(const Mesh& input, const std::vector<FaceId>& kept, const RepairOpt
     }
   });
   const std::vector<WedgeId>& new_wedge = wedges.new_id;
-  mesh.face_wedges.resize(kept.size());
+  resize_touched(mesh.face_wedges, kept.size(), loops);
   loops.run(kept.size(), [&](size_t begin, size_t end) {
     for (size_t j = begin; j < end; ++j) {
       const auto& fw = input.face_wedges[kept[j]];
@@ -478,7 +480,7 @@ std::vector<uint32_t> pair_edges(const std::vector<Triangle>& faces, size_t vert
                                  uint64_t* nonmanifold_edges, bool* sides_paired,
                                  ChunkedLoops& loops) {
   const size_t halfedges = 3 * faces.size();
-  std::vector<uint32_t> twin(halfedges, kNoId);
+  std::vector<uint32_t> twin = filled_touched<uint32_t>(halfedges, kNoId, loops);
   // Each range of vertices groups the halfedges of its undirected edges: bucketed by the lower
   // end, holding (higher end << 32 | halfedge), each bucket sorted (ties by halfedge id). An
   // edge is its lower end's range's alone, so the ranges pair apart; their cut edges are
@@ -550,7 +552,7 @@ void split_fans(const std::vector<uint32_t>& twin, RepairedMesh* out, ChunkedLoo
   // fan with the lowest face first. Crossing a corner's outgoing halfedge leads to the next
   // corner clockwise around the vertex; crossing its incoming halfedge, counter-clockwise. A
   // fan's corners are its vertex's, so the ranges label apart.
-  std::vector<uint32_t> fan_of(corners, kNoId);
+  std::vector<uint32_t> fan_of = filled_touched<uint32_t>(corners, kNoId, loops);
   std::vector<std::vector<std::pair<VertexId, uint32_t>>> extra_in(loops.ranges(n));
   auto vertex_of = [&](size_t c) { return faces[c / 3][c % 3]; };
   const auto corners_of_range = items_of_ranges(loops, corners, n, vertex_of);

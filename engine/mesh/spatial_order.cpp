@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "mesh/repair.h"
+#include "util/fresh_pages.h"
 
 namespace parapm {
 namespace {
@@ -34,7 +35,7 @@ uint64_t quantise(double x, double lo, double hi) {
 // Applies new_index[old] to a per-element array, in chunks (each writes its own places).
 template <typename T>
 void permute(std::vector<T>& values, const std::vector<uint32_t>& new_index, ChunkedLoops& loops) {
-  std::vector<T> out(values.size());
+  std::vector<T> out = filled_touched(values.size(), T(), loops);
   loops.run(values.size(), [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) out[new_index[i]] = std::move(values[i]);
   });
@@ -51,7 +52,7 @@ std::vector<uint32_t> stable_order_by(const std::vector<uint32_t>& keys, size_t 
   std::vector<size_t> offset(loops.ranges(key_count) + 1, 0);
   for (size_t r = 0; r + 1 < offset.size(); ++r)
     offset[r + 1] = offset[r] + RangeItems(items, r, keys.size()).size();
-  std::vector<uint32_t> order(keys.size());
+  std::vector<uint32_t> order = filled_touched<uint32_t>(keys.size(), 0, loops);
   loops.run_indexed(key_count, [&](size_t range, size_t first, size_t last) {
     const RangeItems mine(items, range, keys.size());
     std::vector<size_t> start(last - first + 1, 0);
@@ -65,7 +66,7 @@ std::vector<uint32_t> stable_order_by(const std::vector<uint32_t>& keys, size_t 
 
 // new_index[old] from the elements listed in their new order.
 std::vector<uint32_t> ranks(const std::vector<uint32_t>& order, ChunkedLoops& loops) {
-  std::vector<uint32_t> rank(order.size());
+  std::vector<uint32_t> rank = filled_touched<uint32_t>(order.size(), 0, loops);
   loops.run(order.size(), [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) rank[order[i]] = uint32_t(i);
   });
@@ -114,7 +115,7 @@ void sort_keyed(std::vector<Keyed>& keyed, ChunkedLoops& loops) {
   for (size_t r = 0; r + 1 < ranges; ++r) splitters[r] = sample[(r + 1) * kSamplesPerRange];
   // Range r of a chunked loop over [0, n) begins at n * r / ranges: the key placing an item
   // in range r's list.
-  std::vector<uint32_t> range_key(n);
+  std::vector<uint32_t> range_key = filled_touched<uint32_t>(n, 0, loops);
   loops.run(n, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       const size_t r = size_t(std::upper_bound(splitters.begin(), splitters.end(), keyed[i]) -
@@ -125,7 +126,7 @@ void sort_keyed(std::vector<Keyed>& keyed, ChunkedLoops& loops) {
   const auto items = items_of_ranges(loops, n, n, [&](size_t i) { return range_key[i]; });
   std::vector<size_t> offset(ranges + 1, 0);
   for (size_t r = 0; r < ranges; ++r) offset[r + 1] = offset[r] + items[r].size();
-  std::vector<Keyed> sorted(n);
+  std::vector<Keyed> sorted = filled_touched(n, Keyed(), loops);
   loops.run_indexed(n, [&](size_t range, size_t, size_t) {
     const auto out = sorted.begin() + ptrdiff_t(offset[range]);
     for (size_t j = 0; j < items[range].size(); ++j) out[ptrdiff_t(j)] = keyed[items[range][j]];
@@ -144,13 +145,13 @@ uint64_t morton_code(const Vec3& p, const Box& box) {
 
 std::vector<VertexId> spatial_vertex_order(const Mesh& mesh, ChunkedLoops& loops) {
   const Box box = bounding_box_in_chunks(mesh.positions, loops);
-  std::vector<Keyed> keyed(mesh.vertex_count());
+  std::vector<Keyed> keyed = filled_touched(mesh.vertex_count(), Keyed(), loops);
   loops.run(keyed.size(), [&](size_t begin, size_t end) {
     for (size_t v = begin; v < end; ++v)
       keyed[v] = {morton_code(mesh.positions[v], box), VertexId(v)};
   });
   sort_keyed(keyed, loops);  // (code, id): ties by id
-  std::vector<VertexId> order(keyed.size());
+  std::vector<VertexId> order = filled_touched<VertexId>(keyed.size(), 0, loops);
   loops.run(keyed.size(), [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) order[i] = keyed[i].second;
   });
@@ -180,7 +181,7 @@ void order_spatially(RepairedMesh& repaired, ChunkedLoops& loops) {
   // Faces by their first vertex in the new order (the one whose star they are read with
   // first), ties in their previous order. Corners keep their rotation: orientation and the
   // input's corner order (input_face) stay as they were.
-  std::vector<uint32_t> first(mesh.face_count());
+  std::vector<uint32_t> first = filled_touched<uint32_t>(mesh.face_count(), 0, loops);
   loops.run(mesh.face_count(), [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       const Triangle& t = mesh.faces[f];
@@ -204,7 +205,7 @@ void order_spatially(RepairedMesh& repaired, ChunkedLoops& loops) {
   permute(mesh.wedge_vertex, new_wedge, loops);
   permute(repaired.input_wedge, new_wedge, loops);
   const size_t floats = size_t(mesh.layout.floats_per_wedge());
-  std::vector<float> values(mesh.wedge_values.size());
+  std::vector<float> values = filled_touched<float>(mesh.wedge_values.size(), 0, loops);
   loops.run(mesh.wedge_count(), [&](size_t begin, size_t end) {
     for (size_t w = begin; w < end; ++w)
       std::copy_n(mesh.wedge_values.begin() + ptrdiff_t(w * floats), floats,

@@ -8,6 +8,7 @@
 
 #include "partition/partition_internal.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 #include "util/zeroed_array.h"
 
 namespace parapm {
@@ -96,26 +97,28 @@ VertexGraph build_vertex_graph(const Mesh& mesh, ChunkedLoops& loops, bool with_
     for (size_t j = 0; j < mine.size(); ++j)
       out.face_ids[fill[vertex_of(mine[j]) - first]++] = mine[j] / 3;
   });
+  // The ranges' lists joined in order, each range copying its own (the same ranges as above).
+  std::vector<size_t> neighbours_before(lists.size() + 1, 0), faces_before(lists.size() + 1, 0);
+  for (size_t range = 0; range < lists.size(); ++range) {
+    neighbours_before[range + 1] = neighbours_before[range] + lists[range].neighbours.size();
+    faces_before[range + 1] = faces_before[range] + lists[range].face_ids.size();
+  }
   VertexGraph graph;
-  graph.offsets.assign(n + 1, 0);
-  if (with_faces) graph.face_offsets.assign(n + 1, 0);
-  size_t neighbours = 0, faces = 0;
-  for (const Lists& out : lists) {
-    neighbours += out.neighbours.size();
-    faces += out.face_ids.size();
-  }
-  graph.neighbours.reserve(neighbours);
-  graph.face_ids.reserve(faces);
-  for (size_t range = 0, v = 0; range < lists.size(); ++range) {
+  resize_touched(graph.offsets, n + 1, loops);
+  if (with_faces) resize_touched(graph.face_offsets, n + 1, loops);
+  resize_touched(graph.neighbours, neighbours_before.back(), loops);
+  resize_touched(graph.face_ids, faces_before.back(), loops);
+  loops.run_indexed(n, [&](size_t range, size_t first, size_t) {
     const Lists& out = lists[range];
-    const size_t before = graph.neighbours.size(), faces_before = graph.face_ids.size();
-    for (size_t i = 0; i + 1 < out.offsets.size(); ++i, ++v) {
-      graph.offsets[v] = before + out.offsets[i];
-      if (with_faces) graph.face_offsets[v] = faces_before + out.face_offsets[i];
+    for (size_t i = 0; i + 1 < out.offsets.size(); ++i) {
+      graph.offsets[first + i] = neighbours_before[range] + out.offsets[i];
+      if (with_faces) graph.face_offsets[first + i] = faces_before[range] + out.face_offsets[i];
     }
-    graph.neighbours.insert(graph.neighbours.end(), out.neighbours.begin(), out.neighbours.end());
-    graph.face_ids.insert(graph.face_ids.end(), out.face_ids.begin(), out.face_ids.end());
-  }
+    std::copy(out.neighbours.begin(), out.neighbours.end(),
+              graph.neighbours.begin() + ptrdiff_t(neighbours_before[range]));
+    std::copy(out.face_ids.begin(), out.face_ids.end(),
+              graph.face_ids.begin() + ptrdiff_t(faces_before[range]));
+  });
   graph.offsets[n] = graph.neighbours.size();
   if (with_faces) {
     graph.face_offsets[n] = graph.face_ids.size();

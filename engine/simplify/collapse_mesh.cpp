@@ -4,6 +4,7 @@
 #include <atomic>
 
 #include "util/error.h"
+#include "util/fresh_pages.h"
 
 namespace parapm {
 
@@ -15,18 +16,20 @@ CollapseMesh::CollapseMesh(const Mesh& mesh) {
 CollapseMesh::CollapseMesh(const Mesh& mesh, ChunkedLoops& loops) { build(mesh, loops); }
 
 void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
-  positions_ = mesh.positions;
-  faces_ = mesh.faces;
-  corner_wedges_ = mesh.face_wedges;
-  face_alive_.assign(mesh.faces.size(), 1);
-  vertex_alive_.assign(mesh.positions.size(), 0);
-  faces_of_.resize(mesh.positions.size());
-  boundary_.assign(mesh.positions.size(), 0);
-  imbalance_.assign(mesh.positions.size(), 0);
-  star_version_.assign(mesh.positions.size(), 0);
+  // (each large array's pages touched in chunks first: fresh_pages.h)
+  const size_t vertices = mesh.positions.size();
+  copy_touched(positions_, mesh.positions, loops);
+  copy_touched(faces_, mesh.faces, loops);
+  copy_touched(corner_wedges_, mesh.face_wedges, loops);
+  assign_touched<uint8_t>(face_alive_, mesh.faces.size(), 1, loops);
+  assign_touched<uint8_t>(vertex_alive_, vertices, 0, loops);
+  faces_of_.resize(vertices);
+  assign_touched<uint8_t>(boundary_, vertices, 0, loops);
+  assign_touched<uint64_t>(imbalance_, vertices, 0, loops);
+  assign_touched<uint32_t>(star_version_, vertices, 0, loops);
   identity_ = Identity();
   live_faces_ = mesh.faces.size();
-  mark_.assign(mesh.positions.size(), 0);
+  assign_touched<uint32_t>(mark_, vertices, 0, loops);
   // Each range of vertices lists its own corners' faces, in face order whatever the chunking.
   auto vertex_of = [&](size_t corner) { return faces_[corner / 3][corner % 3]; };
   const auto corners_of_range =
@@ -79,7 +82,7 @@ std::vector<FaceId> CollapseMesh::twin_faces() const {
 }
 
 std::vector<FaceId> CollapseMesh::twin_faces(ChunkedLoops& loops) const {
-  std::vector<FaceId> twin(3 * faces_.size(), kNoId);
+  std::vector<FaceId> twin = filled_touched<FaceId>(3 * faces_.size(), kNoId, loops);
   // A vertex a writes the slots of a's corners only: ranges of vertices write apart.
   loops.run(vertex_capacity(), [&](size_t begin, size_t end) {
     std::vector<std::pair<VertexId, FaceId>> fan;  // (the vertex before a, the face) around a

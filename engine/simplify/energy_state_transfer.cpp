@@ -8,6 +8,7 @@
 
 #include "simplify/energy_priority.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 
 namespace parapm {
 
@@ -73,9 +74,9 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
   }
   first_point[faces.size()] = points;
   for (const VertexId v : vertices) points += parked_point_[v] != kNoPoint ? 1 : 0;
-  out.points.resize(points);
-  if (values) out.point_values.resize(points * size_t(floats));
-  out.faces.resize(faces.size());
+  resize_touched(out.points, points, loops);
+  if (values) resize_touched(out.point_values, points * size_t(floats), loops);
+  resize_touched(out.faces, faces.size(), loops);
   // (Each id translated near its own position in the list: exact when the list is the map
   // itself, a job's export_local.)
   loops.run(faces.size(), [&](size_t begin, size_t end) {
@@ -152,8 +153,8 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   }
   const std::vector<EnergyState::Point>& points = state.points;
   const size_t n = points.size();
-  positions_.resize(n);
-  point_id_.resize(n);
+  resize_touched(positions_, n, loops);
+  resize_touched(point_id_, n, loops);
   reset_point_lists(mesh);
   // Each face's points come as one run (the state lists them grouped by face), which fills
   // its list in the written order; the runs side by side in `loops`' chunks, each chunk taking

@@ -10,6 +10,7 @@
 #include "simplify/back_to_back.h"
 #include "simplify/vec_math.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 
 namespace parapm {
 namespace {
@@ -72,7 +73,7 @@ void QuadricPriority::face_planes(const CollapseMesh& mesh, const std::vector<Fa
 }
 
 void QuadricPriority::initialize_in_chunks(const CollapseMesh& mesh, ChunkedLoops& loops) {
-  quadrics_.assign(mesh.vertex_capacity(), Quadric{});
+  assign_touched(quadrics_, mesh.vertex_capacity(), Quadric{}, loops);
   const std::vector<FaceId> twin = mesh.twin_faces(loops);
   if (loops.chunks() > 1 && sum_by_vertex(mesh, twin, loops)) return;
   quadrics_.assign(mesh.vertex_capacity(), Quadric{});

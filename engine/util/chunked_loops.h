@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "util/fresh_pages.h"
+
 namespace parapm {
 
 class ChunkedLoops {
@@ -84,7 +86,7 @@ std::vector<std::vector<uint32_t>> items_of_ranges(ChunkedLoops& loops, size_t n
   for (size_t r = 0; r < ranges; ++r) {
     uint32_t at = 0;
     for (std::vector<uint32_t>& chunk : slots) at += std::exchange(chunk[r], at);
-    items[r].resize(at);
+    resize_touched(items[r], at, loops);
   }
   loops.run_indexed(n, [&](size_t chunk, size_t begin, size_t end) {
     std::vector<uint32_t>& next = slots[chunk];
@@ -108,7 +110,7 @@ struct KeptItems {
 template <class Keep>
 KeptItems number_kept(ChunkedLoops& loops, size_t n, Keep keep) {
   KeptItems out;
-  out.new_id.assign(n, kNoKey);
+  resize_touched(out.new_id, n, loops, kNoKey);
   std::vector<size_t> first(loops.ranges(n) + 1, 0);  // per range, its first new number
   loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
     size_t count = 0;
@@ -116,7 +118,7 @@ KeptItems number_kept(ChunkedLoops& loops, size_t n, Keep keep) {
     first[range + 1] = count;
   });
   for (size_t r = 0; r + 1 < first.size(); ++r) first[r + 1] += first[r];
-  out.old_id.resize(first.back());
+  resize_touched(out.old_id, first.back(), loops);
   loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
     uint32_t next = uint32_t(first[range]);
     for (size_t i = begin; i < end; ++i)
