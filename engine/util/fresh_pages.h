@@ -1,8 +1,8 @@
 // Large blocks are mapped fresh (map_large_blocks_alone, util/memory.h): the first write to each
-// page of a new block faults it in, the system clearing the page, which costs about three times
-// the write itself. A block filled on one thread pays every fault there. These helpers touch a
-// new block's pages in a ChunkedLoops' chunks first, so that the faults run side by side and only
-// the fill stays on the calling thread.
+// page of a new block faults it in, the system clearing the page, which on the machines measured
+// costs about three times the write itself. A block filled on one thread pays every fault there.
+// These helpers touch a new block's pages in a ChunkedLoops' chunks first, so that the faults
+// run side by side and only the fill stays on the calling thread.
 #pragma once
 
 #include <cstddef>
