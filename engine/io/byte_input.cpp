@@ -12,6 +12,7 @@
 #include <optional>
 #include <utility>
 
+#include "util/chunked_loops.h"
 #include "util/error.h"
 #include "util/fresh_pages.h"
 
@@ -47,9 +48,8 @@ std::string read_file_bytes(const std::string& path, uint64_t max_bytes, Chunked
                                                    " bytes, more than the limit of " +
                                                    std::to_string(max_bytes));
   std::string bytes;
-  bytes.reserve(size);
-  if (loops) touch_pages(bytes.data(), size, *loops);
-  bytes.resize(size);
+  ChunkedLoops one_thread;
+  resize_touched(bytes, size, loops ? *loops : one_thread);
   size_t got = size ? std::fread(bytes.data(), 1, size, file.get()) : 0;
   if (got != size) {
     if (std::ferror(file.get()))
@@ -199,9 +199,8 @@ std::optional<std::string> gunzip_whole(std::string_view compressed, uint64_t ma
   const uint64_t declared = declared_size(compressed);
   if (compressed.size() < 18 || declared > max_bytes) return std::nullopt;
   std::string out;
-  out.reserve(size_t(declared));
-  if (loops) touch_pages(out.data(), size_t(declared), *loops);
-  out.resize(size_t(declared));
+  ChunkedLoops one_thread;
+  resize_touched(out, size_t(declared), loops ? *loops : one_thread);
   libdeflate_decompressor* decompressor = libdeflate_alloc_decompressor();
   if (!decompressor) return std::nullopt;
   size_t in_bytes = 0, out_bytes = 0;

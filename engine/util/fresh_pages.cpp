@@ -28,4 +28,12 @@ void touch_pages(void* data, size_t bytes, ChunkedLoops& loops) {
   });
 }
 
+void resize_touched(std::string& s, size_t n, ChunkedLoops& loops) {
+  if (n > s.capacity()) {
+    s.reserve(n);
+    touch_pages(s.data() + s.size(), n - s.size(), loops);
+  }
+  s.resize(n);
+}
+
 }  // namespace parapm

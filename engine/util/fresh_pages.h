@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace parapm {
@@ -26,6 +27,9 @@ void resize_touched(std::vector<T>& v, size_t n, ChunkedLoops& loops, const T& v
   }
   v.resize(n, value);
 }
+
+// The same for a string's bytes (its new ones '\0').
+void resize_touched(std::string& s, size_t n, ChunkedLoops& loops);
 
 // v.assign(n, value), a new block's pages touched in `loops`' chunks first.
 template <class T>

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include "util/chunked_loops.h"
@@ -73,6 +74,10 @@ TEST(FreshPages, TheHelpersGiveTheVectorsOfResizeAssignAndCopy) {
     EXPECT_EQ(filled, std::vector<Triple>(n, Triple{1, 2, 3}));
     assign_touched(filled, n / 2, Triple{4, 5, 6}, loops);
     EXPECT_EQ(filled, std::vector<Triple>(n / 2, Triple{4, 5, 6}));
+
+    std::string text = "kept";
+    resize_touched(text, n + 4, loops);
+    EXPECT_EQ(text, "kept" + std::string(n, '\0'));
 
     std::vector<double> source(n);
     std::iota(source.begin(), source.end(), 0.5);
