@@ -44,7 +44,8 @@ nlohmann::json json_of(const CliResult& result) {
 
 class ServiceCli : public ServiceTest {
  protected:
-  // `parapm up` with `workers` workers, listening on `server`, its data in the test's folder.
+  // `parapm up` with `workers` workers, listening on `server`, its data in the test's folder,
+  // its viewer on any free port (the default one is the machine's, and tests run side by side).
   std::vector<std::string> up_command(int workers, const std::string& server) {
     return {(fs::path(PARAPM_BINARY_DIR) / "parapm").string(),
             "up",
@@ -53,7 +54,9 @@ class ServiceCli : public ServiceTest {
             "--data",
             (dir() / "up-data").string(),
             "--listen",
-            server};
+            server,
+            "--http",
+            "127.0.0.1:0"};
   }
 };
 
