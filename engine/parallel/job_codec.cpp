@@ -33,7 +33,7 @@
 namespace parapm {
 namespace {
 
-constexpr uint8_t kVersion = 9;
+constexpr uint8_t kVersion = 10;
 constexpr char kJobMagic[4] = {'P', 'P', 'J', 'B'};
 constexpr char kRecordsMagic[4] = {'P', 'P', 'C', 'R'};
 constexpr char kSummaryMagic[4] = {'P', 'P', 'S', 'S'};
@@ -550,6 +550,7 @@ void write_options(ByteWriter& out, const SubsetOptions& o) {
   out.varint(o.target_faces);
   out.f64(o.max_cost);
   out.u8(o.defer_recosting ? 1 : 0);
+  out.u8(o.free_placement ? 1 : 0);
 }
 
 void read_options(ByteReader& in, SubsetOptions& o) {
@@ -575,6 +576,9 @@ void read_options(ByteReader& in, SubsetOptions& o) {
   const uint8_t defer = in.u8();
   if (defer > 1) in.fail("the deferred re-costing flag must be 0 or 1");
   o.defer_recosting = defer == 1;
+  const uint8_t free_placement = in.u8();
+  if (free_placement > 1) in.fail("the free placement flag must be 0 or 1");
+  o.free_placement = free_placement == 1;
 }
 
 // Whether the job's energy module will run E_scalar, so that its state must carry the

@@ -9,14 +9,14 @@
 // one before it in its list, the first from 0). Every message starts with a 4-byte magic naming its
 // kind and a version byte, so that one kind is never decoded as another.
 //
-//   (The version byte is 9 for every kind; DECISIONS.md, "The job codec's versions", says
+//   (The version byte is 10 for every kind; DECISIONS.md, "The job codec's versions", says
 //   what each one added.)
 //   job     "PPJB" 4 | round v, subset v | V v, F v, W v (counts first: checked before
 //           anything is allocated) | options: metric u8 (0 none, 1 quadric, 2 energy),
 //           samples_per_face f64, crease_angle f64, attribute_weight f64, star_planes_weight
 //           f64, volume_weight f64, spring_scale f64, min_crease_edges v, crease_min_length
 //           f64, seed u64, reference_diagonal f64, target_faces v, max_cost f64,
-//           defer_recosting u8 (0/1) | mesh flags u8 (1
+//           defer_recosting u8 (0/1), free_placement u8 (0/1) | mesh flags u8 (1
 //           positions_are_float, 2 normals, 4 texcoords, 8 colours, 16 corner wedges, 32
 //           positions stored as f32: set when every coordinate is exactly a float) | per
 //           vertex: position (3 f32 or 3 f64), owned | locked << 1 | grouped << 2 u8, then

@@ -388,6 +388,7 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
   if (!options.free_copies) copy_groups_ = copy_groups(repaired, on_membrane_);
   locked_ = locked_vertices(copy_groups_, mesh_.vertex_count());
   defer_line_ = defer_recosting_line(input_faces_);
+  free_line_ = options_.free_placement_above_faces.value_or(free_placement_line(input_faces_));
   // After two scheduled rounds (a ratio of 0.32 at the default handover), an extra round at
   // the scheduled ratio would need 3.2 x the floor per subset to start, and mid-sized meshes
   // at p = 2 would get none (a longer sequential final pass).
@@ -753,6 +754,9 @@ void ParallelBuilder::extract_jobs(Round& r) {
   // that ends at the line or above (by default the last scheduled round ends at it).
   for (SubsetJob& job : jobs)
     job.options.defer_recosting = options_.defer_recosting && rs.goal_faces >= defer_line_;
+  // The quadric's placement as the master's at the round's start, where it costed the round's
+  // sample: free while the sequential build's would be.
+  for (SubsetJob& job : jobs) job.options.free_placement = rs.faces_before > free_line_;
   if (parallel_.water_level_factor > 0)
     for (SubsetJob& job : jobs)
       job.options.max_cost = job.options.max_cost > 0

@@ -126,6 +126,7 @@ class ParallelBuilder {
   uint32_t rounds_ = 0;  // scheduled
   uint64_t input_faces_ = 0, target_ = 0, handover_ = 0;
   uint64_t defer_line_ = 0;  // above it, edges are costed when they reach the top
+  uint64_t free_line_ = 0;   // above it, the quadric places freely (free_placement_line)
   std::vector<uint8_t> locked_;
   std::vector<uint8_t> on_membrane_;  // membrane_vertices: free to vanish in the final pass
   CopyGroups

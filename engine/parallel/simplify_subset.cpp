@@ -50,6 +50,7 @@ std::vector<EdgeKey> current_keys_in_global_ids(const KeyMemo& memo, const Colla
 SimplifyOptions simplify_options_of(const SubsetOptions& subset) {
   SimplifyOptions options;
   copy_metric_options(subset, options);
+  options.free_placement_above_faces = subset.free_placement ? 0 : UINT64_MAX;
   check_simplify_options(options);
   return options;
 }

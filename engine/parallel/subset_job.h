@@ -53,6 +53,10 @@ struct SubsetOptions {
   // Edges around a collapse costed when they come to the top of the queue, not at once
   // (SimplifierLimits::defer_above_faces): set for rounds above the sequential build's line.
   bool defer_recosting = false;
+  // The quadric placed at its free optimum throughout (QuadricOptions::
+  // free_placement_above_faces 0), not constrained: set for rounds that start above the
+  // sequential build's line (free_placement_line), as the master places then.
+  bool free_placement = false;
 };
 
 // The options a job's metric is made from, named alike in SimplifyOptions and SubsetOptions:

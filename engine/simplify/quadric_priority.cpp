@@ -178,7 +178,8 @@ bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, Col
   Vec3 kept;
   if (locked_a || locked_b) {
     out.position = mesh.position(out.vs);
-  } else if (!options_.keep_volume && !options_.keep_border) {
+  } else if ((!options_.keep_volume && !options_.keep_border) ||
+             mesh.live_faces() > options_.free_placement_above_faces) {
     out.position = place(q, pa, pb);
   } else if (costing != Costing::kPerform && q.minimizer(kept)) {
     out.position = kept;  // no placement costs less: a lower bound of the constrained cost

@@ -37,6 +37,13 @@ struct QuadricOptions {
   // stays the accumulated quadric's, so that a queue key, its free optimum's cost, stays a
   // close lower bound (docs/DECISIONS.md, "The quadric places with its star's planes").
   double star_planes_weight = 0.3;
+  // While the mesh has more live faces than this, a collapse goes where the accumulated quadric
+  // alone places it (its free optimum, or the best of the ends and the midpoint), costed there:
+  // no star sums, and a queue key that is the collapse's cost. At the coarse levels below it,
+  // where a placement's drift from the star's volume and border shows, the constrained
+  // placement above. Half the build's time on one thread (docs/DECISIONS.md, "The quadric
+  // places freely at fine levels"). SIZE_MAX: never free; 0: always.
+  size_t free_placement_above_faces = SIZE_MAX;
 };
 
 class QuadricPriority : public PriorityModule {

@@ -648,6 +648,11 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
   std::vector<CollapseRecord> records;
   records.reserve(mesh_.live_vertices());
   size_t next_report = 1024;  // records made when progress is next reported
+  // The ceiling as a key: keys are floats, and a collapse costing the ceiling exactly may key a
+  // rounding above it in double.
+  const float key_ceiling = limits.max_cost < double(std::numeric_limits<float>::max())
+                                ? static_cast<float>(limits.max_cost)
+                                : std::numeric_limits<float>::infinity();
   stats_.stop_reason = "no legal collapse left";
 
   while (!queue_.empty()) {
@@ -670,8 +675,8 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.stale;
       continue;
     }
-    if (entry.cost > limits.max_cost) {  // and so does every entry after it
-      queue_.push(entry);                // (deferred_edges() lists what the queue holds)
+    if (entry.cost > key_ceiling) {  // and so does every entry after it
+      queue_.push(entry);            // (deferred_edges() lists what the queue holds)
       stats_.stop_reason = "cost ceiling reached";
       break;
     }

@@ -97,11 +97,12 @@ struct SimplifierLimits {
   // round's jobs, which would otherwise cost them all afresh.
   const std::vector<DeferredEdge>* first_deferred = nullptr;
   // An edge costing more is not collapsed: it stays in the queue at its cost, as a run without
-  // the ceiling would hold it, and the run ends once the queue's cheapest edge costs more
-  // ("cost ceiling reached"). A parallel build's job stops at its round's water level so; its
-  // queue at the end, real keys throughout, is what the next round starts from
-  // (deferred_edges()). A deferred edge comes out below its last key, so one whose cost has
-  // fallen under the ceiling since is still taken unless its last key was twice the ceiling.
+  // the ceiling would hold it, and the run ends once the queue's cheapest key is above the
+  // ceiling rounded to a float, as keys are ("cost ceiling reached"). A parallel build's job stops
+  // at its round's water level so; its queue at the end, real keys throughout, is what the next
+  // round starts from (deferred_edges()). A deferred edge comes out below its last key, so one
+  // whose cost has fallen under the ceiling since is still taken unless its last key was twice the
+  // ceiling.
   double max_cost = std::numeric_limits<double>::infinity();
 };
 

@@ -2,8 +2,10 @@
 // PM out. The CLI, the tests and (later) the worker daemon all call this.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,16 @@ struct EnergyTuning {
   uint32_t min_crease_edges = 8;
   double crease_min_length = 0.05;
 };
+
+// The quadric's line between free and constrained placement (QuadricOptions::
+// free_placement_above_faces): a fifth of the input's faces, and never under 2000 faces, where
+// a level is coarse whatever the input (a small mesh is built constrained throughout).
+constexpr double kFreePlacementAboveRatio = 0.2;
+constexpr uint64_t kFreePlacementFloorFaces = 2000;
+inline uint64_t free_placement_line(uint64_t input_faces) {
+  return std::max<uint64_t>(uint64_t(kFreePlacementAboveRatio * double(input_faces)),
+                            kFreePlacementFloorFaces);
+}
 
 struct SimplifyOptions {
   // Target size of the base mesh: target_faces when non-zero, else target_ratio of the input
@@ -70,6 +82,10 @@ struct SimplifyOptions {
   // defer_above_faces; the energy only). Off: every edge around a collapse is costed at once
   // (for measuring what deferral saves; the PM differs a little).
   bool defer_recosting = true;
+  // The quadric places at its free optimum while more faces than this are live
+  // (QuadricOptions::free_placement_above_faces); unset: free_placement_line of the input's
+  // faces. A parallel build's jobs get 0 or UINT64_MAX by their round.
+  std::optional<uint64_t> free_placement_above_faces;
 };
 
 struct SimplifyStats {

@@ -125,8 +125,8 @@ void expect_same_job(const SubsetJob& a, const SubsetJob& b, const std::string& 
               same_bits(o.energy.spring_scale, p.energy.spring_scale) &&
               o.energy.min_crease_edges == p.energy.min_crease_edges &&
               same_bits(o.energy.crease_min_length, p.energy.crease_min_length) &&
-              o.defer_recosting == p.defer_recosting && o.seed == p.seed &&
-              same_bits(o.reference_diagonal, p.reference_diagonal) &&
+              o.defer_recosting == p.defer_recosting && o.free_placement == p.free_placement &&
+              o.seed == p.seed && same_bits(o.reference_diagonal, p.reference_diagonal) &&
               o.target_faces == p.target_faces && same_bits(o.max_cost, p.max_cost))
       << what;
   expect_same_state(a.state, b.state, what);
@@ -200,6 +200,7 @@ std::vector<SubsetJob> jobs_of(const std::string& name, const std::string& metri
   for (SubsetJob& job : round.jobs) {
     job.options.target_faces = job.mesh.face_count() * 2 / 5;
     job.keys = testing::fresh_keys(*round.master, round.whole, job);
+    job.options.free_placement = metric == "quadric";  // (the default is false: it must travel)
     if (metric != "energy") continue;
     job.options.defer_recosting = true;
     std::vector<EdgeKey> kept;
@@ -394,27 +395,27 @@ TEST(JobCodec, HugeCountsAreRefusedBeforeAllocating) {
   // A job of 3 vertices and 2^40 faces, and one of 2^40 vertices.
   std::string message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(9);  // the codec's version
+    out.u8(10);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), uint64_t(3), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 faces"), std::string::npos) << message;
   EXPECT_NE(message.find("subset job: byte "), std::string::npos) << message;
   message = message_of(Kind::kJob, [&](ByteWriter& out) {
     out.bytes("PPJB", 4);
-    out.u8(9);  // the codec's version
+    out.u8(10);  // the codec's version
     for (uint64_t x : {uint64_t(0), uint64_t(0), kHuge}) out.varint(x);
   });
   EXPECT_NE(message.find("1099511627776 vertices"), std::string::npos) << message;
   message = message_of(Kind::kRecords, [&](ByteWriter& out) {
     out.bytes("PPCR", 4);
-    out.u8(9);  // the codec's version
+    out.u8(10);  // the codec's version
     out.varint(kHuge);
   });
   EXPECT_NE(message.find("1099511627776 records"), std::string::npos) << message;
   // A summary whose energy state claims 2^40 faces.
   message = message_of(Kind::kSummary, [&](ByteWriter& out) {
     out.bytes("PPSS", 4);
-    out.u8(9);  // the codec's version
+    out.u8(10);  // the codec's version
     out.varint(0);
     out.varint(0);
     out.u8(2);  // energy

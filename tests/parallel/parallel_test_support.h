@@ -62,7 +62,11 @@ struct RoundZero {
     jobs =
         extract_subsets(whole, mesh.layout, mesh.wedge_values, mesh.positions_are_float, locked,
                         partition.vertex_subset, p, 0, subset_options_of(options, mesh), &groups);
-    for (SubsetJob& job : jobs) job.state = export_job_state(*master, job);
+    for (SubsetJob& job : jobs) {
+      job.state = export_job_state(*master, job);
+      // The quadric's placement as the master's on the whole mesh (the build's round 0).
+      job.options.free_placement = whole.live_faces() > free_placement_line(mesh.face_count());
+    }
   }
   RepairedMesh repaired;
   std::vector<uint8_t> locked;
