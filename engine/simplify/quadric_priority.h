@@ -39,10 +39,10 @@ struct QuadricOptions {
   double star_planes_weight = 0.3;
   // While the mesh has more live faces than this, a collapse goes where the accumulated quadric
   // alone places it (its free optimum, or the best of the ends and the midpoint), costed there:
-  // no star sums, and a queue key that is the collapse's cost. At the coarse levels below it,
-  // where a placement's drift from the star's volume and border shows, the constrained
-  // placement above. Half the build's time on one thread (docs/DECISIONS.md, "The quadric
-  // places freely at fine levels"). SIZE_MAX: never free; 0: always.
+  // no star sums (most of a fine level's costing), and a queue key that is the collapse's cost.
+  // At the coarse levels below it, where a placement's drift from the star's volume and border
+  // shows, the constrained placement above (docs/DECISIONS.md, "The quadric places freely at
+  // fine levels"). SIZE_MAX: never free; 0: always.
   size_t free_placement_above_faces = SIZE_MAX;
 };
 
@@ -61,7 +61,7 @@ class QuadricPriority : public PriorityModule {
                      CollapseCandidate& out, Costing costing) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   // A queue key is the ends' summed quadric's: at its free optimum, or its least value at the
-  // edge's midpoint, or at a locked end.
+  // edge's midpoint, or at a locked end; placed freely, where place() puts the survivor.
   bool queue_key_of_ends_only() const override { return true; }
   // Prefetches the quadrics (two cache lines each) and lock flags of `from` and `to`.
   void will_cost(VertexId from, std::span<const VertexId> to) const override;
