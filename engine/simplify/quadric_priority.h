@@ -42,8 +42,8 @@ struct QuadricOptions {
   // no star sums (most of a fine level's costing), and a queue key that is the collapse's cost.
   // At the coarse levels below it, where a placement's drift from the star's volume and border
   // shows, the constrained placement above (docs/DECISIONS.md, "The quadric places freely at
-  // fine levels"). SIZE_MAX: never free; 0: always.
-  size_t free_placement_above_faces = SIZE_MAX;
+  // fine levels"). UINT64_MAX: never free; 0: always.
+  uint64_t free_placement_above_faces = UINT64_MAX;
 };
 
 class QuadricPriority : public PriorityModule {

@@ -92,9 +92,8 @@ std::unique_ptr<PriorityModule> make_priority_module(const SimplifyOptions& opti
   }
   QuadricOptions quadric_options;
   quadric_options.round_to_float = mesh.positions_are_float;
-  const uint64_t line =
+  quadric_options.free_placement_above_faces =
       options.free_placement_above_faces.value_or(free_placement_line(mesh.face_count()));
-  quadric_options.free_placement_above_faces = size_t(std::min<uint64_t>(line, SIZE_MAX));
   return std::make_unique<QuadricPriority>(locked, quadric_options);
 }
 
