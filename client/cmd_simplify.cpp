@@ -24,6 +24,7 @@ struct SimplifyArgs {
   uint64_t faces = 0;
   double ratio = 0;
   std::string metric = "quadric";
+  std::string quadric_placement = quadric_placements().front();
   double samples_per_face = SimplifyOptions{}.samples_per_face;
   double crease_angle = 180;
   double attribute_weight = 0.01;
@@ -117,6 +118,7 @@ int run_simplify(const SimplifyArgs& args) {
   options.target_faces = args.faces;
   options.target_ratio = args.ratio;
   options.metric = args.metric;
+  options.free_placement_above_faces = free_placement_above_faces_of(args.quadric_placement);
   options.samples_per_face = args.samples_per_face;
   options.crease_angle_degrees = args.crease_angle;
   options.attribute_weight = args.attribute_weight;
@@ -240,6 +242,15 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
                   "Priority metric: quadric (Garland-Heckbert quadrics, fastest) or energy "
                   "(Hoppe's energy: distances of points sampled on the input)")
       ->check(CLI::IsMember({"quadric", "energy"}))
+      ->capture_default_str();
+  cmd->add_option("--quadric-placement", args->quadric_placement,
+                  "Quadric metric: where a collapse puts its vertex. auto: at the summed "
+                  "quadric's optimum while more than a fifth of the input's faces (and 2000) "
+                  "are live, below that where the star keeps its volume and border; "
+                  "constrained: volume and border kept at every level (the finest levels "
+                  "nearest the input, the build slower); free: the optimum at every level "
+                  "(the fastest build; coarse levels shrink and their borders drift)")
+      ->check(CLI::IsMember(quadric_placements()))
       ->capture_default_str();
   cmd->add_option("--samples-per-face", args->samples_per_face,
                   "Energy metric: extra points drawn on the input per face, by area, beyond "

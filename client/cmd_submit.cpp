@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "service_client.h"
 #include "service_json.h"
+#include "simplify/simplify.h"
 
 namespace parapm::cli {
 namespace {
@@ -22,6 +23,7 @@ struct SubmitArgs {
   std::optional<uint64_t> faces;
   std::optional<double> ratio;
   std::string metric = "quadric";
+  std::optional<std::string> quadric_placement;
   std::optional<uint32_t> parallel, rounds, crease_min_edges;
   std::optional<uint64_t> seed, extra_round_faces, min_subset_faces;
   std::optional<double> samples_per_face, crease_angle, attribute_weight, handover, border_excess;
@@ -32,6 +34,12 @@ struct SubmitArgs {
   bool wait = false;
   bool json = false;
 };
+
+parapm::v1::QuadricPlacement quadric_placement_of(const std::string& name) {
+  if (name == "constrained") return parapm::v1::QUADRIC_PLACEMENT_CONSTRAINED;
+  if (name == "free") return parapm::v1::QUADRIC_PLACEMENT_FREE;
+  return parapm::v1::QUADRIC_PLACEMENT_AUTO;
+}
 
 int run_submit(SubmitArgs& args) {
   ServiceClient client(args.connection);
@@ -52,6 +60,8 @@ int run_submit(SubmitArgs& args) {
   if (args.faces) o.set_target_faces(*args.faces);
   if (args.ratio) o.set_target_ratio(*args.ratio);
   o.set_metric(args.metric == "energy" ? parapm::v1::METRIC_ENERGY : parapm::v1::METRIC_QUADRIC);
+  if (args.quadric_placement)
+    o.set_quadric_placement(quadric_placement_of(*args.quadric_placement));
   if (args.parallel) o.set_parallelism(*args.parallel);
   if (args.rounds) o.set_rounds(*args.rounds);
   if (args.seed) o.set_seed(*args.seed);
@@ -144,6 +154,11 @@ void add_submit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--metric", args->metric, "quadric or energy")
       ->check(CLI::IsMember({"quadric", "energy"}))
       ->capture_default_str();
+  cmd->add_option("--quadric-placement", args->quadric_placement,
+                  "quadric: auto (the optimum at fine levels, volume and border kept at coarse "
+                  "ones; the default), constrained (kept at every level: slower) or free (the "
+                  "optimum at every level: fastest, coarse levels drift)")
+      ->check(CLI::IsMember(quadric_placements()));
   cmd->add_option("--parallel", args->parallel,
                   "subsets p (default: the coordinator's --parallelism)")
       ->check(CLI::Range(1, 256));

@@ -48,6 +48,21 @@ JobSpec job_spec_of(const parapm::v1::JobOptions& options, uint32_t default_para
     default:
       require(false, "unknown metric " + std::to_string(int(options.metric())));
   }
+  switch (options.quadric_placement()) {
+    case parapm::v1::QUADRIC_PLACEMENT_UNSPECIFIED:
+    case parapm::v1::QUADRIC_PLACEMENT_AUTO:
+      break;
+    case parapm::v1::QUADRIC_PLACEMENT_CONSTRAINED:
+      s.free_placement_above_faces = free_placement_above_faces_of("constrained");
+      break;
+    case parapm::v1::QUADRIC_PLACEMENT_FREE:
+      s.free_placement_above_faces = free_placement_above_faces_of("free");
+      break;
+    default:
+      require(false, "unknown quadric_placement " +
+                         std::to_string(int(options.quadric_placement())) +
+                         " (available: 1 auto, 2 constrained, 3 free)");
+  }
   if (options.has_samples_per_face()) {
     require(std::isfinite(options.samples_per_face()) && options.samples_per_face() >= 0 &&
                 options.samples_per_face() <= 64,

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
@@ -25,6 +26,19 @@ uint64_t target_face_count(uint64_t input_faces, const SimplifyOptions& options)
     return static_cast<uint64_t>(std::llround(options.target_ratio * double(input_faces)));
   }
   return 0;
+}
+
+const std::vector<std::string>& quadric_placements() {
+  static const std::vector<std::string> names{"auto", "constrained", "free"};
+  return names;
+}
+
+std::optional<uint64_t> free_placement_above_faces_of(const std::string& placement) {
+  if (placement == "auto") return std::nullopt;
+  if (placement == "constrained") return std::numeric_limits<uint64_t>::max();
+  if (placement == "free") return 0;
+  throw_invalid("unknown quadric placement '" + placement +
+                "' (available: auto, constrained, free)");
 }
 
 void check_energy_tuning(const EnergyTuning& energy) {

@@ -40,6 +40,16 @@ inline uint64_t free_placement_line(uint64_t input_faces) {
                             kFreePlacementFloorFaces);
 }
 
+// The quadric's placements a user chooses from (`parapm simplify --quadric-placement`, the
+// service's JobOptions.quadric_placement), as SimplifyOptions::free_placement_above_faces takes
+// them: "auto", unset (free above free_placement_line, constrained below); "constrained", never
+// free (every level keeps its star's volume and border: the finest levels nearest the input,
+// the build slower); "free", free at every level (the fastest build; coarse levels shrink and
+// their borders drift). Throws InvalidInput for any other name.
+std::optional<uint64_t> free_placement_above_faces_of(const std::string& placement);
+// The names free_placement_above_faces_of takes, "auto" first (the default).
+const std::vector<std::string>& quadric_placements();
+
 struct SimplifyOptions {
   // Target size of the base mesh: target_faces when non-zero, else target_ratio of the input
   // faces when non-zero, else as far as collapses stay legal.

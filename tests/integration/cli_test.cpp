@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "test_support.h"
 
@@ -94,6 +96,30 @@ TEST_F(Cli, SimplifyWithTheEnergyMetric) {
   EXPECT_NE(r.err.find("hausdorff"), std::string::npos) << r.err;
   r = parapm("simplify " + mesh + " -o " + pm + " --metric energy --samples-per-face -1");
   EXPECT_EQ(r.status, 2) << r.err;
+}
+
+// The quadric's three placements build three different PMs, each exact at full resolution;
+// an unknown one is refused by name.
+TEST_F(Cli, TheQuadricPlacementIsTheUsers) {
+  const std::string mesh = testing::test_data("gmsh-aneurysm-20k.stl.gz");
+  std::vector<std::string> bytes;
+  for (const std::string placement : {"auto", "constrained", "free"}) {
+    const std::string pm = path(placement + ".pm");
+    CliRun r =
+        parapm("simplify " + mesh + " -o " + pm + " --ratio 0.02 --quadric-placement " + placement);
+    ASSERT_EQ(r.status, 0) << placement << ": " << r.err;
+    r = parapm("check " + pm + " --against " + mesh);
+    EXPECT_EQ(r.status, 0) << placement << ": " << r.out << r.err;
+    std::ifstream in(pm, std::ios::binary);
+    bytes.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  EXPECT_NE(bytes[0], bytes[1]) << "auto places freely at the fine levels";
+  EXPECT_NE(bytes[0], bytes[2]) << "auto keeps volume and border at the coarse levels";
+  EXPECT_NE(bytes[1], bytes[2]);
+  const CliRun r =
+      parapm("simplify " + mesh + " -o " + path("x.pm") + " --quadric-placement loose");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("loose"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, CheckFailsAgainstAnotherMesh) {

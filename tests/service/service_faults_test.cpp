@@ -279,6 +279,12 @@ TEST_F(ServiceFaults, BadUploadsAreRefusedAndTheServerKeepsServing) {
   bad_metric.set_metric(parapm::v1::Metric(7));
   EXPECT_EQ(service().try_submit(mesh_id, bad_metric, &job).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
+  parapm::v1::JobOptions bad_placement = options(2, parapm::v1::METRIC_QUADRIC, 0.5);
+  bad_placement.set_quadric_placement(parapm::v1::QuadricPlacement(9));
+  const grpc::Status placement_status = service().try_submit(mesh_id, bad_placement, &job);
+  EXPECT_EQ(placement_status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(placement_status.error_message().find("quadric_placement"), std::string::npos)
+      << placement_status.error_message();
   EXPECT_EQ(service().try_get_job("job-unknown", &job).error_code(), grpc::StatusCode::NOT_FOUND);
   std::string bytes;
   EXPECT_EQ(service().try_download("job-unknown", &bytes).error_code(),

@@ -191,6 +191,10 @@ std::vector<std::string> simplify_args(const parapm::v1::JobOptions& o) {
   auto count = [&](const char* flag, uint64_t value) {
     args.insert(args.end(), {flag, std::to_string(value)});
   };
+  if (o.quadric_placement() == parapm::v1::QUADRIC_PLACEMENT_CONSTRAINED)
+    args.insert(args.end(), {"--quadric-placement", "constrained"});
+  if (o.quadric_placement() == parapm::v1::QUADRIC_PLACEMENT_FREE)
+    args.insert(args.end(), {"--quadric-placement", "free"});
   if (o.has_target_ratio()) number("--ratio", o.target_ratio());
   if (o.has_seed()) count("--seed", o.seed());
   if (o.has_samples_per_face()) number("--samples-per-face", o.samples_per_face());

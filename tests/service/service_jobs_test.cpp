@@ -129,6 +129,10 @@ TEST_F(ServiceJobs, ThreeWorkersBuildTheInProcessPm) {
   parapm::v1::JobOptions free_copies = options(2, parapm::v1::METRIC_QUADRIC, 0);
   free_copies.set_free_copies(true);
   build_and_compare("cad-cycloidal-43k.ply", free_copies, names);
+  // The quadric's volume and border kept at every level (`--quadric-placement constrained`).
+  parapm::v1::JobOptions constrained = options(2, parapm::v1::METRIC_QUADRIC, 0.02);
+  constrained.set_quadric_placement(parapm::v1::QUADRIC_PLACEMENT_CONSTRAINED);
+  build_and_compare("gmsh-aneurysm-20k.stl.gz", constrained, names);
   // Every component kept (`--keep-components`), on the guitar's many parts.
   parapm::v1::JobOptions kept = options(2, parapm::v1::METRIC_ENERGY, 0);
   kept.set_keep_components(true);
