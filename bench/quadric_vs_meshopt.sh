@@ -8,8 +8,9 @@
 # faces, ParaPM's seconds (`parapm simplify --json` "seconds": the whole PM built in memory, not
 # reading, repair or writing), meshoptimizer's (its simplification call), their ratio (medians),
 # and ParaPM's costings per input face. The last line: the geometric mean and the largest ratio.
-# Environment: RATIO, REPEATS, PARAPM_BUILD_DIR (default build/), PEERS_BUILD (default
-# ./.peers-build; built with ../shared/tools/build.sh when missing).
+# Environment: RATIO, REPEATS, PLACEMENT (`--quadric-placement`: auto, the default,
+# constrained or free), PARAPM_BUILD_DIR (default build/), PEERS_BUILD (default ./.peers-build;
+# built with ../shared/tools/build.sh when missing).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 shared="$root/../shared"
@@ -17,6 +18,7 @@ shared="$root/../shared"
 source "$root/bench/common.sh"
 ratio="${RATIO:-0.02}"
 repeats="${REPEATS:-3}"
+placement="${PLACEMENT:-auto}"
 check_repeats "$repeats"
 bin="$(parapm_program "$root")"
 peers="${PEERS_BUILD:-$PWD/.peers-build}"
@@ -33,7 +35,7 @@ for mesh in "$@"; do
   ours=() theirs=() faces=0 costings=0
   for ((i = 0; i < repeats; i++)); do
     json="$("$bin" --log-level error simplify "$mesh" -o "$work/pm.pm" --metric quadric \
-      --ratio "$ratio" --json)"
+      --quadric-placement "$placement" --ratio "$ratio" --json)"
     ours+=("$(jq -r .seconds <<< "$json")")
     faces="$(jq -r .in_faces <<< "$json")"
     costings="$(jq -r .costings <<< "$json")"
