@@ -440,7 +440,8 @@ TEST(JobCodec, TheCommittedFuzzSeedsAreAtTheCodecsVersion) {
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     size_t magic = std::string::npos;
     for (const char* kind : {"PPJB", "PPCR", "PPSS"}) magic = std::min(magic, bytes.find(kind));
-    ASSERT_LT(magic + 4, bytes.size()) << entry.path() << ": no message";
+    ASSERT_NE(magic, std::string::npos) << entry.path() << ": no message";
+    ASSERT_LT(magic + 4, bytes.size()) << entry.path() << ": no version byte";
     EXPECT_EQ(uint8_t(bytes[magic + 4]), 10) << entry.path() << ": not the codec's version";
     ++seeds;
   }
