@@ -388,7 +388,7 @@ ParallelBuilder::ParallelBuilder(const RepairedMesh& repaired, const SimplifyOpt
   if (!options.free_copies) copy_groups_ = copy_groups(repaired, on_membrane_);
   locked_ = locked_vertices(copy_groups_, mesh_.vertex_count());
   defer_line_ = defer_recosting_line(input_faces_);
-  free_line_ = options_.free_placement_above_faces.value_or(free_placement_line(input_faces_));
+  free_line_ = free_placement_line_of(options_, input_faces_);
   // After two scheduled rounds (a ratio of 0.32 at the default handover), an extra round at
   // the scheduled ratio would need 3.2 x the floor per subset to start, and mid-sized meshes
   // at p = 2 would get none (a longer sequential final pass).

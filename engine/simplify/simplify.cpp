@@ -106,8 +106,7 @@ std::unique_ptr<PriorityModule> make_priority_module(const SimplifyOptions& opti
   }
   QuadricOptions quadric_options;
   quadric_options.round_to_float = mesh.positions_are_float;
-  quadric_options.free_placement_above_faces =
-      options.free_placement_above_faces.value_or(free_placement_line(mesh.face_count()));
+  quadric_options.free_placement_above_faces = free_placement_line_of(options, mesh.face_count());
   return std::make_unique<QuadricPriority>(locked, quadric_options);
 }
 

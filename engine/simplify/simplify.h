@@ -98,6 +98,11 @@ struct SimplifyOptions {
   std::optional<uint64_t> free_placement_above_faces;
 };
 
+// The quadric's line for a build of `input_faces` faces: the options', else free_placement_line.
+inline uint64_t free_placement_line_of(const SimplifyOptions& options, uint64_t input_faces) {
+  return options.free_placement_above_faces.value_or(free_placement_line(input_faces));
+}
+
 struct SimplifyStats {
   uint64_t collapses = 0;
   uint64_t rejected = 0;
