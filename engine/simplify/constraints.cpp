@@ -182,6 +182,20 @@ class LinkCondition : public ConstraintModule {
   }
 };
 
+// Whether face f of `moved`'s star (not on the edge) folds when `moved` goes to c.position.
+// (Inlined: the geometry rule's loop runs it for every face around both ends.)
+[[gnu::always_inline]] inline bool moved_face_folds(const CollapseMesh& mesh,
+                                                    const CollapseCandidate& c, VertexId moved,
+                                                    FaceId f) {
+  const Triangle& t = mesh.face(f);
+  const Vec3& p0 = mesh.position(t[0]);
+  const Vec3& p1 = mesh.position(t[1]);
+  const Vec3& p2 = mesh.position(t[2]);
+  const int k = corner_of(t, moved);
+  return face_folds(p0, p1, p2, k == 0 ? c.position : p0, k == 1 ? c.position : p1,
+                    k == 2 ? c.position : p2);
+}
+
 // Rejects a collapse after which a face around vs or vt folds (face_fold.h).
 class FaceGeometry : public ConstraintModule {
  public:
@@ -193,21 +207,33 @@ class FaceGeometry : public ConstraintModule {
       if (c.position == mesh.position(moved)) continue;  // its faces stay as they are
       for (FaceId f : mesh.faces_of(moved)) {
         if (f == edge.left || f == edge.right) continue;
-        const Triangle& t = mesh.face(f);
-        const Vec3& p0 = mesh.position(t[0]);
-        const Vec3& p1 = mesh.position(t[1]);
-        const Vec3& p2 = mesh.position(t[2]);
-        const int k = corner_of(t, moved);
-        if (face_folds(p0, p1, p2, k == 0 ? c.position : p0, k == 1 ? c.position : p1,
-                       k == 2 ? c.position : p2))
+        if (moved_face_folds(mesh, c, moved, f)) {
+          folded_ = f;
           return false;
+        }
       }
     }
     return true;
   }
+  FaceId folded_face() const override { return folded_; }
+
+ private:
+  mutable FaceId folded_ = kNoId;  // the last veto's (a simplifier's rules serve one thread)
 };
 
 }  // namespace
+
+bool collapse_folds_face(const CollapseMesh& mesh, const CollapseCandidate& c,
+                         const EdgeFaces& edge, FaceId f) {
+  if (!mesh.face_alive(f) || f == edge.left || f == edge.right) return false;
+  for (VertexId moved : {c.vs, c.vt}) {
+    if (c.position == mesh.position(moved)) continue;
+    const Triangle& t = mesh.face(f);
+    if ((t[0] == moved || t[1] == moved || t[2] == moved) && moved_face_folds(mesh, c, moved, f))
+      return true;
+  }
+  return false;
+}
 
 std::vector<std::unique_ptr<ConstraintModule>> neighbourhood_constraints() {
   std::vector<std::unique_ptr<ConstraintModule>> modules;

@@ -24,6 +24,10 @@ struct CollapseCandidate {
   double error = 0;  // geometric error of the collapse in model units (for cutting a PM)
   // One of a seam collapse's collapses (copy_groups.h): vs and vt may be locked copies.
   bool seam = false;
+  // Set by the priority module: this costing is what a kPerform costing of the edge on the
+  // mesh as it is gives (a kQueue costing may be exactly that: the simplifier then does not
+  // cost the edge again for its collapse).
+  bool as_performed = false;
   Vec3 vs_before{};  // where vs was: set when the collapse is performed (or replayed)
   // Filled by PriorityModule::collapsed when the module changed wedge values (E_scalar): the
   // wedges and their new values, floats_per_wedge each.
@@ -188,6 +192,10 @@ class ConstraintModule {
   // `edge` holds the faces on the edge (vs, vt) as CollapseMesh::edge_faces(vs, vt).
   virtual bool allows(const CollapseMesh& mesh, const CollapseCandidate& candidate,
                       const EdgeFaces& edge) const = 0;
+  // After allows() answered false: a face whose fold alone made that answer
+  // (collapse_folds_face), which the simplifier tests first when it costs the edge again
+  // (most vetoed edges are vetoed again, by the same face); kNoId (the default): none.
+  virtual FaceId folded_face() const { return kNoId; }
   // Whether the answer depends on the edge {vs, vt} only: not on which end survives nor on
   // the placement. Such a rule can veto an edge before any costing.
   virtual bool topological() const { return false; }
@@ -224,6 +232,11 @@ std::vector<std::unique_ptr<ConstraintModule>> standard_constraints(
     const std::vector<uint8_t>& locked,
     std::shared_ptr<const std::vector<uint32_t>> components = {},
     bool components_may_vanish = false, std::vector<uint8_t> on_membrane = {});
+
+// Whether face f, alive, around an end the candidate moves and not on the edge, folds in its
+// collapse (face_fold.h): then the standard geometry rule vetoes the candidate.
+bool collapse_folds_face(const CollapseMesh& mesh, const CollapseCandidate& candidate,
+                         const EdgeFaces& edge, FaceId f);
 
 // The standard rules that read only the faces around the edge's ends (boundary, link
 // condition, geometry): what a seam collapse's trial on a copy of those faces checks

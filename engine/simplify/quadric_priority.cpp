@@ -176,6 +176,8 @@ bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, Col
   const Vec3& pa = mesh.position(a);
   const Vec3& pb = mesh.position(b);
   Vec3 kept;
+  // Placed at a locked end, or freely: every costing is the one for its collapse.
+  out.as_performed = true;
   if (locked_a || locked_b) {
     out.position = mesh.position(out.vs);
   } else if ((!options_.keep_volume && !options_.keep_border) ||
@@ -183,9 +185,11 @@ bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, Col
     out.position = place(q, pa, pb);
   } else if (costing != Costing::kPerform && q.minimizer(kept)) {
     out.position = kept;  // no placement costs less: a lower bound of the constrained cost
+    out.as_performed = false;
   } else if (costing == Costing::kQueue) {
     // A flat or creased star (A singular): the accumulated quadric's least value, a lower
     // bound of the constrained cost as well, without the star's sums.
+    out.as_performed = false;
     out.position = scale(add(pa, pb), 0.5);
     out.cost = q.least_value(out.position);
     out.error = rms_error(q, out.cost);
@@ -193,6 +197,7 @@ bool QuadricPriority::cost(const CollapseMesh& mesh, VertexId a, VertexId b, Col
   } else {
     // Placed with the star's planes; costed by the accumulated quadric alone, whose free
     // optimum's cost (the queue key) stays a lower bound.
+    out.as_performed = costing == Costing::kPerform;
     Quadric total;
     if (place_on_constraints(mesh, a, b, q, total, kept, scratch) && near_edge(kept, pa, pb)) {
       // An end that meets the constraints comes out of the solve up to rounding: a corner

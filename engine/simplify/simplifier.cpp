@@ -141,9 +141,9 @@ bool Simplifier::seam_already_queued(VertexId a, VertexId b) {
   return false;
 }
 
-void Simplifier::reject(VertexId a, VertexId b) {
-  remember_rejected(a, b);
-  remember_rejected(b, a);
+void Simplifier::reject(VertexId a, VertexId b, FaceId folded) {
+  remember_rejected(a, b, folded);
+  remember_rejected(b, a, folded);
 }
 
 bool Simplifier::topologically_legal(VertexId a, VertexId b) const {
@@ -170,13 +170,18 @@ void Simplifier::forget_outdated_requeued() {
 }
 
 // Each side lists a vetoed edge at most once, so the lists stay as short as the valence.
-void Simplifier::remember_rejected(VertexId v, VertexId other) {
+void Simplifier::remember_rejected(VertexId v, VertexId other, FaceId folded) {
   if (!rejected_slot_[v]) {
     rejected_lists_.emplace_back();
     rejected_slot_[v] = uint32_t(rejected_lists_.size());
   }
-  std::vector<VertexId>& list = rejected_lists_[rejected_slot_[v] - 1];
-  if (std::find(list.begin(), list.end(), other) == list.end()) list.push_back(other);
+  std::vector<Vetoed>& list = rejected_lists_[rejected_slot_[v] - 1];
+  const auto it =
+      std::find_if(list.begin(), list.end(), [&](const Vetoed& e) { return e.other == other; });
+  if (it == list.end())
+    list.push_back({other, folded});
+  else
+    it->folded = folded;
 }
 
 bool Simplifier::take_requeued(const Entry& entry, CollapseCandidate& out) {
@@ -193,11 +198,13 @@ bool Simplifier::take_requeued(const Entry& entry, CollapseCandidate& out) {
 }
 
 bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
-                       bool topology_checked, bool star_checked) const {
+                       bool topology_checked, bool star_checked, FaceId* folded) const {
   for (const auto& module : constraints_) {
     if ((topology_checked && module->topological()) || (star_checked && module->star_local()))
       continue;
-    if (!module->allows(mesh_, candidate, edge)) return false;
+    if (module->allows(mesh_, candidate, edge)) continue;
+    if (folded) *folded = module->star_local() ? module->folded_face() : kNoId;
+    return false;
   }
   return true;
 }
@@ -243,17 +250,17 @@ void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits
   // the edges of vs. All are taken off the lists first: a push may veto its edge again, onto
   // the lists (screening).
   for (VertexId end : {vt, vs})
-    if (std::vector<VertexId>* list = rejected_list(end)) list->clear();
+    if (std::vector<Vetoed>* list = rejected_list(end)) list->clear();
   retry_.clear();
   for (VertexId n : ring_) {
-    std::vector<VertexId>* list = rejected_list(n);
+    std::vector<Vetoed>* list = rejected_list(n);
     if (!list) continue;
-    for (VertexId other : *list) {
+    for (const auto& [other, folded] : *list) {
       if (other == vs || !mesh_.vertex_alive(other)) continue;
       // The edge is pushed once, from this side: forget it on the other side too.
-      if (std::vector<VertexId>* mirror = rejected_list(other))
-        mirror->erase(std::remove(mirror->begin(), mirror->end(), n), mirror->end());
-      retry_.emplace_back(n, other);
+      if (std::vector<Vetoed>* mirror = rejected_list(other))
+        std::erase_if(*mirror, [&](const Vetoed& e) { return e.other == n; });
+      retry_.push_back({n, other, folded});
     }
     list->clear();
   }
@@ -264,37 +271,45 @@ void Simplifier::requeue_around(VertexId vs, VertexId vt, const SimplifierLimits
   }
   for (VertexId n : ring_)
     if (!seam_already_queued(vs, n) && !(defer && defer_edge(vs, n))) queue_checked(vs, n, limits);
-  for (const auto& [n, other] : retry_) {
+  for (const auto& [n, other, folded] : retry_) {
     ++stats_.reevaluated;
-    queue_checked(n, other, limits);
+    queue_checked(n, other, limits, folded);
   }
 }
 
-void Simplifier::queue_checked(VertexId a, VertexId b, const SimplifierLimits& limits) {
+void Simplifier::queue_checked(VertexId a, VertexId b, const SimplifierLimits& limits,
+                               FaceId folded) {
   Entry entry;
   if (!queue_entry(a, b, entry)) return;
   // (not within a seam collapse, whose survivors' versions change one after another)
   if (check_when_queued_ && entry.cost <= last_key_ && !queueing_seams_ &&
-      !seam_edge(entry.a, entry.b) && vetoed_when_queued(entry, limits))
+      !seam_edge(entry.a, entry.b) && vetoed_when_queued(entry, limits, folded))
     return;
   queue_.push(entry);
 }
 
-bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits) {
+bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits, FaceId folded) {
   // run()'s steps for a current entry on top, up to its rules; an edge its pop would drop
   // without a veto (unplaced, gone, over the ceiling) is queued.
   CollapseCandidate& candidate = checked_;
-  candidate.seam = false;
-  if (!cost_edge(entry.a, entry.b, candidate, Costing::kPerform)) return false;
+  if (queued_.as_performed) {  // (queue_entry's costing of this edge, just made)
+    candidate = queued_;
+  } else {
+    candidate.seam = false;
+    if (!cost_edge(entry.a, entry.b, candidate, Costing::kPerform)) return false;
+  }
   const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
   if ((edge.left == kNoId && edge.right == kNoId) || candidate.cost > limits.max_cost) return false;
-  for (const auto& module : constraints_) {
-    if (!module->star_local() || module->allows(mesh_, candidate, edge)) continue;
+  const auto veto = [&](FaceId face) {
     ++stats_.rejected;
     ++stats_.vetoed_when_queued;
-    reject(entry.a, entry.b);
+    reject(entry.a, entry.b, face);
     return true;
-  }
+  };
+  if (folded != kNoId && collapse_folds_face(mesh_, candidate, edge, folded)) return veto(folded);
+  for (const auto& module : constraints_)
+    if (module->star_local() && !module->allows(mesh_, candidate, edge))
+      return veto(module->folded_face());
   entry.stamp |= kRequeued;
   requeued_[edge_key(entry.a, entry.b)] = {mesh_.star_version(entry.a), mesh_.star_version(entry.b),
                                            candidate};
@@ -330,16 +345,16 @@ void Simplifier::requeue_costly(VertexId vs, bool defer) {
     }
     plan_costing(vs, n);
   }
-  for (const auto& [n, other] : retry_) {
+  for (const Retry& retry : retry_) {
     ++stats_.reevaluated;
     // Vetoed once, an edge is often vetoed again (near the legal minimum, thousands are, each
     // star change around them): the rules that need no costing first.
-    if (!topologically_legal(n, other)) {
+    if (!topologically_legal(retry.a, retry.b)) {
       ++stats_.screened;
-      reject(n, other);
+      reject(retry.a, retry.b);
       continue;
     }
-    plan_costing(n, other);
+    plan_costing(retry.a, retry.b);
   }
   priority_.evaluate_each(mesh_, std::span(costed_).first(costings), Costing::kQueue);
   for (PlannedPush& push : planned_) {
@@ -352,6 +367,7 @@ void Simplifier::requeue_costly(VertexId vs, bool defer) {
 }
 
 bool Simplifier::cost_edge(VertexId a, VertexId b, CollapseCandidate& out, Costing costing) {
+  out.as_performed = false;  // (the module says when it is)
   if (seam_edge(a, b)) return cost_seam(a, b, out, costing);
   ++stats_.evaluations;
   return priority_.evaluate(mesh_, a, b, out, costing);
@@ -722,9 +738,10 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.over_ceiling;
       continue;
     }
-    if (!legal(candidate, edge, topology_checked, star_checked)) {
+    FaceId folded = kNoId;
+    if (!legal(candidate, edge, topology_checked, star_checked, &folded)) {
       ++stats_.rejected;
-      reject(entry.a, entry.b);
+      reject(entry.a, entry.b, folded);
       continue;
     }
     // A key is kept until an end of its edge changes, though collapses beside the edge change

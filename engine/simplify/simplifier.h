@@ -254,12 +254,17 @@ class Simplifier {
   // same star, so the same costing and veto: its next retry comes with the next change of its
   // star either way, and its key is the same then); when none does, its entry keeps the
   // costing for its pop (requeued_).
-  void queue_checked(VertexId a, VertexId b, const SimplifierLimits& limits);
-  // queue_checked's costing of `entry`'s edge for its collapse: true when a rule of its star
-  // vetoes it (then rejected), false when it is to be queued (its costing kept when it passes).
-  bool vetoed_when_queued(Entry& entry, const SimplifierLimits& limits);
-  void remember_rejected(VertexId v, VertexId other);
-  void reject(VertexId a, VertexId b);
+  // `folded`: the face whose fold vetoed the edge last (ConstraintModule::folded_face), or
+  // kNoId.
+  void queue_checked(VertexId a, VertexId b, const SimplifierLimits& limits, FaceId folded = kNoId);
+  // queue_checked's costing of `entry`'s edge for its collapse (the queue costing's, when it is
+  // that: CollapseCandidate::as_performed): true when a rule of its star vetoes it (then
+  // rejected), false when it is to be queued (its costing kept when it passes). `folded` is
+  // tested first: a face still folding vetoes it as the geometry rule would.
+  bool vetoed_when_queued(Entry& entry, const SimplifierLimits& limits, FaceId folded);
+  void remember_rejected(VertexId v, VertexId other, FaceId folded);
+  // Edge {a, b} among the vetoed edges of both ends, with the face whose fold vetoed it.
+  void reject(VertexId a, VertexId b, FaceId folded = kNoId);
   bool topologically_legal(VertexId a, VertexId b) const;
   bool is_stale(const Entry& entry) const {
     return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
@@ -280,8 +285,10 @@ class Simplifier {
   // All constraints; with topology_checked, those that are not topological(); with
   // star_checked (a kept requeued candidate, which passed them all, its star unchanged since),
   // those that are not star_local().
+  // `folded`, when given: on a veto, the vetoing rule's folded_face().
   bool legal(const CollapseCandidate& candidate, const EdgeFaces& edge,
-             bool topology_checked = false, bool star_checked = false) const;
+             bool topology_checked = false, bool star_checked = false,
+             FaceId* folded = nullptr) const;
   CollapseRecord perform(CollapseCandidate candidate, const EdgeFaces& edge);
   // After a collapse with survivor vs: its version bumped, the vetoed edges around the changed
   // star retried, the edges around vs queued again.
@@ -329,11 +336,16 @@ class Simplifier {
   float last_key_ = 0;  // the key of the collapse last made
   // Per vertex, from zeroed pages (a run over a band of a large mesh touches the band's).
   ZeroedArray<uint32_t> version_;
+  // A vetoed edge's other end, and the face whose fold vetoed it last (kNoId: none).
+  struct Vetoed {
+    VertexId other;
+    FaceId folded;
+  };
   // Per vertex: the edges vetoed since its last change, a list of rejected_lists_ (its index
   // + 1 in rejected_slot_; 0: none yet).
   ZeroedArray<uint32_t> rejected_slot_;
-  std::vector<std::vector<VertexId>> rejected_lists_;
-  std::vector<VertexId>* rejected_list(VertexId v) {
+  std::vector<std::vector<Vetoed>> rejected_lists_;
+  std::vector<Vetoed>* rejected_list(VertexId v) {
     return rejected_slot_[v] ? &rejected_lists_[rejected_slot_[v] - 1] : nullptr;
   }
   // Requeued edges' costings, kept while neither end's star version changes (no collapse
@@ -372,7 +384,11 @@ class Simplifier {
   // zeroing cost as much as a cheap costing.
   CollapseCandidate queued_;
   CollapseCandidate checked_;  // vetoed_when_queued's
-  std::vector<std::pair<VertexId, VertexId>> retry_;
+  struct Retry {
+    VertexId a, b;
+    FaceId folded;
+  };
+  std::vector<Retry> retry_;
   // requeue_costly's pushes in order: an entry, or the index of its costing in costed_.
   static constexpr size_t kNotCosted = ~size_t{0};
   struct PlannedPush {
