@@ -60,6 +60,7 @@ class KeyMemo : public PriorityWrapper {
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   // (a carried key is answered once: what a key answers depends on when it is asked)
   bool queue_key_of_ends_only() const override { return false; }
+  bool placed_when_queued_is_placed() const override { return false; }
 
   // Forgets every key, then carries `keys` in. Throws Error(kInvalidInput) for a key that is
   // not (a, b) with a < b below the vertex capacity (keys may come from a worker).

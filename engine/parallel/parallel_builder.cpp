@@ -239,6 +239,8 @@ class BandPriority : public PriorityWrapper {
   BandPriority(PriorityModule& inner, std::vector<uint8_t> lagging, double ceiling)
       : PriorityWrapper(inner), lagging_(std::move(lagging)), ceiling_(ceiling) {}
   void initialize(const CollapseMesh&) override {}
+  // (its ceiling may refuse a collapse's cost above it whose queue key, a lower bound, is not)
+  bool placed_when_queued_is_placed() const override { return false; }
   bool evaluate(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
                 Costing costing) override {
     if (!lagging_[a] && !lagging_[b]) return false;

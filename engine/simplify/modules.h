@@ -103,6 +103,11 @@ class PriorityModule {
   // while neither end changes, however the faces around them do, and the simplifier may cost
   // an edge's collapse when it queues it (Simplifier::queue_checked). Default: false.
   virtual bool queue_key_of_ends_only() const { return false; }
+  // Whether an edge whose queue costing (kQueue) is placed is placed by the costing for its
+  // collapse (kPerform) too, on the same mesh: then the simplifier may check the rules that
+  // read the edge alone before that costing (Simplifier::vetoed_when_queued), and a veto is
+  // what the costing first would have come to. Default: false.
+  virtual bool placed_when_queued_is_placed() const { return false; }
   // The edges this module has costed itself so far (its evaluate calls; a wrapper's own
   // answers, such as a carried key or a subset rule's refusal, are not counted). Summed over a
   // build's modules it is the build's work in costings, the figure the parallel build's work
@@ -136,6 +141,9 @@ class PriorityWrapper : public PriorityModule {
   std::string name() const override { return inner_.name(); }
   bool costly() const override { return inner_.costly(); }
   bool queue_key_of_ends_only() const override { return inner_.queue_key_of_ends_only(); }
+  bool placed_when_queued_is_placed() const override {
+    return inner_.placed_when_queued_is_placed();
+  }
   uint64_t costings() const override { return inner_.costings(); }
   void release_caches() override { inner_.release_caches(); }
   void use_team(ThreadTeam* team) override { inner_.use_team(team); }

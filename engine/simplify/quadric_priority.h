@@ -63,6 +63,10 @@ class QuadricPriority : public PriorityModule {
   // A queue key is the ends' summed quadric's: at its free optimum, or its least value at the
   // edge's midpoint, or at a locked end; placed freely, where place() puts the survivor.
   bool queue_key_of_ends_only() const override { return true; }
+  // Both costings refuse an edge whose ends are both locked; otherwise a queue costing is
+  // placed when finite, and the collapse's puts the survivor near the edge or at an end, where
+  // the same accumulated quadric is finite too.
+  bool placed_when_queued_is_placed() const override { return true; }
   // Prefetches the quadrics (two cache lines each) and lock flags of `from` and `to`.
   void will_cost(VertexId from, std::span<const VertexId> to) const override;
   uint64_t costings() const override { return costings_; }

@@ -291,24 +291,45 @@ void Simplifier::queue_checked(VertexId a, VertexId b, const SimplifierLimits& l
 bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits, FaceId folded) {
   // run()'s steps for a current entry on top, up to its rules; an edge its pop would drop
   // without a veto (unplaced, gone, over the ceiling) is queued.
-  CollapseCandidate& candidate = checked_;
-  if (queued_.as_performed) {  // (queue_entry's costing of this edge, just made)
-    candidate = queued_;
-  } else {
-    candidate.seam = false;
-    if (!cost_edge(entry.a, entry.b, candidate, Costing::kPerform)) return false;
-  }
-  const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
-  if ((edge.left == kNoId && edge.right == kNoId) || candidate.cost > limits.max_cost) return false;
   const auto veto = [&](FaceId face) {
     ++stats_.rejected;
     ++stats_.vetoed_when_queued;
     reject(entry.a, entry.b, face);
     return true;
   };
+  CollapseCandidate& candidate = checked_;
+  bool topology_checked = false;
+  if (queued_.as_performed) {  // (queue_entry's costing of this edge, just made)
+    candidate = queued_;
+  } else {
+    // A costing for the collapse (the quadric's constrained placement) costs far more than the
+    // rules of the star that read the edge alone, which veto most edges retried at coarse
+    // levels: those first, but for an edge a fold vetoed last (its face is tested first, after
+    // the costing: the link condition costs more around a hub). Only where that costing is
+    // placed (PriorityModule::placed_when_queued_is_placed) and under no ceiling, where its cost
+    // is never over it: else the edge would be queued, not vetoed.
+    if (folded == kNoId && priority_.placed_when_queued_is_placed() &&
+        limits.max_cost == std::numeric_limits<double>::infinity()) {
+      const EdgeFaces edge = mesh_.edge_faces(entry.a, entry.b);
+      if (edge.left == kNoId && edge.right == kNoId) return false;
+      CollapseCandidate edge_only;
+      edge_only.vs = entry.a;
+      edge_only.vt = entry.b;
+      for (const auto& module : constraints_)
+        if (module->topological() && module->star_local() &&
+            !module->allows(mesh_, edge_only, edge))
+          return veto(kNoId);
+      topology_checked = true;
+    }
+    candidate.seam = false;
+    if (!cost_edge(entry.a, entry.b, candidate, Costing::kPerform)) return false;
+  }
+  const EdgeFaces edge = mesh_.edge_faces(candidate.vs, candidate.vt);
+  if ((edge.left == kNoId && edge.right == kNoId) || candidate.cost > limits.max_cost) return false;
   if (folded != kNoId && collapse_folds_face(mesh_, candidate, edge, folded)) return veto(folded);
   for (const auto& module : constraints_)
-    if (module->star_local() && !module->allows(mesh_, candidate, edge))
+    if (module->star_local() && !(topology_checked && module->topological()) &&
+        !module->allows(mesh_, candidate, edge))
       return veto(module->folded_face());
   entry.stamp |= kRequeued;
   requeued_[edge_key(entry.a, entry.b)] = {mesh_.star_version(entry.a), mesh_.star_version(entry.b),
