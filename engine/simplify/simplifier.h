@@ -260,7 +260,9 @@ class Simplifier {
   // queue_checked's costing of `entry`'s edge for its collapse (the queue costing's, when it is
   // that: CollapseCandidate::as_performed): true when a rule of its star vetoes it (then
   // rejected), false when it is to be queued (its costing kept when it passes). `folded` is
-  // tested first: a face still folding vetoes it as the geometry rule would.
+  // tested first: a face still folding vetoes it as the geometry rule would. Without one, the
+  // rules that read the edge alone come before a costing that must be made, where it is sure
+  // to be placed and no ceiling applies: a veto either way.
   bool vetoed_when_queued(Entry& entry, const SimplifierLimits& limits, FaceId folded);
   void remember_rejected(VertexId v, VertexId other, FaceId folded);
   // Edge {a, b} among the vetoed edges of both ends, with the face whose fold vetoed it.
