@@ -147,12 +147,18 @@ void Simplifier::reject(VertexId a, VertexId b, FaceId folded) {
 }
 
 bool Simplifier::topologically_legal(VertexId a, VertexId b) const {
+  return topologically_legal(a, b, mesh_.edge_faces(a, b), false);
+}
+
+bool Simplifier::topologically_legal(VertexId a, VertexId b, const EdgeFaces& edge,
+                                     bool star_local_only) const {
   CollapseCandidate edge_only;
   edge_only.vs = a;
   edge_only.vt = b;
-  const EdgeFaces edge = mesh_.edge_faces(a, b);
   for (const auto& module : constraints_)
-    if (module->topological() && !module->allows(mesh_, edge_only, edge)) return false;
+    if (module->topological() && (!star_local_only || module->star_local()) &&
+        !module->allows(mesh_, edge_only, edge))
+      return false;
   return true;
 }
 
@@ -203,7 +209,7 @@ bool Simplifier::legal(const CollapseCandidate& candidate, const EdgeFaces& edge
     if ((topology_checked && module->topological()) || (star_checked && module->star_local()))
       continue;
     if (module->allows(mesh_, candidate, edge)) continue;
-    if (folded) *folded = module->star_local() ? module->folded_face() : kNoId;
+    if (folded) *folded = module->folded_face();
     return false;
   }
   return true;
@@ -312,13 +318,7 @@ bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits
         limits.max_cost == std::numeric_limits<double>::infinity()) {
       const EdgeFaces edge = mesh_.edge_faces(entry.a, entry.b);
       if (edge.left == kNoId && edge.right == kNoId) return false;
-      CollapseCandidate edge_only;
-      edge_only.vs = entry.a;
-      edge_only.vt = entry.b;
-      for (const auto& module : constraints_)
-        if (module->topological() && module->star_local() &&
-            !module->allows(mesh_, edge_only, edge))
-          return veto(kNoId);
+      if (!topologically_legal(entry.a, entry.b, edge, true)) return veto(kNoId);
       topology_checked = true;
     }
     candidate.seam = false;

@@ -268,6 +268,10 @@ class Simplifier {
   // Edge {a, b} among the vetoed edges of both ends, with the face whose fold vetoed it.
   void reject(VertexId a, VertexId b, FaceId folded = kNoId);
   bool topologically_legal(VertexId a, VertexId b) const;
+  // The same with the edge's faces given; with star_local_only, the rules that are also
+  // star_local() (those vetoed_when_queued asks).
+  bool topologically_legal(VertexId a, VertexId b, const EdgeFaces& edge,
+                           bool star_local_only) const;
   bool is_stale(const Entry& entry) const {
     return !mesh_.vertex_alive(entry.a) || !mesh_.vertex_alive(entry.b) ||
            version_[entry.a] + version_[entry.b] != (entry.stamp & kVersions);
