@@ -231,15 +231,25 @@ bool star_border(const CollapseMesh& mesh, VertexId a, VertexId b, const Vec3& o
   border.clear();
   for (const VertexId end : {a, b}) {
     if (!mesh.is_boundary(end)) continue;
+    // A face holding the reverse of a half-edge at end holds end too: the faces around end,
+    // as (next, previous), tell which of their half-edges lie on the border.
+    auto& fan = scratch.fan;
+    fan.clear();
     for (const FaceId f : mesh.faces_of(end)) {
       const Triangle& t = mesh.face(f);
       const int k = corner_of(t, end);
-      const VertexId next = t[(k + 1) % 3], previous = t[(k + 2) % 3];
+      fan.push_back({t[(k + 1) % 3], t[(k + 2) % 3]});
+    }
+    auto held = [&](VertexId from, VertexId to) {  // some face around end holds from -> to
+      for (const auto& [next, previous] : fan)
+        if ((from == end && to == next) || (to == end && from == previous)) return true;
+      return false;
+    };
+    for (const auto& [next, previous] : fan) {
       for (const auto& [from, to] : {std::pair{end, next}, std::pair{previous, end}}) {
         const VertexId far = from == end ? to : from;
         if (end == b && far == a) continue;
-        if (mesh.is_boundary(far) && mesh.edge_faces(to, from).left == kNoId)
-          border.push_back({from, to});
+        if (mesh.is_boundary(far) && !held(to, from)) border.push_back({from, to});
       }
     }
   }

@@ -53,6 +53,7 @@ struct StarTermsScratch {
   // faster than a term; ties on p1[0] are broken by the terms).
   std::vector<std::pair<double, uint32_t>> order;
   std::vector<std::pair<VertexId, VertexId>> border;  // directed as their faces hold them
+  std::vector<std::pair<VertexId, VertexId>> fan;     // a border end's faces: (next, previous)
   // Sums over the faces around one vertex v, each face (v, p1, p2) as its corners follow v:
   // cross = sum of (p1 - v) x (p2 - v), turn = sum of p2 - p1, planes = the faces' planes
   // weighted by area (when asked for).

@@ -151,5 +151,79 @@ TEST(StarSums, TheBitsDoNotDependOnIdsOrFaceOrder) {
         << a << " " << b;
 }
 
+// The border equations (star_border) against their definition: every half-edge of a live face
+// without a twin, with an end at a or b, once; e2 sums (p - o) x (q - o) over them, e1 the ends
+// that stay on those with one moving end. On a disc and on a sphere with holes cut, as drawn
+// and after collapses along the border (each end with one fan: a repaired mesh's).
+TEST(StarSums, TheBorderEquationsSumEveryBorderEdgeAtEitherEnd) {
+  auto border_by_definition = [](const CollapseMesh& mesh, VertexId a, VertexId b,
+                                 const Vec3& origin, Vec3& e1, Vec3& e2) {
+    std::set<std::pair<VertexId, VertexId>> held;
+    for (FaceId f = 0; f < mesh.face_capacity(); ++f)
+      if (mesh.face_alive(f))
+        for (int k = 0; k < 3; ++k) held.insert({mesh.face(f)[k], mesh.face(f)[(k + 1) % 3]});
+    e1 = e2 = {0, 0, 0};
+    bool any = false;
+    for (const auto& [p, q] : held) {
+      const bool p_moves = p == a || p == b, q_moves = q == a || q == b;
+      if ((!p_moves && !q_moves) || held.count({q, p})) continue;
+      any = true;
+      const Vec3 from = sub(mesh.position(p), origin), to = sub(mesh.position(q), origin);
+      e2 = add(e2, cross(from, to));
+      if (p_moves && !q_moves) e1 = add(e1, to);
+      if (q_moves && !p_moves) e1 = sub(e1, from);
+    }
+    return any;
+  };
+  // (holes apart: a vertex on two, a bowtie, is the repair's to split)
+  Mesh holed = testing::uv_sphere(10, 24, 0.1);
+  std::erase_if(holed.faces, [](const Triangle& t) {
+    return std::find(t.begin(), t.end(), VertexId(1 + 2 * 24 + 3)) != t.end() ||
+           std::find(t.begin(), t.end(), VertexId(1 + 6 * 24 + 15)) != t.end();
+  });
+  for (const Mesh& drawn : {testing::disc(4, 16), holed}) {
+    CollapseMesh mesh(drawn);
+    StarTermsScratch scratch;
+    auto check_every_edge = [&](const char* when) {
+      int checked = 0;
+      for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
+        if (!mesh.face_alive(f)) continue;
+        for (int k = 0; k < 3; ++k) {
+          const VertexId a = mesh.face(f)[k], b = mesh.face(f)[(k + 1) % 3];
+          const Vec3 origin = scale(add(mesh.position(a), mesh.position(b)), 0.5);
+          Vec3 e1, e2, want_e1, want_e2;
+          const bool found = star_border(mesh, a, b, origin, scratch, e1, e2);
+          ASSERT_EQ(found, border_by_definition(mesh, a, b, origin, want_e1, want_e2))
+              << when << ": " << a << " " << b;
+          if (!found) continue;
+          ++checked;
+          for (int i = 0; i < 3; ++i) {
+            EXPECT_NEAR(e1[i], want_e1[i], 1e-12) << when << ": " << a << " " << b;
+            EXPECT_NEAR(e2[i], want_e2[i], 1e-12) << when << ": " << a << " " << b;
+          }
+        }
+      }
+      EXPECT_GT(checked, 20) << when;
+    };
+    check_every_edge("as drawn");
+    // Border edges collapsed (b into a, where a is), those whose ends share their apex only
+    // (the link condition: each vertex keeps one fan).
+    int collapsed = 0;
+    for (FaceId f = 0; f < mesh.face_capacity() && collapsed < 6; ++f) {
+      for (int k = 0; k < 3 && mesh.face_alive(f); ++k) {
+        const VertexId a = mesh.face(f)[k], b = mesh.face(f)[(k + 1) % 3];
+        const EdgeFaces edge = mesh.edge_faces(a, b);
+        int common = 0;
+        mesh.for_each_common_neighbor(a, b, [&](VertexId) { ++common; });
+        if (edge.right != kNoId || common != 1) continue;  // not a border edge, or not legal
+        mesh.collapse(a, b, mesh.position(a), edge);
+        ++collapsed;
+      }
+    }
+    ASSERT_GT(collapsed, 0);
+    check_every_edge("after border collapses");
+  }
+}
+
 }  // namespace
 }  // namespace parapm
