@@ -43,6 +43,27 @@ void ByteWriter::bytes(const void* data, size_t size) {
   }
 }
 
+void ByteWriter::bytes_with_crc(const void* data, size_t size, uint32_t crc) {
+  update_crc();
+  crc_ = crc32_combine(crc_, crc, z_off_t(size));
+  const char* p = static_cast<const char*>(data);
+  if (size >= kBufferSize) {  // past the buffer: straight to the stream
+    flush_buffer();
+    if (out_) out_->write(p, std::streamsize(size));
+    flushed_ += size;
+    return;
+  }
+  while (size > 0) {
+    room(1);
+    const size_t n = std::min(size, kBufferSize - used_);
+    std::memcpy(buffer_.get() + used_, p, n);
+    used_ += n;
+    crc_done_ = used_;
+    p += n;
+    size -= n;
+  }
+}
+
 void ByteWriter::update_crc() {
   if (crc_done_ < used_)
     crc_ = crc32(crc_, reinterpret_cast<const Bytef*>(buffer_.get() + crc_done_),

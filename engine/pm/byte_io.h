@@ -53,6 +53,9 @@ class ByteWriter {
   void zigzag32(int32_t v) { varint((uint32_t(v) << 1) ^ uint32_t(v >> 31)); }
   void zigzag64(int64_t v) { varint((uint64_t(v) << 1) ^ uint64_t(v >> 63)); }
   void bytes(const void* data, size_t size);
+  // The same bytes, whose CRC-32 the caller has (another writer's crc() over exactly them):
+  // the running CRC is combined with it, not computed over them again.
+  void bytes_with_crc(const void* data, size_t size, uint32_t crc);
 
   uint64_t offset() const { return flushed_ + used_; }
   // CRC-32 of the bytes written since construction or the last reset_crc().

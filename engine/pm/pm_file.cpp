@@ -156,6 +156,7 @@ void write_splits(const ProgressiveMesh& pm, ByteWriter& out, std::vector<uint64
     });
     for (size_t r = 0; r < ranges; ++r) new_wedges[r + 1] += new_wedges[r];
     std::vector<std::string> bytes(ranges);
+    std::vector<uint32_t> crcs(ranges);
     std::vector<std::vector<uint64_t>> offsets(ranges);
     loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
       std::ostringstream buffer;
@@ -164,12 +165,13 @@ void write_splits(const ProgressiveMesh& pm, ByteWriter& out, std::vector<uint64
                         size_t(new_wedges[range]) * fpw, writer,
                         split_offsets ? &offsets[range] : nullptr);
       writer.flush();
+      crcs[range] = writer.crc();
       bytes[range] = std::move(buffer).str();
     });
     for (size_t r = 0; r < ranges; ++r) {
       if (split_offsets)
         for (uint64_t offset : offsets[r]) split_offsets->push_back(out.offset() + offset);
-      out.bytes(bytes[r].data(), bytes[r].size());
+      out.bytes_with_crc(bytes[r].data(), bytes[r].size(), crcs[r]);
     }
   }
   if (split_offsets) split_offsets->push_back(out.offset());
@@ -245,7 +247,7 @@ void write_pm(const ProgressiveMesh& pm, std::ostream& out, std::vector<uint64_t
 
 void write_pm(const ProgressiveMesh& pm, std::ostream& out, ChunkedLoops& loops,
               std::vector<uint64_t>* split_offsets) {
-  validate_pm(pm);
+  validate_pm(pm, loops);
   ByteWriter writer(&out);
   write_all(pm, writer, loops, split_offsets);
 }
@@ -264,7 +266,7 @@ void write_pm_file(const ProgressiveMesh& pm, const std::string& path) {
 }
 
 void write_pm_file(const ProgressiveMesh& pm, const std::string& path, ChunkedLoops& loops) {
-  validate_pm(pm);  // before the file is created
+  validate_pm(pm, loops);  // before the file is created
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(ErrorCode::kIo, "cannot open " + path + " for writing");
   try {

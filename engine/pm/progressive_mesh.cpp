@@ -10,6 +10,7 @@
 #include <cmath>
 #include <string>
 
+#include "util/chunked_loops.h"
 #include "util/error.h"
 
 namespace parapm {
@@ -186,97 +187,188 @@ void validate_copies_and_orders(const ProgressiveMesh& pm, const std::vector<Vec
   }
 }
 
+// What the splits before split i added: the wedges and wedge changes its checks count from.
+struct SplitsBefore {
+  uint64_t wedges = 0;   // wedges present before the split, the base's included
+  uint64_t changes = 0;  // wedge changes the splits before it own
+};
+
+// Split i's checks that need no replay of the splits before it: ids in range, errors, positions,
+// corner wedges, where its wedge changes and new wedge values lie. Throws naming the violation.
+void check_split_alone(const ProgressiveMesh& pm, size_t i, const SplitsBefore& before) {
+  const Mesh& base = pm.base;
+  const size_t fpw = size_t(base.layout.floats_per_wedge());
+  const VertexSplit& s = pm.splits[i];
+  // A function, not a string: messages are built only on failure (this runs per split).
+  const auto where = [i] { return "vsplit " + str(i); };
+  const uint64_t n = base.vertex_count() + i;  // vertices present before the split
+  if (s.vs >= n) fail(where() + ": vs " + str(s.vs) + " out of range (" + str(n) + " vertices)");
+  if (s.vl != kNoId && s.vl >= n)
+    fail(where() + ": vl " + str(s.vl) + " out of range (" + str(n) + " vertices)");
+  if (s.vr != kNoId && s.vr >= n)
+    fail(where() + ": vr " + str(s.vr) + " out of range (" + str(n) + " vertices)");
+  if (!s.has_fl() && !s.has_fr()) fail(where() + " has neither vl nor vr");
+  if (s.vl == s.vr) fail(where() + ": vl and vr are both " + str(s.vl));
+  if (s.vl == s.vs || s.vr == s.vs) fail(where() + ": vl or vr equals vs " + str(s.vs));
+  if (!std::isfinite(s.error) || s.error < 0)
+    fail(where() + ": error " + std::to_string(s.error) + " is not a finite non-negative number");
+  if (i > 0 && s.error > pm.splits[i - 1].error)
+    fail(where() + ": error " + std::to_string(s.error) + " exceeds the previous split's " +
+         std::to_string(pm.splits[i - 1].error) + " (errors must not increase)");
+  check_position(s.vs_before, base.positions_are_float, [&] { return where() + " vs_before"; });
+  check_position(s.vs_after, base.positions_are_float, [&] { return where() + " vs_after"; });
+  check_position(s.vt_after, base.positions_are_float, [&] { return where() + " vt_after"; });
+
+  validate_corner_wedges(s, i, base.layout.any(), before.wedges);
+  if (s.wedge_changes_begin != before.changes)
+    fail(where() + ": its wedge changes begin at " + str(s.wedge_changes_begin) + ", expected " +
+         str(before.changes) + " (changes are stored in split order)");
+  if (uint64_t(s.wedge_changes_count) > pm.wedge_changes.size() - before.changes)
+    fail(where() + ": wedge changes run past the end of the list");
+  for (uint32_t c = 0; c < s.wedge_changes_count; ++c) {
+    const WedgeChange& change = pm.wedge_changes[before.changes + c];
+    if (change.wedge >= before.wedges)
+      fail(where() + ": changes wedge " + str(change.wedge) + " but only " + str(before.wedges) +
+           " existed before it");
+    if (uint64_t(change.values_offset) + 2 * fpw > pm.wedge_change_values.size())
+      fail(where() + ": wedge change values out of range");
+  }
+  const uint64_t wedges_after = before.wedges + s.new_wedge_count;
+  if (wedges_after > kMaxElements) fail("too many wedges for 32-bit ids");
+  if ((wedges_after - base.wedge_count()) * fpw > pm.new_wedge_values.size())
+    fail(where() + ": new wedge values missing");
+}
+
+// The splits' bookkeeping replayed in order, one split at a time after its own checks passed
+// (check_split_alone): every split's vs_before is where vs is at that level, every wedge change's
+// coarse values are the wedge's values there, and no split changes a wedge twice. Ends with
+// every vertex's full-resolution position.
+class SplitReplay {
+ public:
+  explicit SplitReplay(const ProgressiveMesh& pm)
+      : pm_(pm),
+        fpw_(size_t(pm.base.layout.floats_per_wedge())),
+        position_(pm.base.positions),
+        // A wedge is read only once it exists: every wedge's value as created, up front.
+        wedge_value_(pm.base.wedge_values),
+        changed_in_(pm.base.wedge_count() + pm.new_wedge_values.size() / std::max<size_t>(fpw_, 1),
+                    ~uint64_t(0)) {
+    position_.reserve(pm.base.vertex_count() + pm.splits.size());
+    wedge_value_.insert(wedge_value_.end(), pm.new_wedge_values.begin(), pm.new_wedge_values.end());
+  }
+
+  void step(size_t i) {
+    const VertexSplit& s = pm_.splits[i];
+    if (!same_bits(s.vs_before, position_[s.vs]))
+      fail("vsplit " + str(i) + ": vs_before is not the position of vertex " + str(s.vs) +
+           " at that level");
+    position_[s.vs] = s.vs_after;
+    position_.push_back(s.vt_after);
+    for (uint32_t c = 0; c < s.wedge_changes_count; ++c) {
+      const WedgeChange& change = pm_.wedge_changes[s.wedge_changes_begin + c];
+      if (changed_in_[change.wedge] == i)
+        fail("vsplit " + str(i) + " changes wedge " + str(change.wedge) + " twice");
+      changed_in_[change.wedge] = i;
+      const float* coarse = pm_.wedge_change_values.data() + change.values_offset;
+      float* current = wedge_value_.data() + size_t(change.wedge) * fpw_;
+      for (size_t k = 0; k < fpw_; ++k)
+        if (std::bit_cast<uint32_t>(coarse[k]) != std::bit_cast<uint32_t>(current[k]))
+          fail("vsplit " + str(i) + ": the coarse value of wedge " + str(change.wedge) +
+               " is not its value at that level");
+      std::copy(coarse + fpw_, coarse + 2 * fpw_, current);
+    }
+  }
+
+  const std::vector<Vec3>& positions() const { return position_; }
+
+ private:
+  const ProgressiveMesh& pm_;
+  size_t fpw_;
+  std::vector<Vec3> position_;
+  std::vector<float> wedge_value_;
+  std::vector<uint64_t> changed_in_;  // per wedge: the split that last changed it
+};
+
+// The checks after the last split: the totals the splits add up to.
+void check_totals(const ProgressiveMesh& pm, const SplitsBefore& all, uint64_t faces) {
+  const size_t fpw = size_t(pm.base.layout.floats_per_wedge());
+  const uint64_t base_wedges = pm.base.wedge_count();
+  if (faces > kMaxElements) fail("too many faces for 32-bit ids");
+  if (all.changes != pm.wedge_changes.size())
+    fail("the splits own " + str(all.changes) + " wedge changes but the PM lists " +
+         str(pm.wedge_changes.size()));
+  if ((all.wedges - base_wedges) * fpw != pm.new_wedge_values.size())
+    fail("the splits introduce " + str(all.wedges - base_wedges) + " wedges but the PM holds " +
+         str(pm.new_wedge_values.size()) + " new wedge values");
+}
+
+void check_split_count(const ProgressiveMesh& pm) {
+  if (pm.base.vertex_count() + pm.splits.size() > kMaxElements)
+    fail("too many vertices for 32-bit ids");
+}
+
 }  // namespace
 
 void validate_pm(const ProgressiveMesh& pm) {
-  const Mesh& base = pm.base;
-  validate_base(base);
-  const bool attributes = base.layout.any();
-  const size_t fpw = size_t(base.layout.floats_per_wedge());
-  const uint64_t n0 = base.vertex_count();
-  if (n0 + pm.splits.size() > kMaxElements) fail("too many vertices for 32-bit ids");
-
-  // Replay the bookkeeping of the splits: where every vertex is, which wedges exist and
-  // their values, so that vs_before and the coarse values of wedge changes can be checked.
-  std::vector<Vec3> position(base.positions);
-  position.reserve(n0 + pm.splits.size());
-  std::vector<float> wedge_value(base.wedge_values);
-  std::vector<uint64_t> changed_in(base.wedge_count(), ~uint64_t(0));  // split that last changed
-  uint64_t wedges = base.wedge_count();
-  uint64_t faces = base.face_count();
-  uint64_t changes = 0;
-  float previous_error = 0;
+  validate_base(pm.base);
+  check_split_count(pm);
+  SplitsBefore before{pm.base.wedge_count(), 0};
+  uint64_t faces = pm.base.face_count();
+  SplitReplay replay(pm);
   for (size_t i = 0; i < pm.splits.size(); ++i) {
     const VertexSplit& s = pm.splits[i];
-    // A function, not a string: messages are built only on failure (this runs per split).
-    const auto where = [i] { return "vsplit " + str(i); };
-    const uint64_t n = n0 + i;  // vertices present before the split
-    if (s.vs >= n) fail(where() + ": vs " + str(s.vs) + " out of range (" + str(n) + " vertices)");
-    if (s.vl != kNoId && s.vl >= n)
-      fail(where() + ": vl " + str(s.vl) + " out of range (" + str(n) + " vertices)");
-    if (s.vr != kNoId && s.vr >= n)
-      fail(where() + ": vr " + str(s.vr) + " out of range (" + str(n) + " vertices)");
-    if (!s.has_fl() && !s.has_fr()) fail(where() + " has neither vl nor vr");
-    if (s.vl == s.vr) fail(where() + ": vl and vr are both " + str(s.vl));
-    if (s.vl == s.vs || s.vr == s.vs) fail(where() + ": vl or vr equals vs " + str(s.vs));
-    if (!std::isfinite(s.error) || s.error < 0)
-      fail(where() + ": error " + std::to_string(s.error) + " is not a finite non-negative number");
-    if (i > 0 && s.error > previous_error)
-      fail(where() + ": error " + std::to_string(s.error) + " exceeds the previous split's " +
-           std::to_string(previous_error) + " (errors must not increase)");
-    previous_error = s.error;
-    check_position(s.vs_before, base.positions_are_float, [&] { return where() + " vs_before"; });
-    check_position(s.vs_after, base.positions_are_float, [&] { return where() + " vs_after"; });
-    check_position(s.vt_after, base.positions_are_float, [&] { return where() + " vt_after"; });
-    if (!same_bits(s.vs_before, position[s.vs]))
-      fail(where() + ": vs_before is not the position of vertex " + str(s.vs) + " at that level");
-    position[s.vs] = s.vs_after;
-    position.push_back(s.vt_after);
+    check_split_alone(pm, i, before);
+    replay.step(i);
+    before.wedges += s.new_wedge_count;
+    before.changes += s.wedge_changes_count;
     faces += uint64_t(s.new_faces());
-
-    validate_corner_wedges(s, i, attributes, wedges);
-    if (s.wedge_changes_begin != changes)
-      fail(where() + ": its wedge changes begin at " + str(s.wedge_changes_begin) + ", expected " +
-           str(changes) + " (changes are stored in split order)");
-    if (uint64_t(s.wedge_changes_count) > pm.wedge_changes.size() - changes)
-      fail(where() + ": wedge changes run past the end of the list");
-    for (uint32_t c = 0; c < s.wedge_changes_count; ++c) {
-      const WedgeChange& change = pm.wedge_changes[changes + c];
-      if (change.wedge >= wedges)
-        fail(where() + ": changes wedge " + str(change.wedge) + " but only " + str(wedges) +
-             " existed before it");
-      if (changed_in[change.wedge] == i)
-        fail(where() + " changes wedge " + str(change.wedge) + " twice");
-      changed_in[change.wedge] = i;
-      if (uint64_t(change.values_offset) + 2 * fpw > pm.wedge_change_values.size())
-        fail(where() + ": wedge change values out of range");
-      const float* coarse = pm.wedge_change_values.data() + change.values_offset;
-      float* current = wedge_value.data() + size_t(change.wedge) * fpw;
-      for (size_t k = 0; k < fpw; ++k)
-        if (std::bit_cast<uint32_t>(coarse[k]) != std::bit_cast<uint32_t>(current[k]))
-          fail(where() + ": the coarse value of wedge " + str(change.wedge) +
-               " is not its value at that level");
-      std::copy(coarse + fpw, coarse + 2 * fpw, current);
-    }
-    changes += s.wedge_changes_count;
-
-    const uint64_t first_new = (wedges - base.wedge_count()) * fpw;
-    wedges += s.new_wedge_count;
-    if (wedges > kMaxElements) fail("too many wedges for 32-bit ids");
-    if (wedges * fpw - base.wedge_count() * fpw > pm.new_wedge_values.size())
-      fail(where() + ": new wedge values missing");
-    wedge_value.insert(wedge_value.end(), pm.new_wedge_values.begin() + first_new,
-                       pm.new_wedge_values.begin() + (wedges - base.wedge_count()) * fpw);
-    changed_in.resize(wedges, ~uint64_t(0));
   }
-  if (faces > kMaxElements) fail("too many faces for 32-bit ids");
-  if (changes != pm.wedge_changes.size())
-    fail("the splits own " + str(changes) + " wedge changes but the PM lists " +
-         str(pm.wedge_changes.size()));
-  if ((wedges - base.wedge_count()) * fpw != pm.new_wedge_values.size())
-    fail("the splits introduce " + str(wedges - base.wedge_count()) + " wedges but the PM holds " +
-         str(pm.new_wedge_values.size()) + " new wedge values");
-  validate_copies_and_orders(pm, position);
+  check_totals(pm, before, faces);
+  validate_copies_and_orders(pm, replay.positions());
+}
+
+void validate_pm(const ProgressiveMesh& pm, ChunkedLoops& loops) {
+  const size_t n = pm.splits.size();
+  const size_t ranges = loops.ranges(n);
+  if (ranges <= 1) return validate_pm(pm);
+  validate_base(pm.base);
+  check_split_count(pm);
+  // Per range, what the splits before it added.
+  std::vector<SplitsBefore> before(ranges + 1);
+  std::vector<uint64_t> faces(ranges + 1, 0);
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    SplitsBefore& added = before[range + 1];
+    for (size_t i = begin; i < end; ++i) {
+      added.wedges += pm.splits[i].new_wedge_count;
+      added.changes += pm.splits[i].wedge_changes_count;
+      faces[range + 1] += uint64_t(pm.splits[i].new_faces());
+    }
+  });
+  before[0] = {pm.base.wedge_count(), 0};
+  faces[0] = pm.base.face_count();
+  for (size_t r = 0; r < ranges; ++r) {
+    before[r + 1].wedges += before[r].wedges;
+    before[r + 1].changes += before[r].changes;
+    faces[r + 1] += faces[r];
+  }
+  try {
+    loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+      SplitsBefore at = before[range];
+      for (size_t i = begin; i < end; ++i) {
+        check_split_alone(pm, i, at);
+        at.wedges += pm.splits[i].new_wedge_count;
+        at.changes += pm.splits[i].wedge_changes_count;
+      }
+    });
+  } catch (const Error&) {
+    validate_pm(pm);  // names the first violation in split order, as one thread does
+    throw;
+  }
+  // Every split passed its own checks: the replay's first violation is the first of all.
+  SplitReplay replay(pm);
+  for (size_t i = 0; i < n; ++i) replay.step(i);
+  check_totals(pm, before[ranges], faces[ranges]);
+  validate_copies_and_orders(pm, replay.positions());
 }
 
 }  // namespace parapm

@@ -27,6 +27,8 @@
 
 namespace parapm {
 
+class ChunkedLoops;
+
 struct VertexSplit {
   VertexId vs = kNoId;
   VertexId vl = kNoId;  // third corner of fl, or kNoId
@@ -91,5 +93,8 @@ struct ProgressiveMesh {
 // non-increasing, copies and orders are permutations of the right size); throws
 // Error(kInvalidInput) naming the first violation. Readers of untrusted .pm files call it.
 void validate_pm(const ProgressiveMesh& pm);
+// The same checks and the same error, each split's own checks in `loops`' chunks side by side
+// and the replay of positions and wedge values after them, in one pass.
+void validate_pm(const ProgressiveMesh& pm, ChunkedLoops& loops);
 
 }  // namespace parapm

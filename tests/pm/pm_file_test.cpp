@@ -14,6 +14,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include "pm/byte_io.h"
 #include "pm/pm_format.h"
 #include "pm/pm_restore.h"
 #include "pm_fixtures.h"
@@ -158,6 +159,29 @@ TEST(PmFile, TheSplitsWrittenInChunksAreTheSameBytes) {
       EXPECT_EQ(a.min, b.min);
       EXPECT_EQ(a.max, b.max);
     }
+  }
+}
+
+// Bytes appended with their CRC known (a chunk's own writer's) are the same bytes and the same
+// running CRC as bytes written plainly: short ones through the buffer, long ones past it.
+TEST(PmFile, BytesWithTheirCrcKeepTheRunningCrc) {
+  for (const size_t size : {size_t(0), size_t(5), size_t(70000), size_t(300000)}) {
+    std::string chunk(size, '\0');
+    for (size_t i = 0; i < size; ++i) chunk[i] = char(i * 131 + (i >> 9));
+    ByteWriter counted(nullptr);
+    counted.bytes(chunk.data(), chunk.size());
+    const uint32_t chunk_crc = counted.crc();
+    std::ostringstream plain_out, combined_out;
+    ByteWriter plain(&plain_out), combined(&combined_out);
+    for (ByteWriter* w : {&plain, &combined}) w->u32(0xdeadbeef);
+    plain.bytes(chunk.data(), chunk.size());
+    combined.bytes_with_crc(chunk.data(), chunk.size(), chunk_crc);
+    for (ByteWriter* w : {&plain, &combined}) w->varint(300);
+    EXPECT_EQ(combined.offset(), plain.offset()) << size;
+    EXPECT_EQ(combined.crc(), plain.crc()) << size;
+    plain.flush();
+    combined.flush();
+    EXPECT_EQ(combined_out.str(), plain_out.str()) << size;
   }
 }
 

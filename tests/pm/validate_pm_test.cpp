@@ -9,20 +9,41 @@
 #include "pm/progressive_mesh.h"
 #include "pm_fixtures.h"
 #include "test_support.h"
+#include "util/chunked_loops.h"
 #include "util/error.h"
 
 namespace parapm {
 namespace {
 
-// Expects validate_pm to throw kInvalidInput with `fragment` in its message.
-void expect_invalid(const ProgressiveMesh& pm, const std::string& fragment) {
+// validate_pm in chunks of a split or more each, on two threads: every test's PMs go through
+// it too, and must fail with the very error the one-thread check gives.
+ChunkedLoops split_chunks() { return ChunkedLoops(4, 2, 1); }
+
+// validate_pm's error message, or "" when it accepts the PM.
+std::string error_of(const std::function<void()>& validate) {
   try {
-    validate_pm(pm);
-    ADD_FAILURE() << "accepted; expected an error about '" << fragment << "'";
+    validate();
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kInvalidInput);
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    return e.what();
   }
+  return "";
+}
+
+// Expects validate_pm to throw kInvalidInput with `fragment` in its message, and the chunked
+// check the same message.
+void expect_invalid(const ProgressiveMesh& pm, const std::string& fragment) {
+  const std::string error = error_of([&] { validate_pm(pm); });
+  if (error.empty()) ADD_FAILURE() << "accepted; expected an error about '" << fragment << "'";
+  EXPECT_NE(error.find(fragment), std::string::npos) << error;
+  ChunkedLoops loops = split_chunks();
+  EXPECT_EQ(error_of([&] { validate_pm(pm, loops); }), error);
+}
+
+void expect_valid(const ProgressiveMesh& pm) {
+  EXPECT_NO_THROW(validate_pm(pm));
+  ChunkedLoops loops = split_chunks();
+  EXPECT_NO_THROW(validate_pm(pm, loops));
 }
 
 ProgressiveMesh with(ProgressiveMesh pm, const std::function<void(ProgressiveMesh&)>& edit) {
@@ -31,12 +52,32 @@ ProgressiveMesh with(ProgressiveMesh pm, const std::function<void(ProgressiveMes
 }
 
 TEST(ValidatePm, FixturesAreValid) {
-  EXPECT_NO_THROW(validate_pm(testing::strip_pm()));
-  EXPECT_NO_THROW(validate_pm(testing::octahedron_pm(false)));
-  EXPECT_NO_THROW(validate_pm(testing::octahedron_pm(true)));
-  EXPECT_NO_THROW(validate_pm(testing::cut_fan_pm()));
-  EXPECT_NO_THROW(validate_pm(testing::random_pm(200, {false, true, false, 5})));
-  EXPECT_NO_THROW(validate_pm(ProgressiveMesh{}));
+  expect_valid(testing::strip_pm());
+  expect_valid(testing::octahedron_pm(false));
+  expect_valid(testing::octahedron_pm(true));
+  expect_valid(testing::cut_fan_pm());
+  expect_valid(testing::random_pm(200, {false, true, false, 5}));
+  expect_valid(ProgressiveMesh{});
+}
+
+// A PM of many splits in many chunks: a violation late in one chunk and one early in the next
+// are reported in split order, whichever chunk finds its own first.
+TEST(ValidatePm, ChunksReportTheFirstViolationInSplitOrder) {
+  const ProgressiveMesh pm = testing::random_pm(200, {false, true, false, 5});
+  ASSERT_GT(pm.splits.size(), 40u);
+  ChunkedLoops loops(8, 2, 1);
+  const size_t late = pm.splits.size() / 2 - 1, early = pm.splits.size() / 2 + 1;
+  ProgressiveMesh broken = with(pm, [&](auto& p) {
+    p.splits[early].vs = kNoId - 1;                      // a split's own check, in a later chunk
+    p.splits[late].vs_before = p.splits[late].vt_after;  // the replay's, earlier
+  });
+  const std::string one_thread = error_of([&] { validate_pm(broken); });
+  EXPECT_NE(one_thread.find("vsplit " + std::to_string(late) + ": vs_before"), std::string::npos)
+      << one_thread;
+  EXPECT_EQ(error_of([&] { validate_pm(broken, loops); }), one_thread);
+  broken.splits[late] = pm.splits[late];
+  EXPECT_NE(error_of([&] { validate_pm(broken, loops); }).find("vsplit " + std::to_string(early)),
+            std::string::npos);
 }
 
 TEST(ValidatePm, Counts) {
@@ -74,10 +115,10 @@ TEST(ValidatePm, PositionsAndErrors) {
                  "non-finite");
   expect_invalid(with(strip, [](auto& pm) { pm.base.positions[4][0] = 0.1; }), "not a float32");
   expect_invalid(with(strip, [](auto& pm) { pm.splits[1].vs_after[0] = 0.1; }), "not a float32");
-  EXPECT_NO_THROW(validate_pm(with(strip, [](auto& pm) {
+  expect_valid(with(strip, [](auto& pm) {
     pm.base.positions_are_float = false;
     pm.splits[1].vs_after[0] = 0.1;
-  })));
+  }));
   expect_invalid(with(strip, [](auto& pm) { pm.splits[1].error = 0.75f; }), "must not increase");
   expect_invalid(with(strip, [](auto& pm) { pm.splits[1].error = -1; }), "non-negative");
   expect_invalid(
@@ -142,7 +183,7 @@ TEST(ValidatePm, CopiesAndOrders) {
   ProgressiveMesh strip = testing::strip_pm();
   strip.splits[0].vt_after = {2, 2, 0};  // vertex 5 ends where vertex 4 is
   ASSERT_NO_THROW(validate_pm(strip));
-  EXPECT_NO_THROW(validate_pm(with(strip, [](auto& pm) { pm.vertex_copies = {{5, 4}}; })));
+  expect_valid(with(strip, [](auto& pm) { pm.vertex_copies = {{5, 4}}; }));
   expect_invalid(with(strip,
                       [](auto& pm) {
                         pm.vertex_copies = {{5, 3}};
@@ -168,7 +209,7 @@ TEST(ValidatePm, CopiesAndOrders) {
     pm.input_face_order = {0, 1, 2, 3, 4, 5};
     return pm;
   };
-  EXPECT_NO_THROW(validate_pm(ordered(strip)));
+  expect_valid(ordered(strip));
   expect_invalid(with(ordered(strip), [](auto& pm) { pm.input_vertex_order.pop_back(); }),
                  "6 entries for 7 vertices");
   expect_invalid(with(ordered(strip), [](auto& pm) { pm.input_vertex_order[0] = 5; }),
@@ -179,10 +220,10 @@ TEST(ValidatePm, CopiesAndOrders) {
                  "input face 4 twice");
   // A copy maps to its original's input vertex; an input vertex the repair removed leaves a
   // gap (the map is injective, not onto).
-  EXPECT_NO_THROW(validate_pm(with(ordered(strip), [](auto& pm) {
+  expect_valid(with(ordered(strip), [](auto& pm) {
     pm.vertex_copies = {{5, 4}};
     pm.input_vertex_order = {0, 1, 2, 3, 6, 6, 5};
-  })));
+  }));
   expect_invalid(with(ordered(strip),
                       [](auto& pm) {
                         pm.vertex_copies = {{5, 4}};
