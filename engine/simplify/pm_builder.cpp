@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <utility>
 
+#include "util/chunked_loops.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 
 namespace parapm {
 namespace {
@@ -53,6 +56,46 @@ class WedgeNumbering {
 
 // Replays the records' wedge value changes from the input's values: returns the values at the
 // base mesh and, per change in record order, the values it replaced (floats each).
+// The copies made by the repair step, (copy, original) in the PM's ids, sorted: each vertex that
+// came from the same input vertex as a vertex of a lesser id goes back to the least one (the
+// original) when the input is restored. In `loops`' chunks: the least vertex of each input
+// vertex, then each range's copies.
+std::vector<std::pair<VertexId, VertexId>> vertex_copies(const RepairedMesh& repaired,
+                                                         const std::vector<VertexId>& pm_vertex,
+                                                         ChunkedLoops& loops) {
+  const std::vector<VertexId>& input = repaired.input_vertex;
+  const size_t n = input.size();
+  std::vector<size_t> range_inputs(loops.ranges(n), 0);  // per range: its largest input + 1
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v)
+      range_inputs[range] = std::max(range_inputs[range], size_t(input[v]) + 1);
+  });
+  const size_t inputs =
+      range_inputs.empty() ? 0 : *std::max_element(range_inputs.begin(), range_inputs.end());
+  std::vector<VertexId> first_of_input(inputs, kNoId);
+  loops.run(n, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      std::atomic_ref<VertexId> first(first_of_input[input[v]]);
+      VertexId seen = first.load(std::memory_order_relaxed);
+      while (VertexId(v) < seen &&
+             !first.compare_exchange_weak(seen, VertexId(v), std::memory_order_relaxed)) {
+      }
+    }
+  });
+  std::vector<std::vector<std::pair<VertexId, VertexId>>> range_copies(loops.ranges(n));
+  loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      const VertexId original = first_of_input[input[v]];
+      if (original != VertexId(v))
+        range_copies[range].emplace_back(pm_vertex[v], pm_vertex[original]);
+    }
+  });
+  std::vector<std::pair<VertexId, VertexId>> copies;
+  for (const auto& some : range_copies) copies.insert(copies.end(), some.begin(), some.end());
+  std::sort(copies.begin(), copies.end());
+  return copies;
+}
+
 std::vector<float> replay_wedge_changes(const Mesh& mesh,
                                         const std::vector<CollapseRecord>& records,
                                         std::vector<float>& replaced) {
@@ -171,7 +214,7 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
     new_faces[range + 1] = count;
   });
   for (size_t r = 0; r + 1 < new_faces.size(); ++r) new_faces[r + 1] += new_faces[r];
-  pm.splits.resize(splits);
+  resize_touched(pm.splits, splits, loops);
   loops.run_indexed(splits, [&](size_t range, size_t begin, size_t end) {
     FaceId next_face = FaceId(base_faces + new_faces[range]);
     for (size_t j = begin; j < end; ++j) {
@@ -219,26 +262,18 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
       base_faces + new_faces.back() != mesh.face_count())
     throw_internal("PM builder: the collapses do not account for every vertex and face");
 
-  // Copies made by the repair step go back to their original (the first vertex that came
-  // from the same input vertex) when the input is restored.
-  std::vector<VertexId> first_of_input;
-  for (VertexId v = 0; v < mesh.vertex_count(); ++v) {
-    const VertexId in = repaired.input_vertex[v];
-    if (in >= first_of_input.size()) first_of_input.resize(size_t(in) + 1, kNoId);
-    if (first_of_input[in] == kNoId)
-      first_of_input[in] = v;
-    else
-      pm.vertex_copies.emplace_back(pm_vertex[v], pm_vertex[first_of_input[in]]);
-  }
-  std::sort(pm.vertex_copies.begin(), pm.vertex_copies.end());
-
+  pm.vertex_copies = vertex_copies(repaired, pm_vertex, loops);
   if (options.keep_order) {
+    // pm_vertex and pm_face are permutations: each chunk writes its own entries.
     pm.input_vertex_order.assign(mesh.vertex_count(), 0);
-    for (VertexId v = 0; v < mesh.vertex_count(); ++v)
-      pm.input_vertex_order[pm_vertex[v]] = repaired.input_vertex[v];
+    loops.run(mesh.vertex_count(), [&](size_t begin, size_t end) {
+      for (size_t v = begin; v < end; ++v)
+        pm.input_vertex_order[pm_vertex[v]] = repaired.input_vertex[v];
+    });
     pm.input_face_order.assign(mesh.face_count(), 0);
-    for (FaceId f = 0; f < mesh.face_count(); ++f)
-      pm.input_face_order[pm_face[f]] = repaired.input_face[f];
+    loops.run(mesh.face_count(), [&](size_t begin, size_t end) {
+      for (size_t f = begin; f < end; ++f) pm.input_face_order[pm_face[f]] = repaired.input_face[f];
+    });
   }
   return pm;
 }
