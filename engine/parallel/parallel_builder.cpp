@@ -926,15 +926,14 @@ double ParallelBuilder::take_results(Round& r) {
     // them all in its queue); the others stand unless a collapse changed an end.
     drop_changed(deferred_, whole_->vertex_capacity(), changes);
     // A job reports again what it was given and left as it was: its report first, so
-    // that the stable sort keeps it.
-    std::vector<DeferredEdge> now;
+    // that the merge keeps it.
+    std::vector<const std::vector<DeferredEdge>*> lists;
     for (SubsetResult& result : r.results) {
       check_deferred_edges(result.deferred, whole_->vertex_capacity());
-      now.insert(now.end(), result.deferred.begin(), result.deferred.end());
+      lists.push_back(&result.deferred);
     }
-    now.insert(now.end(), deferred_.begin(), deferred_.end());
-    sort_unique_edges(now);
-    deferred_ = std::move(now);
+    lists.push_back(&deferred_);
+    deferred_ = merge_unique_edges(lists);
   }
   keys_->reset(returned);
   return seconds_since(tb) - import_saved;

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "simplify/collapse_mesh.h"
@@ -70,6 +71,49 @@ void sort_unique_edges(std::vector<Edge>& edges) {
   edges.erase(std::unique(edges.begin(), edges.end(),
                           [](const Edge& x, const Edge& y) { return x.a == y.a && x.b == y.b; }),
               edges.end());
+}
+
+// sort_unique_edges of the lists joined in order, merged where each list is sorted already (the
+// lists of a parallel build's jobs and the master's): O(n log lists), not a sort of them all.
+template <typename Edge>
+std::vector<Edge> merge_unique_edges(const std::vector<const std::vector<Edge>*>& lists) {
+  std::vector<Edge> out;
+  size_t total = 0;
+  bool sorted = true;
+  for (const std::vector<Edge>* list : lists) {
+    total += list->size();
+    sorted = sorted && std::is_sorted(list->begin(), list->end(), ByEdge{});
+  }
+  out.reserve(total);
+  if (!sorted) {
+    for (const std::vector<Edge>* list : lists) out.insert(out.end(), list->begin(), list->end());
+    sort_unique_edges(out);
+    return out;
+  }
+  // A heap of each list's next record, by edge, then by list: among equal edges the earlier
+  // list's record comes out first and is the one kept, as the stable sort keeps it.
+  std::vector<std::pair<size_t, size_t>> heads;  // (list, index)
+  auto later = [&](const std::pair<size_t, size_t>& x, const std::pair<size_t, size_t>& y) {
+    const Edge& ex = (*lists[x.first])[x.second];
+    const Edge& ey = (*lists[y.first])[y.second];
+    if (ex.a != ey.a) return ex.a > ey.a;
+    if (ex.b != ey.b) return ex.b > ey.b;
+    return x.first > y.first;
+  };
+  for (size_t l = 0; l < lists.size(); ++l)
+    if (!lists[l]->empty()) heads.emplace_back(l, 0);
+  std::make_heap(heads.begin(), heads.end(), later);
+  while (!heads.empty()) {
+    std::pop_heap(heads.begin(), heads.end(), later);
+    auto& [l, i] = heads.back();
+    const Edge& e = (*lists[l])[i];
+    if (out.empty() || out.back().a != e.a || out.back().b != e.b) out.push_back(e);
+    if (++i < lists[l]->size())
+      std::push_heap(heads.begin(), heads.end(), later);
+    else
+      heads.pop_back();
+  }
+  return out;
 }
 
 struct SimplifierLimits {
