@@ -117,7 +117,8 @@ double EnergyPriority::diagonal_of(const CollapseMesh& mesh) const {
 
 void EnergyPriority::evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
                                    Costing costing) {
-  if (!team_ || !team_awake_ || edges.size() < 2 || scalar_.enabled()) {
+  if (!team_ || edges.size() < 2 || scalar_.enabled() ||
+      (!team_awake_ && edges.size() < kEdgesWakingTheTeam)) {
     PriorityModule::evaluate_each(mesh, edges, costing);
     return;
   }

@@ -177,10 +177,12 @@ class EnergyPriority : public PriorityModule {
                                EnergySeam{vs, at});
   }
   // On the team, one edge per range, when the collapse before woke it (its projections ran
-  // there) and there are two edges or more, without E_scalar (whose costing writes the
-  // module's attribute scratch): each range costs on a view of the evaluator.
+  // there) and there are two edges or more, or when there are kEdgesWakingTheTeam or more (a
+  // first queue's), without E_scalar (whose costing writes the module's attribute scratch):
+  // each range costs on a view of the evaluator.
   void evaluate_each(const CollapseMesh& mesh, std::span<EdgeCosting> edges,
                      Costing costing) override;
+  static constexpr size_t kEdgesWakingTheTeam = 64;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   uint64_t costings() const override;
   void release_caches() override { evaluator_.release(); }

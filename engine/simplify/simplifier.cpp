@@ -21,6 +21,11 @@ void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
   std::vector<uint8_t> listed(mesh_.vertex_capacity(), 0);
   for (VertexId v : vertices)
     if (v < listed.size()) listed[v] = 1;
+  // A costly module's costings of single edges are planned and made together
+  // (PriorityModule::evaluate_each: on its team, if it has one); seams are costed at once. The
+  // queue's order does not depend on the order of its pushes.
+  const bool together = priority_.costly();
+  size_t costings = 0;
   std::vector<VertexId> ring;
   for (size_t i = 0; i < vertices.size(); ++i) {
     const VertexId v = vertices[i];
@@ -30,9 +35,24 @@ void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
     for (VertexId u : ring) {
       if (listed[u] && u < v)
         continue;  // an edge between two listed vertices: from its smaller end
+      if (together && !seam_edge(v, u)) {
+        if (costings == costed_.size()) costed_.emplace_back();
+        EdgeCosting& planned = costed_[costings++];
+        planned.a = std::min(v, u);
+        planned.b = std::max(v, u);
+        planned.candidate.seam = false;
+        ++stats_.evaluations;
+        continue;
+      }
       Entry entry;
       if (queue_entry(v, u, entry)) queue_.push(entry);
     }
+  }
+  if (costings == 0) return;
+  priority_.evaluate_each(mesh_, std::span(costed_).first(costings), Costing::kQueue);
+  for (const EdgeCosting& c : std::span(costed_).first(costings)) {
+    Entry entry;
+    if (entry_of_costing(c.a, c.b, c.placed, c.candidate.cost, entry)) queue_.push(entry);
   }
 }
 

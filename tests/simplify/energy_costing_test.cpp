@@ -481,6 +481,39 @@ TEST(EnergyPriority, EdgesCostedTogetherOnTheTeamCostAsOneAfterAnother) {
   }
 }
 
+// A first queue's many edges (a band pass's, Simplifier::queue_edges_around) go to the team
+// before any collapse woke it, and cost as one after another; a few edges stay off it.
+TEST(EnergyPriority, ManyEdgesAreCostedOnTheTeamBeforeACollapseWakesIt) {
+  Simplified s = simplified("cad-featuretype-3k.stl", EnergyOptions{}, 0.2);
+  CollapseMesh& mesh = *s.mesh;
+  EnergyPriority& energy = *s.energy;
+  ThreadTeam team(4, 4, 1);
+  energy.use_team(&team);
+  std::vector<EdgeCosting> edges;
+  for_each_edge(mesh, [&](VertexId a, VertexId b) {
+    if (mesh.vertex_alive(a) && mesh.vertex_alive(b) && edges.size() < 200)
+      edges.push_back({a, b, false, {}});
+  });
+  ASSERT_GE(edges.size(), EnergyPriority::kEdgesWakingTheTeam);
+  std::vector<EdgeCosting> few(edges.begin(), edges.begin() + 8);
+  double team_seconds = team.seconds();
+  energy.evaluate_each(mesh, few, Costing::kQueue);
+  EXPECT_EQ(team.seconds(), team_seconds) << "a few edges woke the team";
+  energy.evaluate_each(mesh, edges, Costing::kQueue);
+  EXPECT_GT(team.seconds(), team_seconds) << "many edges not costed on the team";
+  size_t placed = 0;
+  for (const EdgeCosting& e : edges) {
+    CollapseCandidate alone;
+    ASSERT_EQ(energy.evaluate(mesh, e.a, e.b, alone, Costing::kQueue), e.placed);
+    if (!e.placed) continue;
+    EXPECT_EQ(alone.position, e.candidate.position);
+    EXPECT_EQ(alone.cost, e.candidate.cost) << e.a << "-" << e.b;
+    ++placed;
+  }
+  EXPECT_GT(placed, 100u);
+  energy.use_team(nullptr);
+}
+
 TEST(EnergyPriority, InitializationInChunksSideBySideEqualsInitialize) {
   // Keeps the state the chunks made: the simplifier would initialise the module again.
   class Initialized : public PriorityWrapper {
