@@ -316,6 +316,7 @@ std::vector<DeferredEdge> deferred_of_job(const std::vector<DeferredEdge>& defer
 // the deferral no longer stands for the edge as it is).
 void drop_changed(std::vector<DeferredEdge>& deferred, size_t vertex_capacity,
                   const std::vector<const std::vector<CollapseRecord>*>& lists) {
+  if (deferred.empty()) return;
   std::vector<uint8_t> changed(vertex_capacity, 0);
   for (const std::vector<CollapseRecord>* list : lists)
     for (const CollapseRecord& r : *list) changed[r.vs] = changed[r.vt] = 1;
@@ -933,7 +934,7 @@ double ParallelBuilder::take_results(Round& r) {
       lists.push_back(&result.deferred);
     }
     lists.push_back(&deferred_);
-    deferred_ = merge_unique_edges(lists);
+    deferred_ = merge_unique_edges(lists, master_loops_);
   }
   keys_->reset(returned);
   return seconds_since(tb) - import_saved;

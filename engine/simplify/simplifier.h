@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <span>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "simplify/copy_groups.h"
 #include "simplify/modules.h"
 #include "simplify/tiered_queue.h"
+#include "util/chunked_loops.h"
 #include "util/progress.h"
 #include "util/zeroed_array.h"
 
@@ -73,16 +75,46 @@ void sort_unique_edges(std::vector<Edge>& edges) {
               edges.end());
 }
 
-// sort_unique_edges of the lists joined in order, merged where each list is sorted already (the
-// lists of a parallel build's jobs and the master's): O(n log lists), not a sort of them all.
+// The records of sorted `lists`, merged into `out` by edge, one per edge: among equal edges the
+// earlier list's record, as the stable sort keeps it (a heap of the lists' next records).
 template <typename Edge>
-std::vector<Edge> merge_unique_edges(const std::vector<const std::vector<Edge>*>& lists) {
+void merge_sorted_edges(const std::vector<std::span<const Edge>>& lists, std::vector<Edge>& out) {
+  std::vector<std::pair<size_t, size_t>> heads;  // (list, index)
+  auto later = [&](const std::pair<size_t, size_t>& x, const std::pair<size_t, size_t>& y) {
+    const Edge& ex = lists[x.first][x.second];
+    const Edge& ey = lists[y.first][y.second];
+    if (ex.a != ey.a) return ex.a > ey.a;
+    if (ex.b != ey.b) return ex.b > ey.b;
+    return x.first > y.first;
+  };
+  for (size_t l = 0; l < lists.size(); ++l)
+    if (!lists[l].empty()) heads.emplace_back(l, 0);
+  std::make_heap(heads.begin(), heads.end(), later);
+  while (!heads.empty()) {
+    std::pop_heap(heads.begin(), heads.end(), later);
+    auto& [l, i] = heads.back();
+    const Edge& e = lists[l][i];
+    if (out.empty() || out.back().a != e.a || out.back().b != e.b) out.push_back(e);
+    if (++i < lists[l].size())
+      std::push_heap(heads.begin(), heads.end(), later);
+    else
+      heads.pop_back();
+  }
+}
+
+// sort_unique_edges of the lists joined in order, merged where each list is sorted already (the
+// lists of a parallel build's jobs and the master's): each of `loops`' ranges of first ends
+// merges its part of every list, O(n log lists) in all.
+template <typename Edge>
+std::vector<Edge> merge_unique_edges(const std::vector<const std::vector<Edge>*>& lists,
+                                     ChunkedLoops& loops) {
   std::vector<Edge> out;
-  size_t total = 0;
+  size_t total = 0, ends = 0;  // ends: past the largest first end
   bool sorted = true;
   for (const std::vector<Edge>* list : lists) {
     total += list->size();
     sorted = sorted && std::is_sorted(list->begin(), list->end(), ByEdge{});
+    if (!list->empty()) ends = std::max(ends, size_t(list->back().a) + 1);
   }
   out.reserve(total);
   if (!sorted) {
@@ -90,30 +122,26 @@ std::vector<Edge> merge_unique_edges(const std::vector<const std::vector<Edge>*>
     sort_unique_edges(out);
     return out;
   }
-  // A heap of each list's next record, by edge, then by list: among equal edges the earlier
-  // list's record comes out first and is the one kept, as the stable sort keeps it.
-  std::vector<std::pair<size_t, size_t>> heads;  // (list, index)
-  auto later = [&](const std::pair<size_t, size_t>& x, const std::pair<size_t, size_t>& y) {
-    const Edge& ex = (*lists[x.first])[x.second];
-    const Edge& ey = (*lists[y.first])[y.second];
-    if (ex.a != ey.a) return ex.a > ey.a;
-    if (ex.b != ey.b) return ex.b > ey.b;
-    return x.first > y.first;
-  };
-  for (size_t l = 0; l < lists.size(); ++l)
-    if (!lists[l]->empty()) heads.emplace_back(l, 0);
-  std::make_heap(heads.begin(), heads.end(), later);
-  while (!heads.empty()) {
-    std::pop_heap(heads.begin(), heads.end(), later);
-    auto& [l, i] = heads.back();
-    const Edge& e = (*lists[l])[i];
-    if (out.empty() || out.back().a != e.a || out.back().b != e.b) out.push_back(e);
-    if (++i < lists[l]->size())
-      std::push_heap(heads.begin(), heads.end(), later);
-    else
-      heads.pop_back();
-  }
+  std::vector<std::vector<Edge>> parts(loops.ranges(ends));
+  loops.run_indexed(ends, [&](size_t range, size_t begin, size_t end) {
+    std::vector<std::span<const Edge>> here;
+    for (const std::vector<Edge>* list : lists) {
+      const auto from = std::partition_point(list->begin(), list->end(),
+                                             [&](const Edge& e) { return e.a < begin; });
+      const auto to =
+          std::partition_point(from, list->end(), [&](const Edge& e) { return e.a < end; });
+      here.emplace_back(std::to_address(from), size_t(to - from));
+    }
+    merge_sorted_edges(here, parts[range]);
+  });
+  for (const std::vector<Edge>& part : parts) out.insert(out.end(), part.begin(), part.end());
   return out;
+}
+
+template <typename Edge>
+std::vector<Edge> merge_unique_edges(const std::vector<const std::vector<Edge>*>& lists) {
+  ChunkedLoops one_thread;
+  return merge_unique_edges(lists, one_thread);
 }
 
 struct SimplifierLimits {

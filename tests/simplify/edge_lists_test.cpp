@@ -1,6 +1,6 @@
 // Lists of edge records (simplifier.h): merge_unique_edges gives what sort_unique_edges of the
 // lists joined in order gives, the first record of an edge kept, whether the lists are sorted
-// (merged) or not (sorted).
+// (merged, in ranges of first ends side by side or not) or not (sorted).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "simplify/simplifier.h"
+#include "util/chunked_loops.h"
 
 namespace parapm {
 namespace {
@@ -22,10 +23,15 @@ std::vector<DeferredEdge> joined_and_sorted(const Lists& lists) {
   return all;
 }
 
-std::vector<DeferredEdge> merged(const Lists& lists) {
+std::vector<DeferredEdge> merged(const Lists& lists, ChunkedLoops& loops) {
   std::vector<const std::vector<DeferredEdge>*> pointers;
   for (const auto& list : lists) pointers.push_back(&list);
-  return merge_unique_edges(pointers);
+  return merge_unique_edges(pointers, loops);
+}
+
+std::vector<DeferredEdge> merged(const Lists& lists) {
+  ChunkedLoops one_thread;
+  return merged(lists, one_thread);
 }
 
 void expect_same(const std::vector<DeferredEdge>& x, const std::vector<DeferredEdge>& y) {
@@ -57,6 +63,8 @@ TEST(EdgeLists, MergedAsTheJoinedListsSortedKeepingTheFirstRecord) {
   for (int trial = 0; trial < 300; ++trial) {
     const Lists lists = random_lists(random, trial % 3 != 0);
     expect_same(merged(lists), joined_and_sorted(lists));
+    ChunkedLoops by_first_end(5, 2, 1);  // ranges of first ends, merged side by side
+    expect_same(merged(lists, by_first_end), joined_and_sorted(lists));
   }
 }
 
