@@ -16,6 +16,16 @@ Simplifier::Simplifier(CollapseMesh& mesh, PriorityModule& priority,
   queue_.drop_when([this](const Entry& e) { return is_stale(e); });
 }
 
+size_t Simplifier::plan_costing(VertexId a, VertexId b, size_t& costings) {
+  if (costings == costed_.size()) costed_.emplace_back();
+  EdgeCosting& planned = costed_[costings];
+  planned.a = a;
+  planned.b = b;
+  planned.candidate.seam = false;
+  ++stats_.evaluations;
+  return costings++;
+}
+
 void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
                                     const CancelToken* cancel) {
   std::vector<uint8_t> listed(mesh_.vertex_capacity(), 0);
@@ -36,12 +46,7 @@ void Simplifier::queue_edges_around(const std::vector<VertexId>& vertices,
       if (listed[u] && u < v)
         continue;  // an edge between two listed vertices: from its smaller end
       if (together && !seam_edge(v, u)) {
-        if (costings == costed_.size()) costed_.emplace_back();
-        EdgeCosting& planned = costed_[costings++];
-        planned.a = std::min(v, u);
-        planned.b = std::max(v, u);
-        planned.candidate.seam = false;
-        ++stats_.evaluations;
+        plan_costing(std::min(v, u), std::max(v, u), costings);
         continue;
       }
       Entry entry;
@@ -363,19 +368,14 @@ bool Simplifier::vetoed_when_queued(Entry& entry, const SimplifierLimits& limits
 void Simplifier::requeue_costly(VertexId vs, bool defer) {
   planned_.clear();
   size_t costings = 0;
-  auto plan_costing = [&](VertexId a, VertexId b) {
+  auto plan = [&](VertexId a, VertexId b) {
     if (a > b) std::swap(a, b);
     Entry entry{};
     if (seam_edge(a, b)) {  // a seam's: costed now, alone
       if (queue_entry(a, b, entry)) planned_.push_back({entry, kNotCosted});
       return;
     }
-    if (costings == costed_.size()) costed_.emplace_back();
-    costed_[costings].a = a;
-    costed_[costings].b = b;
-    costed_[costings].candidate.seam = false;
-    planned_.push_back({entry, costings++});
-    ++stats_.evaluations;
+    planned_.push_back({entry, plan_costing(a, b, costings)});
   };
   for (VertexId n : ring_) {
     if (seam_already_queued(vs, n)) continue;
@@ -384,7 +384,7 @@ void Simplifier::requeue_costly(VertexId vs, bool defer) {
       planned_.push_back({entry, kNotCosted});
       continue;
     }
-    plan_costing(vs, n);
+    plan(vs, n);
   }
   for (const Retry& retry : retry_) {
     ++stats_.reevaluated;
@@ -395,7 +395,7 @@ void Simplifier::requeue_costly(VertexId vs, bool defer) {
       reject(retry.a, retry.b);
       continue;
     }
-    plan_costing(retry.a, retry.b);
+    plan(retry.a, retry.b);
   }
   priority_.evaluate_each(mesh_, std::span(costed_).first(costings), Costing::kQueue);
   for (PlannedPush& push : planned_) {

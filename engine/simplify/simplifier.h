@@ -467,6 +467,9 @@ class Simplifier {
     FaceId folded;
   };
   std::vector<Retry> retry_;
+  // Edge {a, b} (a < b) planned as costed_[costings] for evaluate_each; returns that index and
+  // counts it (costings, and the evaluation in stats_).
+  size_t plan_costing(VertexId a, VertexId b, size_t& costings);
   // requeue_costly's pushes in order: an entry, or the index of its costing in costed_.
   static constexpr size_t kNotCosted = ~size_t{0};
   struct PlannedPush {
