@@ -31,6 +31,11 @@ class WithoutInitialize : public PriorityWrapper {
                      Costing costing) override {
     inner_.evaluate_each(mesh, edges, costing);
   }
+  void evaluate_seam_at(const CollapseMesh& mesh, std::span<const SeamPair> pairs,
+                        std::span<const Vec3> places, Costing costing,
+                        std::span<SeamCosting> out) override {
+    inner_.evaluate_seam_at(mesh, pairs, places, costing, out);
+  }
 };
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "parallel/subset_rule.h"
 
+#include <algorithm>
 #include <atomic>
 #include <utility>
 
@@ -70,6 +71,16 @@ class SubsetPriority : public PriorityWrapper {
                      CollapseCandidate& out, Costing costing) override {
     if (!free_[vs] || !free_[vt]) return false;
     return inner_.evaluate_seam(mesh, vs, vt, at, out, costing);
+  }
+  // (where a pair is refused, pair by pair: the pairs before it are costed, as ever)
+  void evaluate_seam_at(const CollapseMesh& mesh, std::span<const SeamPair> pairs,
+                        std::span<const Vec3> places, Costing costing,
+                        std::span<SeamCosting> out) override {
+    if (std::all_of(pairs.begin(), pairs.end(),
+                    [&](const SeamPair& p) { return free_[p.vs] && free_[p.vt]; }))
+      inner_.evaluate_seam_at(mesh, pairs, places, costing, out);
+    else
+      cost_seam_pair_by_pair(mesh, pairs, places, costing, out);
   }
 
  private:

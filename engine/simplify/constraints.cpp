@@ -76,16 +76,15 @@ class ComponentMinimum : public ConstraintModule {
     const uint32_t comp = component_[c.vs];
     return count_[comp] > smallest(comp);
   }
-  void drop_too_small(const CollapseMesh&,
-                      std::vector<CollapseCandidate>& collapses) const override {
+  void drop_too_small(const CollapseMesh&, std::vector<SeamPair>& collapses) const override {
     // Where every collapse's component could take them all, none is dropped.
-    if (std::all_of(collapses.begin(), collapses.end(), [&](const CollapseCandidate& c) {
+    if (std::all_of(collapses.begin(), collapses.end(), [&](const SeamPair& c) {
           const uint32_t comp = component_[c.vs];
           return count_[comp] > smallest(comp) + collapses.size();
         }))
       return;
     std::vector<std::pair<uint32_t, uint32_t>> made;  // (component, collapses kept in it)
-    std::erase_if(collapses, [&](const CollapseCandidate& c) {
+    std::erase_if(collapses, [&](const SeamPair& c) {
       const uint32_t comp = component_[c.vs];
       auto it =
           std::find_if(made.begin(), made.end(), [&](const auto& m) { return m.first == comp; });

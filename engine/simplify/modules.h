@@ -3,6 +3,8 @@
 // per-vertex state (quadrics, sample points) belongs to the module.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <span>
@@ -45,6 +47,19 @@ struct CollapseCandidate {
 // near the cost kPerform would give.
 enum class Costing { kPerform, kQueue, kEstimate };
 
+// One collapse of a seam collapse (Simplifier::join_copies): vt into vs.
+struct SeamPair {
+  VertexId vs = kNoId;
+  VertexId vt = kNoId;
+};
+
+// A seam collapse costed at one place (PriorityModule::evaluate_seam_at).
+struct SeamCosting {
+  bool placed = false;  // every pair costed, their summed cost finite
+  // The first pair's costing, with the pairs' summed cost and their largest error.
+  CollapseCandidate candidate;
+};
+
 // An edge to cost, and what its costing gave (PriorityModule::evaluate_each).
 struct EdgeCosting {
   VertexId a = kNoId, b = kNoId;
@@ -82,6 +97,15 @@ class PriorityModule {
   virtual bool evaluate_seam(const CollapseMesh&, VertexId /*vs*/, VertexId /*vt*/,
                              const Vec3* /*at*/, CollapseCandidate&, Costing) {
     return false;
+  }
+  // A seam collapse's pairs costed at each of `places` (out: one per place): evaluate_seam of
+  // every pair in order with vs at the place, summed. A place is not placed where a pair cannot
+  // be costed or the sum is not finite. Default: evaluate_seam pair by pair, place by place (a
+  // place stops at its first refusal); a module may share its work between the places.
+  virtual void evaluate_seam_at(const CollapseMesh& mesh, std::span<const SeamPair> pairs,
+                                std::span<const Vec3> places, Costing costing,
+                                std::span<SeamCosting> out) {
+    cost_seam_pair_by_pair(mesh, pairs, places, costing, out);
   }
   // Called after the mesh performed `done`, to update the module's state. `edge` names the two
   // faces the collapse removed (now dead); done.vs_before where vs was (vt keeps its position
@@ -130,6 +154,34 @@ class PriorityModule {
   // read per-vertex state scattered in memory may start loading it now, so that the loads
   // overlap instead of waiting one after another. No effect on any result (the default: none).
   virtual void will_cost(VertexId /*from*/, std::span<const VertexId> /*to*/) const {}
+
+ protected:
+  // evaluate_seam_at's default: through this module's evaluate_seam.
+  void cost_seam_pair_by_pair(const CollapseMesh& mesh, std::span<const SeamPair> pairs,
+                              std::span<const Vec3> places, Costing costing,
+                              std::span<SeamCosting> out) {
+    for (size_t k = 0; k < places.size(); ++k) {
+      SeamCosting& s = out[k];
+      s.candidate = CollapseCandidate{};
+      s.placed = false;
+      double cost = 0, error = 0;
+      bool each = true;
+      for (size_t i = 0; i < pairs.size() && each; ++i) {
+        CollapseCandidate& c = i == 0 ? s.candidate : other_pair_;
+        each = evaluate_seam(mesh, pairs[i].vs, pairs[i].vt, &places[k], c, costing);
+        cost += c.cost;
+        error = std::max(error, c.error);
+      }
+      if (!each) continue;
+      s.candidate.cost = cost;
+      s.candidate.error = error;
+      s.candidate.seam = true;
+      s.placed = std::isfinite(cost);
+    }
+  }
+
+ private:
+  CollapseCandidate other_pair_;  // cost_seam_pair_by_pair's costing of a pair after the first
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every
@@ -163,8 +215,9 @@ class PriorityWrapper : public PriorityModule {
                  const EdgeFaces& edge) override {
     inner_.collapsed(mesh, done, edge);
   }
-  // (evaluate_each is not forwarded: a wrapper whose evaluate() changes answers costs each
-  // edge through it, unless it overrides evaluate_each too, with evaluate_picked.)
+  // (evaluate_each and evaluate_seam_at are not forwarded: a wrapper whose evaluate() or
+  // evaluate_seam() changes answers costs each edge or pair through them, unless it overrides
+  // these too, with evaluate_picked or cost_seam_pair_by_pair.)
 
  protected:
   // inner.evaluate_each of the edges `pick(edge)` is true of, in their order; `pick` may
@@ -215,7 +268,7 @@ class ConstraintModule {
   // would veto once the ones before them were made because their part is at its smallest form
   // (the component minimum); such a copy stays where it is. A rule that vetoes for other
   // reasons removes none: its veto stops the whole seam collapse.
-  virtual void drop_too_small(const CollapseMesh&, std::vector<CollapseCandidate>&) const {}
+  virtual void drop_too_small(const CollapseMesh&, std::vector<SeamPair>&) const {}
   virtual void collapsed(const CollapseMesh&, const CollapseCandidate&) {}
 };
 

@@ -236,6 +236,40 @@ bool QuadricPriority::cost_seam(const CollapseMesh& mesh, VertexId vs, VertexId 
   return std::isfinite(out.cost);
 }
 
+void QuadricPriority::evaluate_seam_at(const CollapseMesh&, std::span<const SeamPair> pairs,
+                                       std::span<const Vec3> places, Costing,
+                                       std::span<SeamCosting> out) {
+  costings_ += pairs.size() * places.size();
+  cost_seam_at(pairs, places, out, seam_sums_);
+}
+
+void QuadricPriority::cost_seam_at(std::span<const SeamPair> pairs, std::span<const Vec3> places,
+                                   std::span<SeamCosting> out, std::vector<Quadric>& sums) const {
+  // cost_seam's sums and costs, in the same order: the same bits.
+  sums.resize(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    sums[i] = quadrics_[std::min(pairs[i].vs, pairs[i].vt)];
+    sums[i] += quadrics_[std::max(pairs[i].vs, pairs[i].vt)];
+  }
+  for (size_t k = 0; k < places.size(); ++k) {
+    double cost = 0, error = 0;
+    for (const Quadric& q : sums) {
+      const double c = std::max(0.0, q.evaluate(places[k]));
+      cost += c;
+      error = std::max(error, rms_error(q, c));
+    }
+    SeamCosting& at = out[k];
+    at.candidate = CollapseCandidate{};
+    at.candidate.vs = pairs[0].vs;
+    at.candidate.vt = pairs[0].vt;
+    at.candidate.position = places[k];
+    at.candidate.cost = cost;
+    at.candidate.error = error;
+    at.candidate.seam = true;
+    at.placed = std::isfinite(cost);
+  }
+}
+
 // QuadricPriority::costing_view: the owner's costings with a scratch and a count of its own.
 class QuadricCostingView : public PriorityModule {
  public:
@@ -254,6 +288,12 @@ class QuadricCostingView : public PriorityModule {
     ++costings_;
     return owner_.cost_seam(mesh, vs, vt, at, out);
   }
+  void evaluate_seam_at(const CollapseMesh&, std::span<const SeamPair> pairs,
+                        std::span<const Vec3> places, Costing,
+                        std::span<SeamCosting> out) override {
+    costings_ += pairs.size() * places.size();
+    owner_.cost_seam_at(pairs, places, out, seam_sums_);
+  }
   void collapsed(const CollapseMesh&, CollapseCandidate&, const EdgeFaces&) override {
     throw_internal("a quadric costing view performs no collapse");
   }
@@ -262,6 +302,7 @@ class QuadricCostingView : public PriorityModule {
  private:
   const QuadricPriority& owner_;
   StarTermsScratch scratch_;
+  std::vector<Quadric> seam_sums_;
   uint64_t costings_ = 0;
 };
 

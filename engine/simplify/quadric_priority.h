@@ -59,6 +59,10 @@ class QuadricPriority : public PriorityModule {
                 Costing costing) override;
   bool evaluate_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                      CollapseCandidate& out, Costing costing) override;
+  // Each pair's quadrics summed once for all the places.
+  void evaluate_seam_at(const CollapseMesh& mesh, std::span<const SeamPair> pairs,
+                        std::span<const Vec3> places, Costing costing,
+                        std::span<SeamCosting> out) override;
   void collapsed(const CollapseMesh& mesh, CollapseCandidate& done, const EdgeFaces& edge) override;
   // A queue key is the ends' summed quadric's: at its free optimum, or its least value at the
   // edge's midpoint, or at a locked end; placed freely, where place() puts the survivor.
@@ -114,13 +118,17 @@ class QuadricPriority : public PriorityModule {
             Costing costing, StarTermsScratch& scratch) const;
   bool cost_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                  CollapseCandidate& out) const;
+  // evaluate_seam_at without counting; `sums`: working memory, a quadric per pair.
+  void cost_seam_at(std::span<const SeamPair> pairs, std::span<const Vec3> places,
+                    std::span<SeamCosting> out, std::vector<Quadric>& sums) const;
   friend class QuadricCostingView;
 
   uint64_t costings_ = 0;
   std::vector<uint8_t> locked_;
   QuadricOptions options_;
   std::vector<Quadric> quadrics_;
-  StarTermsScratch star_scratch_;  // place_on_constraints's working memory
+  StarTermsScratch star_scratch_;   // place_on_constraints's working memory
+  std::vector<Quadric> seam_sums_;  // cost_seam_at's
 };
 
 }  // namespace parapm

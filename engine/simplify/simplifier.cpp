@@ -432,19 +432,7 @@ bool Simplifier::pair_seam(uint32_t from, uint32_t into) {
     seam_pairs_.push_back({partner, copy});
   }
   // Copies in parts too small to shrink stay.
-  std::vector<CollapseCandidate>& pairs = seam_planned_;
-  pairs.resize(seam_pairs_.size());
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    CollapseCandidate& c = pairs[i];
-    c.vs = seam_pairs_[i].vs;
-    c.vt = seam_pairs_[i].vt;
-    c.position = mesh_.position(c.vs);
-    c.cost = c.error = 0;
-    c.seam = true;
-  }
-  for (const auto& module : constraints_) module->drop_too_small(mesh_, pairs);
-  seam_pairs_.clear();
-  for (const CollapseCandidate& c : pairs) seam_pairs_.push_back({c.vs, c.vt});
+  for (const auto& module : constraints_) module->drop_too_small(mesh_, seam_pairs_);
   return !seam_pairs_.empty();
 }
 
@@ -521,22 +509,6 @@ bool Simplifier::seam_holds_in_turn(const Vec3& place) {
   return true;
 }
 
-bool Simplifier::cost_seam_at(const Vec3& at, Costing costing, CollapseCandidate& out) {
-  double cost = 0, error = 0;
-  for (size_t i = 0; i < seam_pairs_.size(); ++i) {
-    CollapseCandidate& c = i == 0 ? out : seam_other_cost_;
-    ++stats_.evaluations;
-    if (!priority_.evaluate_seam(mesh_, seam_pairs_[i].vs, seam_pairs_[i].vt, &at, c, costing))
-      return false;
-    cost += c.cost;
-    error = std::max(error, c.error);
-  }
-  out.cost = cost;
-  out.error = error;
-  out.seam = true;
-  return std::isfinite(cost);
-}
-
 bool Simplifier::cost_seam(VertexId a, VertexId b, CollapseCandidate& out, Costing costing) {
   const uint32_t group_a = groups_->group[a], group_b = groups_->group[b];
   bool found = false;
@@ -557,10 +529,12 @@ bool Simplifier::cost_seam(VertexId a, VertexId b, CollapseCandidate& out, Costi
           places.push_back(c.position);
       }
     }
-    for (const Vec3& place : places) {
-      CollapseCandidate c;
-      if (!cost_seam_at(place, costing, c) || (found && !(c.cost < out.cost))) continue;
-      out = std::move(c);
+    seam_costs_.resize(places.size());
+    stats_.evaluations += seam_pairs_.size() * places.size();
+    priority_.evaluate_seam_at(mesh_, seam_pairs_, places, costing, seam_costs_);
+    for (SeamCosting& at : seam_costs_) {
+      if (!at.placed || (found && !(at.candidate.cost < out.cost))) continue;
+      out = std::move(at.candidate);
       found = true;
     }
   }

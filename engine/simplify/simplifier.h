@@ -299,12 +299,12 @@ class Simplifier {
   // Costs edge {a, b}; false when the module cannot place it.
   bool queue_entry(VertexId a, VertexId b, Entry& entry);
   // A seam's queue costing: cost_seam's answer and cost.
-  struct SeamCosting {
+  struct SeamKey {
     bool placed = false;
     double cost = 0;
   };
   // By the groups of an edge's ends (a < b), the first's in the high half.
-  using SeamCostings = std::unordered_map<uint64_t, SeamCosting>;
+  using SeamCostings = std::unordered_map<uint64_t, SeamKey>;
   // While build_first_queue runs: the seams costed so far, each costed once (queue_entry).
   SeamCostings* first_queue_seams_ = nullptr;
   // The entry of edge {a, b} (a < b) from its queue costing, its key remembered; false (and
@@ -377,9 +377,6 @@ class Simplifier {
   bool seam_edge(VertexId a, VertexId b) const {
     return groups_ && groups_->is_copy(a) && groups_->is_copy(b);
   }
-  struct SeamPair {
-    VertexId vs, vt;
-  };
   // Every live copy of group `from` (as vt) with the copy of group `into` adjacent to it of
   // the smallest id (as vs), into seam_pairs_, but for copies in parts too small to shrink
   // (ConstraintModule::drop_too_small: they stay); false when a copy has no such neighbour,
@@ -393,9 +390,6 @@ class Simplifier {
   // Whether seam_pairs_' collapses, made one after the other with the survivors at `place`,
   // each pass the neighbourhood rules: tried on a copy of the faces around their ends.
   bool seam_holds_in_turn(const Vec3& place);
-  // The seam_pairs_' collapses with the survivors at `at`: their summed cost, the largest
-  // error, the first's candidate.
-  bool cost_seam_at(const Vec3& at, Costing costing, CollapseCandidate& out);
   bool cost_seam(VertexId a, VertexId b, CollapseCandidate& out, Costing costing);
   // Performs the seam collapse `seam` names (its first pair and place); false, and nothing
   // done, when one of its collapses is illegal on the mesh as it is.
@@ -451,9 +445,8 @@ class Simplifier {
   bool seam_already_queued(VertexId a, VertexId b);
   bool queueing_seams_ = false;
   std::vector<std::pair<uint32_t, uint32_t>> queued_seams_;
-  std::vector<CollapseCandidate> seam_planned_;
-  CollapseCandidate seam_other_cost_;  // cost_seam_at's costing of a pair after the first
-  std::vector<uint32_t> seam_mark_;    // per vertex: the pair whose ring holds it (rings_apart)
+  std::vector<SeamCosting> seam_costs_;  // cost_seam's, one per place of a way round
+  std::vector<uint32_t> seam_mark_;      // per vertex: the pair whose ring holds it (rings_apart)
   std::vector<FaceId> seam_faces_;
   std::vector<std::unique_ptr<ConstraintModule>> seam_rules_;  // neighbourhood_constraints()
   uint32_t seam_stamp_ = 0;

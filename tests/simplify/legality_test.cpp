@@ -133,15 +133,7 @@ TEST(Legality, SeamCollapsesInAComponentTooSmallToShrinkAreDropped) {
   CollapseMesh cm(m);
   auto modules = standard_constraints({});
   for (auto& mod : modules) mod->initialize(cm);
-  auto collapse = [&](VertexId vs, VertexId vt) {
-    CollapseCandidate c;
-    c.vs = vs;
-    c.vt = vt;
-    c.position = cm.position(vs);
-    c.seam = true;
-    return c;
-  };
-  std::vector<CollapseCandidate> collapses{collapse(0, 1), collapse(3, 4), collapse(5, 6)};
+  std::vector<SeamPair> collapses{{0, 1}, {3, 4}, {5, 6}};
   for (auto& mod : modules) mod->drop_too_small(cm, collapses);
   // The triangle is at its smallest form; the strip affords one collapse, not two.
   ASSERT_EQ(collapses.size(), 1u);

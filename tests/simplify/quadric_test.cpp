@@ -1,5 +1,5 @@
 // The quadric priority module's placement: the volume and the border area its collapses keep
-// (placement_constraints.h), and the star's planes it weighs.
+// (placement_constraints.h), and the star's planes it weighs; its costings.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -218,6 +218,58 @@ TEST(QuadricCostingView, CostsAsItsOwnerOnSeveralThreads) {
     CollapseCandidate done = expected.front().c;
     EXPECT_THROW(a->collapsed(working, done, EdgeFaces{}), Error);
   }
+}
+
+// A seam collapse costed at several places at once (evaluate_seam_at, each pair's quadrics
+// summed once) gives the bits the pair-by-pair default (through evaluate_seam) gives, for the
+// owner and for a costing view, and counts a costing per pair and place.
+TEST(QuadricSeamCostings, AtSeveralPlacesAsPairByPair) {
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")));
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh working(repaired.mesh);
+  QuadricPriority owner(locked, QuadricOptions{});
+  Simplifier simplifier(working, owner, standard_constraints(locked));
+  simplifier.run({repaired.mesh.face_count() / 3}, {}, nullptr);
+  std::vector<VertexId> alive, ring;
+  for (VertexId v = 0; v < working.vertex_capacity(); ++v)
+    if (working.vertex_alive(v)) alive.push_back(v);
+  ASSERT_GT(alive.size(), 1000u);
+  PriorityWrapper pair_by_pair(owner);  // (does not forward evaluate_seam_at)
+  const std::unique_ptr<PriorityModule> view = owner.costing_view();
+  ASSERT_TRUE(view);
+  size_t compared = 0;
+  for (size_t group = 0; group + 3 < alive.size(); group += 97) {
+    std::vector<SeamPair> pairs;
+    std::vector<Vec3> places;
+    for (size_t i = group; i < group + 3; ++i) {  // three pairs: a vertex and its first neighbour
+      working.neighbors(alive[i], ring);
+      if (ring.empty()) continue;
+      pairs.push_back({alive[i], ring.front()});
+      places.push_back(working.position(alive[i]));
+      places.push_back(working.position(ring.front()));
+    }
+    if (pairs.empty()) continue;
+    places.push_back(scale(add(places[0], places[1]), 0.5));
+    std::vector<SeamCosting> expected(places.size()), shared(places.size()), viewed(places.size());
+    pair_by_pair.evaluate_seam_at(working, pairs, places, Costing::kPerform, expected);
+    const uint64_t before = owner.costings();
+    owner.evaluate_seam_at(working, pairs, places, Costing::kPerform, shared);
+    EXPECT_EQ(owner.costings() - before, pairs.size() * places.size());
+    view->evaluate_seam_at(working, pairs, places, Costing::kPerform, viewed);
+    for (const std::vector<SeamCosting>* got : {&shared, &viewed})
+      for (size_t k = 0; k < places.size(); ++k) {
+        const SeamCosting &x = (*got)[k], &y = expected[k];
+        ASSERT_EQ(x.placed, y.placed) << group << " " << k;
+        ASSERT_TRUE(x.candidate.seam);
+        ASSERT_EQ(x.candidate.vs, y.candidate.vs);
+        ASSERT_EQ(x.candidate.vt, y.candidate.vt);
+        ASSERT_EQ(x.candidate.position, places[k]);
+        ASSERT_EQ(std::memcmp(&x.candidate.cost, &y.candidate.cost, sizeof(double)), 0);
+        ASSERT_EQ(std::memcmp(&x.candidate.error, &y.candidate.error, sizeof(double)), 0);
+        ++compared;
+      }
+  }
+  EXPECT_GT(compared, 100u);
 }
 
 // A quadric's least value (Quadric::least_value) is its value at the optimum where it has

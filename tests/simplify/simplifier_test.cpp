@@ -421,8 +421,7 @@ class CountedRule : public ConstraintModule {
   FaceId folded_face() const override { return tells_the_fold_ ? inner_->folded_face() : kNoId; }
   bool topological() const override { return inner_->topological(); }
   bool star_local() const override { return inner_->star_local(); }
-  void drop_too_small(const CollapseMesh& mesh,
-                      std::vector<CollapseCandidate>& collapses) const override {
+  void drop_too_small(const CollapseMesh& mesh, std::vector<SeamPair>& collapses) const override {
     inner_->drop_too_small(mesh, collapses);
   }
   void collapsed(const CollapseMesh& mesh, const CollapseCandidate& c) override {
