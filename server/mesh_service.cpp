@@ -65,8 +65,11 @@ grpc::Status MeshService::Upload(grpc::ServerContext* context,
     }
     service::Upload upload = coordinator_.begin_upload(chunk.file_name());
     do {
-      ticket->touch();
+      // Storing a chunk (a large upload's buffer grows, its pages fresh) is the server's work:
+      // the idle clock waits on the client from after it.
+      ticket->working();
       upload.add(chunk.data());
+      ticket->touch();
     } while (reader->Read(&chunk));
     if (auto expired = ticket->expired()) return *expired;
     if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "upload cut off");

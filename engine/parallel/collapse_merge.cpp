@@ -14,13 +14,16 @@
 namespace parapm {
 
 std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord>> lists) {
+  std::vector<const CollapseRecord*> order;
+  append_merge_order(lists, order);
   std::vector<CollapseRecord> merged;
-  append_merged_by_cost(lists, merged);
+  merged.reserve(order.size());
+  for (const CollapseRecord* r : order) merged.push_back(*r);
   return merged;
 }
 
-void append_merged_by_cost(std::vector<std::vector<CollapseRecord>>& lists,
-                           std::vector<CollapseRecord>& out) {
+void append_merge_order(const std::vector<std::vector<CollapseRecord>>& lists,
+                        std::vector<const CollapseRecord*>& out) {
   struct Head {
     double cost;
     uint32_t list;
@@ -42,10 +45,9 @@ void append_merged_by_cost(std::vector<std::vector<CollapseRecord>>& lists,
   while (!heads.empty()) {
     const uint32_t i = heads.top().list;
     heads.pop();
-    out.push_back(std::move(lists[i][next[i]]));
+    out.push_back(&lists[i][next[i]]);
     if (++next[i] < lists[i].size()) heads.push({lists[i][next[i]].cost, i});
   }
-  lists.clear();
 }
 
 namespace {

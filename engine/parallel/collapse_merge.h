@@ -18,9 +18,10 @@ namespace parapm {
 // the subset rule needs for the sequence to replay (subset_rule.h); a list's costs need not
 // be sorted (a subset's cost sequence is only roughly increasing). O(n log k).
 std::vector<CollapseRecord> merge_by_cost(std::vector<std::vector<CollapseRecord>> lists);
-// The same merge, appended to `out` (each record moved once; `lists` is left empty).
-void append_merged_by_cost(std::vector<std::vector<CollapseRecord>>& lists,
-                           std::vector<CollapseRecord>& out);
+// The same merge as the records' addresses, appended to `out`: no record moves (the PM's
+// assembly reads them where their lists hold them).
+void append_merge_order(const std::vector<std::vector<CollapseRecord>>& lists,
+                        std::vector<const CollapseRecord*>& out);
 
 struct ReplayReport {
   uint64_t collapses = 0;

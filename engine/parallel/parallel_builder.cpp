@@ -471,7 +471,23 @@ std::shared_ptr<const std::vector<uint32_t>> ParallelBuilder::whole_components()
   return components_;
 }
 
-void ParallelBuilder::append_pending() { append_merged_by_cost(pending_lists_, records_); }
+void ParallelBuilder::append_pending() {
+  append_merge_order(pending_lists_, records_);
+  for (std::vector<CollapseRecord>& list : pending_lists_) keep_list(std::move(list));
+  pending_lists_.clear();
+}
+
+void ParallelBuilder::append_list(std::vector<CollapseRecord> list) {
+  for (const CollapseRecord& r : list) records_.push_back(&r);
+  keep_list(std::move(list));
+}
+
+void ParallelBuilder::keep_list(std::vector<CollapseRecord> list) {
+  // A simplifier reserves a record per vertex and makes fewer; where the allocator reused
+  // memory for the reserve, its unused pages are resident.
+  release_unused_capacity(list);
+  record_lists_.push_back(std::move(list));
+}
 
 ParallelBuilder::RoundPlan ParallelBuilder::plan_round(uint64_t faces, size_t vertices,
                                                        uint32_t scheduled_rounds_left,
@@ -876,7 +892,7 @@ void ParallelBuilder::merge(Round& r) {
     std::vector<CollapseRecord> merged = merge_by_cost(r.lists);
     r.replay = replay_collapses(*whole_, merged, master_.get());
     take_results(r);
-    records_.insert(records_.end(), merged.begin(), merged.end());
+    append_list(std::move(merged));
   } else {
     const auto tr = std::chrono::steady_clock::now();
     double bookkeeping_seconds = 0;
@@ -1011,8 +1027,7 @@ void ParallelBuilder::band_pass(Round& r) {
     rs.band_pass_collapses = band_records.size();
     if (carry_deferred_ && !band_records.empty())
       drop_changed(deferred_, whole.vertex_capacity(), {&band_records});
-    records_.insert(records_.end(), std::make_move_iterator(band_records.begin()),
-                    std::make_move_iterator(band_records.end()));
+    append_list(std::move(band_records));
   }
   rs.band_pass_seconds = seconds_since(t) - team_saved;
   // With one thread, the band pass's time holds the append's and the partition's, which the
@@ -1090,8 +1105,7 @@ void ParallelBuilder::final_pass() {
       fs.requeued, fs.stale, fs.seam_collapses, fs.seams_split);
   if (events_.final_pass_done)
     events_.final_pass_done(st_.final_pass_collapses, st_.final_pass_seconds);
-  records_.insert(records_.end(), std::make_move_iterator(final_records.begin()),
-                  std::make_move_iterator(final_records.end()));
+  append_list(std::move(final_records));
 }
 
 ProgressiveMesh ParallelBuilder::progressive_mesh() {

@@ -92,6 +92,10 @@ class ParallelBuilder {
   // band pass outlasted it.
   void forgo_foreseen();
   void append_pending();
+  // `list`'s records after those in records_, in its order, the list kept (keep_list).
+  void append_list(std::vector<CollapseRecord> list);
+  // Into record_lists_, the pages of its unused capacity released.
+  void keep_list(std::vector<CollapseRecord> list);
   // What the team's loops so far took beyond their time with a core per chunk (seconds): the
   // critical path counts the latter.
   double team_saving() const { return team_ ? team_->saved_seconds() : 0; }
@@ -168,9 +172,13 @@ class ParallelBuilder {
   // merge nor split them).
   std::shared_ptr<const std::vector<uint32_t>> components_;
 
-  // Every collapse so far, in the PM's order. At most one per vertex: reserved once, so no
-  // round's records move the earlier ones.
-  std::vector<CollapseRecord> records_;
+  // Every collapse so far, in the PM's order, as its record's address in record_lists_ (a
+  // record never moves: the PM's assembly reads it there). At most one per vertex: reserved
+  // once.
+  std::vector<const CollapseRecord*> records_;
+  // The lists the records lie in: the subsets', the band passes', the final pass's (moved in
+  // whole, their items staying where they are).
+  std::vector<std::vector<CollapseRecord>> record_lists_;
   // A round's subsets' lists wait for the next step of the master to go into records_, k-way
   // merged by cost (the band pass's records follow them). Nothing reads records_ before the PM
   // is assembled, so the merge by cost runs beside the band pass, the next round's partition,

@@ -54,8 +54,6 @@ class WedgeNumbering {
   WedgeId next_ = 0;
 };
 
-// Replays the records' wedge value changes from the input's values: returns the values at the
-// base mesh and, per change in record order, the values it replaced (floats each).
 // The copies made by the repair step, (copy, original) in the PM's ids, sorted: each vertex that
 // came from the same input vertex as a vertex of a lesser id goes back to the least one (the
 // original) when the input is restored. In `loops`' chunks: the least vertex of each input
@@ -96,12 +94,27 @@ std::vector<std::pair<VertexId, VertexId>> vertex_copies(const RepairedMesh& rep
   return copies;
 }
 
-std::vector<float> replay_wedge_changes(const Mesh& mesh,
-                                        const std::vector<CollapseRecord>& records,
+// The records in the PM's order, read where they lie: a list, or the records' addresses.
+struct RecordList {
+  const std::vector<CollapseRecord>& list;
+  size_t size() const { return list.size(); }
+  const CollapseRecord& operator[](size_t i) const { return list[i]; }
+};
+struct RecordAddresses {
+  std::span<const CollapseRecord* const> addresses;
+  size_t size() const { return addresses.size(); }
+  const CollapseRecord& operator[](size_t i) const { return *addresses[i]; }
+};
+
+// Replays the records' wedge value changes from the input's values: returns the values at the
+// base mesh and, per change in record order, the values it replaced (floats each).
+template <typename Records>
+std::vector<float> replay_wedge_changes(const Mesh& mesh, const Records& records,
                                         std::vector<float>& replaced) {
   const size_t floats = size_t(mesh.layout.floats_per_wedge());
   std::vector<float> values = mesh.wedge_values;
-  for (const CollapseRecord& r : records) {
+  for (size_t i = 0; i < records.size(); ++i) {
+    const CollapseRecord& r = records[i];
     if (r.changed_values.size() != r.changed_wedges.size() * floats)
       throw_internal("PM builder: a record's wedge changes and values disagree");
     for (size_t c = 0; c < r.changed_wedges.size(); ++c) {
@@ -113,12 +126,9 @@ std::vector<float> replay_wedge_changes(const Mesh& mesh,
   return values;
 }
 
-}  // namespace
-
-ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
-                                        const CollapseMesh& final_mesh,
-                                        const std::vector<CollapseRecord>& records,
-                                        const PmBuildOptions& options) {
+template <typename Records>
+ProgressiveMesh build_pm(const RepairedMesh& repaired, const CollapseMesh& final_mesh,
+                         const Records& records, const PmBuildOptions& options) {
   ChunkedLoops one_thread;
   ChunkedLoops& loops = options.loops ? *options.loops : one_thread;
   const Mesh& mesh = repaired.mesh;
@@ -276,6 +286,22 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
     });
   }
   return pm;
+}
+
+}  // namespace
+
+ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
+                                        const CollapseMesh& final_mesh,
+                                        const std::vector<CollapseRecord>& records,
+                                        const PmBuildOptions& options) {
+  return build_pm(repaired, final_mesh, RecordList{records}, options);
+}
+
+ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
+                                        const CollapseMesh& final_mesh,
+                                        std::span<const CollapseRecord* const> records,
+                                        const PmBuildOptions& options) {
+  return build_pm(repaired, final_mesh, RecordAddresses{records}, options);
 }
 
 }  // namespace parapm

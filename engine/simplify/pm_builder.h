@@ -3,6 +3,7 @@
 // and every id is renumbered to the PM's streaming order (progressive_mesh.h).
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "mesh/repair.h"
@@ -26,6 +27,11 @@ struct PmBuildOptions {
 ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
                                         const CollapseMesh& final_mesh,
                                         const std::vector<CollapseRecord>& records,
+                                        const PmBuildOptions& options);
+// The same, the records read where they lie (the parallel build's stay in their subsets' lists).
+ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
+                                        const CollapseMesh& final_mesh,
+                                        std::span<const CollapseRecord* const> records,
                                         const PmBuildOptions& options);
 
 }  // namespace parapm

@@ -1,5 +1,6 @@
 // fresh_pages.h: a block's pages faulted in by the chunks (resident before any element is
-// written), and the helpers' vectors those of resize, assign and copy.
+// written), and the helpers' vectors those of resize, assign and copy; memory.h's pages handed
+// back.
 #include "util/fresh_pages.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "util/chunked_loops.h"
+#include "util/memory.h"
 
 namespace parapm {
 namespace {
@@ -85,6 +87,38 @@ TEST(FreshPages, TheHelpersGiveTheVectorsOfResizeAssignAndCopy) {
     copy_touched(copied, source, loops);
     EXPECT_EQ(copied, source);
   }
+}
+
+// release_pages hands back the pages wholly inside its range only: the bytes around them keep
+// their values, the pages inside read as zeros, and a vector's unused capacity released leaves
+// its items and its growth as they were.
+TEST(FreshPages, ReleasedPagesAreThoseWhollyInsideTheRange) {
+  const size_t page = size_t(sysconf(_SC_PAGESIZE));
+  const size_t bytes = 8 * page;
+  void* block = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(block, MAP_FAILED);
+  auto* b = static_cast<unsigned char*>(block);
+  for (size_t i = 0; i < bytes; ++i) b[i] = static_cast<unsigned char>(1 + i % 251);
+  release_pages(b + 100, b + 5 * page + 7);  // pages 1 to 4
+  EXPECT_EQ(resident_pages(b, page), 1u);
+  EXPECT_EQ(resident_pages(b + page, 4 * page), 0u);
+  EXPECT_EQ(resident_pages(b + 5 * page, 3 * page), 3u);
+  for (size_t i = 0; i < bytes; ++i) {
+    const bool released = i >= page && i < 5 * page;
+    ASSERT_EQ(b[i], released ? 0 : static_cast<unsigned char>(1 + i % 251)) << i;
+  }
+  release_pages(b + 10, b + page - 10);  // no whole page
+  EXPECT_EQ(b[page / 2], static_cast<unsigned char>(1 + (page / 2) % 251));
+  munmap(block, bytes);
+
+  std::vector<uint32_t> v;
+  v.reserve(64 * page);
+  for (uint32_t i = 0; i < 1000; ++i) v.push_back(i * 7);
+  release_unused_capacity(v);
+  ASSERT_EQ(v.size(), 1000u);
+  for (uint32_t i = 0; i < 1000; ++i) ASSERT_EQ(v[i], i * 7);
+  for (uint32_t i = 1000; i < 5000; ++i) v.push_back(i * 7);
+  for (uint32_t i = 0; i < 5000; ++i) ASSERT_EQ(v[i], i * 7);
 }
 
 }  // namespace

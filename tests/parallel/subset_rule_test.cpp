@@ -372,5 +372,28 @@ TEST(SubsetRule, MergeByCostKeepsEachListsOrderAndPrefersCheapHeads) {
   EXPECT_EQ(tags, (std::vector<VertexId>{0, 10, 11, 1, 2}));
 }
 
+// The merge as addresses (the parallel build's PM order): the same order, after what `out`
+// held, each address the record's own place in its list.
+TEST(SubsetRule, MergeOrderIsTheMergeAsTheRecordsAddresses) {
+  auto record = [](double cost, VertexId tag) {
+    CollapseRecord r;
+    r.cost = cost;
+    r.vs = tag;
+    return r;
+  };
+  const std::vector<std::vector<CollapseRecord>> lists = {
+      {record(1, 0), record(5, 1), record(2, 2)}, {record(1, 10), record(3, 11)}, {}};
+  const CollapseRecord before = record(0, 99);
+  std::vector<const CollapseRecord*> order{&before};
+  append_merge_order(lists, order);
+  const std::vector<CollapseRecord> merged = merge_by_cost(lists);
+  ASSERT_EQ(order.size(), merged.size() + 1);
+  EXPECT_EQ(order[0], &before);
+  for (size_t i = 0; i < merged.size(); ++i) EXPECT_EQ(order[i + 1]->vs, merged[i].vs);
+  EXPECT_EQ(order[1], &lists[0][0]);
+  EXPECT_EQ(order[2], &lists[1][0]);
+  EXPECT_EQ(order[5], &lists[0][2]);
+}
+
 }  // namespace
 }  // namespace parapm
