@@ -356,13 +356,15 @@ TEST(SubsetRule, ABrokenOrderIsCaughtByTheReplay) {
   EXPECT_THROW(replay_collapses(whole, records, nullptr), Error);
 }
 
+// A record of `cost` told apart by its vs.
+CollapseRecord record(double cost, VertexId tag) {
+  CollapseRecord r;
+  r.cost = cost;
+  r.vs = tag;
+  return r;
+}
+
 TEST(SubsetRule, MergeByCostKeepsEachListsOrderAndPrefersCheapHeads) {
-  auto record = [](double cost, VertexId tag) {
-    CollapseRecord r;
-    r.cost = cost;
-    r.vs = tag;
-    return r;
-  };
   std::vector<std::vector<CollapseRecord>> lists = {
       {record(1, 0), record(5, 1), record(2, 2)}, {record(1, 10), record(3, 11)}, {}};
   const auto merged = merge_by_cost(lists);
@@ -375,12 +377,6 @@ TEST(SubsetRule, MergeByCostKeepsEachListsOrderAndPrefersCheapHeads) {
 // The merge as addresses (the parallel build's PM order): the same order, after what `out`
 // held, each address the record's own place in its list.
 TEST(SubsetRule, MergeOrderIsTheMergeAsTheRecordsAddresses) {
-  auto record = [](double cost, VertexId tag) {
-    CollapseRecord r;
-    r.cost = cost;
-    r.vs = tag;
-    return r;
-  };
   const std::vector<std::vector<CollapseRecord>> lists = {
       {record(1, 0), record(5, 1), record(2, 2)}, {record(1, 10), record(3, 11)}, {}};
   const CollapseRecord before = record(0, 99);

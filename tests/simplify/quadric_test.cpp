@@ -163,16 +163,30 @@ TEST(QuadricPlacement, TheStarsPlanesKeepACoarseLevelsRims) {
   EXPECT_LT(with, 0.95 * without);
 }
 
+// cad-cycloidal-43k simplified to a third by the quadric: accumulated quadrics, stars with
+// borders.
+struct MidwayQuadric {
+  MidwayQuadric()
+      : repaired(repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")))),
+        locked(locked_vertices(repaired)),
+        working(repaired.mesh),
+        owner(locked, QuadricOptions{}) {
+    Simplifier simplifier(working, owner, standard_constraints(locked));
+    simplifier.run({repaired.mesh.face_count() / 3}, {}, nullptr);
+  }
+  const RepairedMesh repaired;
+  const std::vector<uint8_t> locked;
+  CollapseMesh working;
+  QuadricPriority owner;
+};
+
 // A costing view (PriorityModule::costing_view) costs every edge as its owner does, queue keys
 // and performed placements, midway through a simplification (accumulated quadrics, stars with
 // borders), two views on two threads at once; it counts its own costings and performs nothing.
 TEST(QuadricCostingView, CostsAsItsOwnerOnSeveralThreads) {
-  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")));
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  CollapseMesh working(repaired.mesh);
-  QuadricPriority owner(locked, QuadricOptions{});
-  Simplifier simplifier(working, owner, standard_constraints(locked));
-  simplifier.run({repaired.mesh.face_count() / 3}, {}, nullptr);
+  MidwayQuadric midway;
+  CollapseMesh& working = midway.working;
+  QuadricPriority& owner = midway.owner;
   std::vector<std::pair<VertexId, VertexId>> edges;
   std::vector<VertexId> ring;
   for (VertexId v = 0; v < working.vertex_capacity(); ++v) {
@@ -224,12 +238,9 @@ TEST(QuadricCostingView, CostsAsItsOwnerOnSeveralThreads) {
 // summed once) gives the bits the pair-by-pair default (through evaluate_seam) gives, for the
 // owner and for a costing view, and counts a costing per pair and place.
 TEST(QuadricSeamCostings, AtSeveralPlacesAsPairByPair) {
-  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("cad-cycloidal-43k.ply")));
-  const std::vector<uint8_t> locked = locked_vertices(repaired);
-  CollapseMesh working(repaired.mesh);
-  QuadricPriority owner(locked, QuadricOptions{});
-  Simplifier simplifier(working, owner, standard_constraints(locked));
-  simplifier.run({repaired.mesh.face_count() / 3}, {}, nullptr);
+  MidwayQuadric midway;
+  CollapseMesh& working = midway.working;
+  QuadricPriority& owner = midway.owner;
   std::vector<VertexId> alive, ring;
   for (VertexId v = 0; v < working.vertex_capacity(); ++v)
     if (working.vertex_alive(v)) alive.push_back(v);
