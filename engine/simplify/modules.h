@@ -160,6 +160,7 @@ class PriorityModule {
   void cost_seam_pair_by_pair(const CollapseMesh& mesh, std::span<const SeamPair> pairs,
                               std::span<const Vec3> places, Costing costing,
                               std::span<SeamCosting> out) {
+    CollapseCandidate other_pair;  // the costing of a pair after the first
     for (size_t k = 0; k < places.size(); ++k) {
       SeamCosting& s = out[k];
       s.candidate = CollapseCandidate{};
@@ -167,7 +168,7 @@ class PriorityModule {
       double cost = 0, error = 0;
       bool each = true;
       for (size_t i = 0; i < pairs.size() && each; ++i) {
-        CollapseCandidate& c = i == 0 ? s.candidate : other_pair_;
+        CollapseCandidate& c = i == 0 ? s.candidate : other_pair;
         each = evaluate_seam(mesh, pairs[i].vs, pairs[i].vt, &places[k], c, costing);
         cost += c.cost;
         error = std::max(error, c.error);
@@ -179,9 +180,6 @@ class PriorityModule {
       s.placed = std::isfinite(cost);
     }
   }
-
- private:
-  CollapseCandidate other_pair_;  // cost_seam_pair_by_pair's costing of a pair after the first
 };
 
 // A module wrapped around another (a restriction, a memo, a step left out): forwards every

@@ -223,10 +223,15 @@ bool QuadricPriority::evaluate_seam(const CollapseMesh& mesh, VertexId vs, Verte
   return cost_seam(mesh, vs, vt, at, out);
 }
 
+Quadric QuadricPriority::pair_quadric(VertexId a, VertexId b) const {
+  Quadric q = quadrics_[std::min(a, b)];
+  q += quadrics_[std::max(a, b)];
+  return q;
+}
+
 bool QuadricPriority::cost_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                                 CollapseCandidate& out) const {
-  Quadric q = quadrics_[std::min(vs, vt)];
-  q += quadrics_[std::max(vs, vt)];
+  const Quadric q = pair_quadric(vs, vt);
   out.vs = vs;
   out.vt = vt;
   out.position =
@@ -247,10 +252,7 @@ void QuadricPriority::cost_seam_at(std::span<const SeamPair> pairs, std::span<co
                                    std::span<SeamCosting> out, std::vector<Quadric>& sums) const {
   // cost_seam's sums and costs, in the same order: the same bits.
   sums.resize(pairs.size());
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    sums[i] = quadrics_[std::min(pairs[i].vs, pairs[i].vt)];
-    sums[i] += quadrics_[std::max(pairs[i].vs, pairs[i].vt)];
-  }
+  for (size_t i = 0; i < pairs.size(); ++i) sums[i] = pair_quadric(pairs[i].vs, pairs[i].vt);
   for (size_t k = 0; k < places.size(); ++k) {
     double cost = 0, error = 0;
     for (const Quadric& q : sums) {

@@ -116,6 +116,8 @@ class QuadricPriority : public PriorityModule {
   // costing view calls too.
   bool cost(const CollapseMesh& mesh, VertexId a, VertexId b, CollapseCandidate& out,
             Costing costing, StarTermsScratch& scratch) const;
+  // A seam pair's summed quadric, the lesser id's first: the same bits whichever end is vs.
+  Quadric pair_quadric(VertexId a, VertexId b) const;
   bool cost_seam(const CollapseMesh& mesh, VertexId vs, VertexId vt, const Vec3* at,
                  CollapseCandidate& out) const;
   // evaluate_seam_at without counting; `sums`: working memory, a quadric per pair.
