@@ -16,7 +16,8 @@ set(PARAPM_ENGINE_HEADERS io/gltf_writer.h io/mesh_io.h mesh/mesh.h mesh/repair.
   parallel/edge_keys.h parallel/parallel_build.h parallel/simplify_subset.h parallel/subset_job.h
   pm/face_lists.h pm/levels.h pm/pm_file.h pm/progressive_mesh.h simplify/collapse_mesh.h
   simplify/module_state.h
-  simplify/copy_groups.h simplify/modules.h simplify/quad_heap.h simplify/quadric.h
+  simplify/copy_groups.h simplify/key_rank.h simplify/modules.h simplify/quad_heap.h
+  simplify/quadric.h
   simplify/simplifier.h simplify/tiered_queue.h
   simplify/simplify.h util/chunked_loops.h util/error.h util/fresh_pages.h util/progress.h
   util/zeroed_array.h)

@@ -90,8 +90,8 @@ bool Simplifier::entry_of_costing(VertexId a, VertexId b, bool placed, double co
     if (defer_) remember_key(a, b, std::numeric_limits<float>::infinity());
     return false;
   }
-  entry = {key_of(cost, a, b), a, b, version_[a] + version_[b]};
-  if (defer_) remember_key(a, b, entry.cost);
+  entry = Entry::of(key_of(cost, a, b), a, b, version_[a] + version_[b]);
+  if (defer_) remember_key(a, b, entry.cost());
   return true;
 }
 
@@ -130,7 +130,7 @@ bool Simplifier::deferred_entry(VertexId a, VertexId b, Entry& entry) {
   // and an edge that comes out too early only costs one costing. A refused edge (infinite)
   // comes out when nothing else is left.
   if (!std::isinf(key)) key -= 0.5f * std::abs(key);
-  entry = {key, a, b, (version_[a] + version_[b]) | kDeferred};
+  entry = Entry::of(key, a, b, (version_[a] + version_[b]) | kDeferred);
   ++stats_.deferred;
   return true;
 }
@@ -313,7 +313,7 @@ void Simplifier::queue_checked(VertexId a, VertexId b, const SimplifierLimits& l
   Entry entry;
   if (!queue_entry(a, b, entry)) return;
   // (not within a seam collapse, whose survivors' versions change one after another)
-  if (check_when_queued_ && entry.cost <= last_key_ && !queueing_seams_ &&
+  if (check_when_queued_ && entry.cost() <= last_key_ && !queueing_seams_ &&
       !seam_edge(entry.a, entry.b) && vetoed_when_queued(entry, limits, folded))
     return;
   queue_.push(entry);
@@ -706,8 +706,8 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       ++stats_.stale;
       continue;
     }
-    if (entry.cost > key_ceiling) {  // and so does every entry after it
-      queue_.push(entry);            // (deferred_edges() lists what the queue holds)
+    if (entry.cost() > key_ceiling) {  // and so does every entry after it
+      queue_.push(entry);              // (deferred_edges() lists what the queue holds)
       stats_.stop_reason = "cost ceiling reached";
       break;
     }
@@ -768,9 +768,9 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
       queue_.pop();
       ++stats_.stale;
     }
-    const Entry now{key_of(candidate.cost, entry.a, entry.b), entry.a, entry.b,
-                    entry.stamp | kRequeued};
-    if (!queue_.empty() && queue_.top().cost < now.cost) {
+    const Entry now = Entry::of(key_of(candidate.cost, entry.a, entry.b), entry.a, entry.b,
+                                entry.stamp | kRequeued);
+    if (!queue_.empty() && queue_.top().key < now.key) {
       queue_.push(now);
       ++stats_.requeued;
       // (a seam collapse's costing also reads its other copies' stars and its parts' sizes,
@@ -780,7 +780,7 @@ std::vector<CollapseRecord> Simplifier::run(const SimplifierLimits& limits,
                                                  mesh_.star_version(entry.b), std::move(candidate)};
       continue;
     }
-    last_key_ = now.cost;
+    last_key_ = now.cost();
     if (candidate.seam) {
       if (!perform_seam(candidate, limits, records)) {
         ++stats_.rejected;

@@ -17,6 +17,7 @@
 
 #include "simplify/collapse_mesh.h"
 #include "simplify/copy_groups.h"
+#include "simplify/key_rank.h"
 #include "simplify/modules.h"
 #include "simplify/tiered_queue.h"
 #include "util/chunked_loops.h"
@@ -266,15 +267,21 @@ class Simplifier {
   static constexpr uint32_t kRequeued = 0x40000000u;
   static constexpr uint32_t kVersions = ~(kDeferred | kRequeued);
   struct Entry {
-    float cost;  // the key
-    VertexId a, b;
+    VertexId a;
+    uint32_t key;  // the queue key's rank (key_rank.h): the order of the float key
+    VertexId b;
     uint32_t stamp;
+    static Entry of(float key, VertexId a, VertexId b, uint32_t stamp) {
+      return {a, key_rank(key), b, stamp};
+    }
+    float cost() const { return rank_key(key); }  // the float key
+    // The key's rank and a, the order's first two words, as one number.
+    uint64_t rank_and_a() const { return uint64_t(key) << 32 | a; }
   };
   struct Before {  // by key, ties broken by the edge's ids for determinism
     bool operator()(const Entry& x, const Entry& y) const {
-      if (x.cost != y.cost) return x.cost < y.cost;
-      if (x.a != y.a) return x.a < y.a;
-      return x.b < y.b;
+      const uint64_t kx = x.rank_and_a(), ky = y.rank_and_a();
+      return kx != ky ? kx < ky : x.b < y.b;
     }
   };
 

@@ -10,7 +10,8 @@
 // while they waited in a range (drop_when) are dropped as it moves into the heap, instead of
 // each sifted out of it.
 //
-// T has a float `cost`, its key, which Before orders first; NaN keys are not allowed.
+// T has a `key` (a float, or an unsigned integer such as a float key's rank: key_rank.h), which
+// Before orders first; NaN keys are not allowed.
 #pragma once
 
 #include <algorithm>
@@ -18,6 +19,8 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "simplify/quad_heap.h"
@@ -27,6 +30,7 @@ namespace parapm {
 template <typename T, typename Before>
 class TieredQueue {
  public:
+  using Key = std::remove_cvref_t<decltype(std::declval<T>().key)>;
   static constexpr size_t kMinBatch = 4096;  // an open bucket this small goes to the heap whole
 
   // Items for which `dead` holds are dropped as a range moves into the heap: they would
@@ -37,7 +41,7 @@ class TieredQueue {
   size_t size() const { return heap_.size() + bucketed_; }
   void clear() {
     heap_.clear();
-    threshold_ = -std::numeric_limits<float>::infinity();
+    threshold_ = kLowest;
     bounds_.clear();
     ranges_.clear();
     open_.clear();
@@ -46,8 +50,8 @@ class TieredQueue {
   }
 
   void push(const T& item) {
-    if (item.cost <= threshold_) return heap_.push(item);
-    const size_t i = range_of(item.cost, next_);
+    if (item.key <= threshold_) return heap_.push(item);
+    const size_t i = range_of(item.key, next_);
     if (i < bounds_.size())
       ranges_[i].push_back(item);
     else
@@ -100,7 +104,7 @@ class TieredQueue {
   // The range from `first` on whose keys take `key`; bounds_.size(): the open bucket. The
   // first bound not below the key (bounds ascend), found by counting those below it: at most
   // kParts - 1 compares without a branch, where a binary search mispredicts at every step.
-  size_t range_of(float key, size_t first) const {
+  size_t range_of(Key key, size_t first) const {
     size_t i = first;
     for (size_t k = first; k < bounds_.size(); ++k) i += bounds_[k] < key;
     return i;
@@ -150,7 +154,7 @@ class TieredQueue {
           if (!(dead_ && dead_(item))) items.push_back(item);
       heap_.rebuild();
       bucketed_ -= count;
-      threshold_ = std::numeric_limits<float>::infinity();
+      threshold_ = kHighest;
       return;
     }
     // Every stride-th item (blocks hold fewer than kBlock once remove_if has run).
@@ -159,18 +163,18 @@ class TieredQueue {
     size_t block = 0, before = 0;  // the block holding item i * stride, and the items before it
     for (size_t i = 0; i < kSample; ++i) {
       while (i * stride >= before + blocks[block].size()) before += blocks[block++].size();
-      sample_.push_back(blocks[block][i * stride - before].cost);
+      sample_.push_back(blocks[block][i * stride - before].key);
     }
     std::sort(sample_.begin(), sample_.end());
     for (size_t k = 1; k < kParts; ++k) {
-      const float bound = sample_[k * kSample / kParts - 1];
+      const Key bound = sample_[k * kSample / kParts - 1];
       if (bounds_.empty() || bound > bounds_.back()) bounds_.push_back(bound);
     }
     std::vector<size_t> counts(bounds_.size() + 1, 0);
     range_index_.resize(count);
     size_t at = 0;
     for (const Items& block : blocks)
-      for (const T& item : block) ++counts[range_index_[at++] = uint8_t(range_of(item.cost, 0))];
+      for (const T& item : block) ++counts[range_index_[at++] = uint8_t(range_of(item.key, 0))];
     ranges_.resize(bounds_.size());
     for (size_t i = 0; i < ranges_.size(); ++i) ranges_[i].reserve(counts[i]);
     at = 0;
@@ -190,15 +194,22 @@ class TieredQueue {
   static constexpr size_t kParts = 16;
   static_assert(kParts <= 256, "a range index is a byte");
   QuadHeap<T, Before> heap_;
-  float threshold_ = -std::numeric_limits<float>::infinity();  // the heap's keys are at most it
+  // Below and above every key.
+  static constexpr Key kLowest = std::numeric_limits<Key>::has_infinity
+                                     ? -std::numeric_limits<Key>::infinity()
+                                     : std::numeric_limits<Key>::lowest();
+  static constexpr Key kHighest = std::numeric_limits<Key>::has_infinity
+                                      ? std::numeric_limits<Key>::infinity()
+                                      : std::numeric_limits<Key>::max();
+  Key threshold_ = kLowest;  // the heap's keys are at most it
   // ranges_[i] holds the keys in (bounds_[i - 1], bounds_[i]] (the first from threshold_); the
   // open bucket, in blocks, those above every bound.
-  std::vector<float> bounds_;
+  std::vector<Key> bounds_;
   std::vector<Items> ranges_;
   std::vector<Items> open_;
   size_t next_ = 0;                   // the first range not yet moved to the heap
   size_t bucketed_ = 0;               // the items in ranges and the open bucket
-  std::vector<float> sample_;         // cut_open's working memory
+  std::vector<Key> sample_;           // cut_open's working memory
   std::vector<uint8_t> range_index_;  // and each item's range (kParts fit a byte)
   std::function<bool(const T&)> dead_;
 };

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "simplify/key_rank.h"
 #include "simplify/quad_heap.h"
 #include "simplify/tiered_queue.h"
 
@@ -15,19 +16,19 @@ namespace parapm {
 namespace {
 
 struct Item {
-  float cost;
+  float key;
   uint32_t a, b;
 };
 
 struct ItemBefore {
   bool operator()(const Item& x, const Item& y) const {
-    if (x.cost != y.cost) return x.cost < y.cost;
+    if (x.key != y.key) return x.key < y.key;
     if (x.a != y.a) return x.a < y.a;
     return x.b < y.b;
   }
 };
 
-bool same(const Item& x, const Item& y) { return x.cost == y.cost && x.a == y.a && x.b == y.b; }
+bool same(const Item& x, const Item& y) { return x.key == y.key && x.a == y.a && x.b == y.b; }
 
 // Keys as a collapse queue sees them: many tied (flat regions cost 0), most a little above the
 // water level, some far above it, a few infinite (refused edges at the end of the queue).
@@ -60,7 +61,7 @@ TEST(TieredQueue, GivesTheOrderOfOneHeapThroughPushesAndPops) {
       const Item out = tiered.pop();
       ASSERT_TRUE(same(out, heap.pop())) << "seed " << seed << ", item " << popped;
       ++popped;
-      if (std::isfinite(out.cost)) level = out.cost;
+      if (std::isfinite(out.key)) level = out.key;
       // A collapse's edges come back around the water level, while the queue is long.
       if (popped % 3 == 0 && popped < 150000) {
         for (int k = 0; k < 4; ++k) {
@@ -146,7 +147,7 @@ TEST(TieredQueue, DropsDeadItemsAndKeepsTheOrderOfTheLiveOnes) {
     dead[out.b] = 1;  // out of the queue: any copy left is stale
     --live_left;
     ++popped;
-    if (std::isfinite(out.cost)) level = out.cost;
+    if (std::isfinite(out.key)) level = out.key;
     if (popped < 100000 && popped % 2 == 0) {
       // A collapse: some queued items die, new ones come.
       for (int k = 0; k < 3; ++k) {
@@ -159,6 +160,63 @@ TEST(TieredQueue, DropsDeadItemsAndKeepsTheOrderOfTheLiveOnes) {
   }
   EXPECT_GT(popped, 50000u);
   EXPECT_LT(dead_from_tiers, dead_from_heap / 2);  // most were dropped on the way
+}
+
+// The collapse queue's keys as ranks (key_rank.h): one 64-bit word of rank and first id.
+struct RankedItem {
+  uint32_t a;
+  uint32_t key;
+  uint32_t b;
+};
+
+struct RankedBefore {
+  bool operator()(const RankedItem& x, const RankedItem& y) const {
+    const uint64_t kx = uint64_t(x.key) << 32 | x.a, ky = uint64_t(y.key) << 32 | y.a;
+    return kx != ky ? kx < ky : x.b < y.b;
+  }
+};
+
+TEST(KeyRank, OrdersAsTheFloatsAndGivesThemBack) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const float denormal = std::numeric_limits<float>::denorm_min();
+  const float big = std::numeric_limits<float>::max();
+  std::vector<float> keys = {-inf,     -big,   -1e20f, -1.5f, -1.0f, -denormal, -0.0f, 0.0f,
+                             denormal, 1e-30f, 1.0f,   1.5f,  3e38f, big,       inf};
+  std::mt19937 random(5);
+  for (int i = 0; i < 2000; ++i)
+    keys.push_back(std::ldexp(float(random() % 2000) - 1000.0f, int(random() % 200) - 100));
+  for (float x : keys) {
+    EXPECT_EQ(rank_key(key_rank(x)), x + 0.0f);
+    EXPECT_FALSE(std::signbit(rank_key(key_rank(x))) && x == 0) << "-0 ranks as +0";
+    for (float y :
+         {-inf, -1.0f, -0.0f, 0.0f, denormal, 1.0f, inf, keys[size_t(random() % keys.size())]}) {
+      EXPECT_EQ(key_rank(x) < key_rank(y), x < y) << x << " " << y;
+      EXPECT_EQ(key_rank(x) == key_rank(y), x == y) << x << " " << y;
+    }
+  }
+}
+
+TEST(TieredQueue, GivesRankedKeysOutInTheOrderOfTheirFloats) {
+  std::mt19937 random(13);
+  TieredQueue<RankedItem, RankedBefore> ranked;
+  QuadHeap<Item, ItemBefore> heap;
+  auto push = [&](float key) {
+    // Negative keys too (the simplifier's keys of flat collapses), a few -0 beside +0.
+    if (random() % 8 == 0) key = -key;
+    const Item item{key, uint32_t(random() % 1000), uint32_t(random() % 100000)};
+    ranked.push({item.a, key_rank(item.key), item.b});
+    heap.push(item);
+  };
+  for (int i = 0; i < 50000; ++i) push(draw_key(random, 0.0f));
+  size_t popped = 0;
+  while (!heap.empty()) {
+    const Item want = heap.pop();
+    const RankedItem got = ranked.pop();
+    ASSERT_TRUE(rank_key(got.key) == want.key && got.a == want.a && got.b == want.b)
+        << "item " << popped;
+    if (++popped < 40000 && popped % 2 == 0) push(std::isfinite(want.key) ? want.key + 1.0f : 1.0f);
+  }
+  EXPECT_TRUE(ranked.empty());
 }
 
 }  // namespace
