@@ -60,18 +60,18 @@ EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
   VertexId& onward_apex = from_a ? result.left_apex : result.right_apex;
   FaceId& back = from_a ? result.right : result.left;  // the face holding to -> from
   VertexId& back_apex = from_a ? result.right_apex : result.left_apex;
+  // (selected, not branched to: which faces of the fan hold the edge follows no pattern)
   for (FaceId f : faces_of(from)) {
     const Triangle& t = faces_[f];
     const int i = corner_of(t, from);
     const VertexId next = t[(i + 1) % 3];
     const VertexId prev = t[(i + 2) % 3];
-    if (next == to) {
-      onward = f;
-      onward_apex = prev;
-    } else if (prev == to) {
-      back = f;
-      back_apex = next;
-    }
+    const bool holds_onward = next == to;
+    const bool holds_back = (prev == to) & !holds_onward;
+    onward = holds_onward ? f : onward;
+    onward_apex = holds_onward ? prev : onward_apex;
+    back = holds_back ? f : back;
+    back_apex = holds_back ? next : back_apex;
   }
   return result;
 }
@@ -94,8 +94,10 @@ std::vector<FaceId> CollapseMesh::twin_faces(ChunkedLoops& loops) const {
         const int i = corner_of(faces_[f], VertexId(a));
         const VertexId next = faces_[f][(i + 1) % 3];
         // The face holding next -> a: next comes before a there (the last one, as edge_faces).
-        for (const auto& [before, g] : fan)
-          if (before == next) twin[3 * size_t(f) + size_t(i)] = g;
+        // Chosen without a branch: which of the fan's faces it is follows no pattern.
+        FaceId across = kNoId;
+        for (const auto& [before, g] : fan) across = before == next ? g : across;
+        twin[3 * size_t(f) + size_t(i)] = across;
       }
     }
   });
@@ -111,15 +113,20 @@ uint32_t CollapseMesh::next_stamp() const {
 }
 
 void CollapseMesh::neighbors(VertexId v, std::vector<VertexId>& out) const {
-  out.clear();
+  const std::span<const FaceId> fan = faces_of(v);
+  out.resize(3 * fan.size());
   const uint32_t seen = next_stamp();
   mark_[v] = seen;
-  for (FaceId f : faces_of(v))
-    for (VertexId n : faces_[f])
-      if (mark_[n] != seen) {
-        mark_[n] = seen;
-        out.push_back(n);
-      }
+  // Each corner written, kept when not seen before: no branch on whether a neighbour repeats
+  // (half of them do, in no pattern).
+  size_t count = 0;
+  for (FaceId f : fan)
+    for (VertexId n : faces_[f]) {
+      out[count] = n;
+      count += mark_[n] != seen;
+      mark_[n] = seen;
+    }
+  out.resize(count);
 }
 
 // A vertex is on the boundary when one of its edges has a face on one side only. On a
@@ -200,8 +207,7 @@ void CollapseMesh::collapse(VertexId vs, VertexId vt, const Vec3& position,
   for (VertexId v : {vs, vt, removed.left_apex, removed.right_apex})
     if (v != kNoId) ++star_version_[v];
   for (FaceId f : faces_of(vs))
-    for (VertexId v : faces_[f])
-      if (v != vs) ++star_version_[v];
+    for (VertexId v : faces_[f]) star_version_[v] += v != vs;  // (vs's, above)
 }
 
 uint64_t CollapseMesh::Identity::next() {

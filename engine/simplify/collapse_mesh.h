@@ -80,9 +80,11 @@ class CollapseMesh {
     for (FaceId f : faces_of(a))
       for (VertexId n : faces_[f]) mark_[n] = seen;
     const uint32_t done = next_stamp();
+    // (tested together, not one after the other: b is a corner of every face, in any of the
+    // three places, and the common neighbours are few)
     for (FaceId f : faces_of(b))
       for (VertexId n : faces_[f])
-        if (n != a && n != b && mark_[n] == seen) {
+        if ((n != a) & (n != b) & (mark_[n] == seen)) {
           mark_[n] = done;
           visit(n);
         }
@@ -146,9 +148,12 @@ class CollapseMesh {
 // number of components.
 uint32_t connected_components(const CollapseMesh& mesh, std::vector<uint32_t>& component);
 
-// Index of vertex v among the corners of face t (0, 1, 2), or -1.
+// Index of vertex v among the corners of face t (0, 1, 2; the first where it repeats), or -1.
+// Without a branch: which corner a face's vertex is follows no pattern a predictor learns.
 inline int corner_of(const Triangle& t, VertexId v) {
-  return t[0] == v ? 0 : t[1] == v ? 1 : t[2] == v ? 2 : -1;
+  int corner = t[2] == v ? 2 : -1;
+  corner = t[1] == v ? 1 : corner;
+  return t[0] == v ? 0 : corner;
 }
 
 }  // namespace parapm
