@@ -1,7 +1,7 @@
 // A float queue key as an unsigned integer of the same order: key_rank(x) < key_rank(y) exactly
 // when x < y, for every key but NaN (-0 ranks as +0, its equal). A queue entry keeps the rank
-// beside an end's id, so that its heap compares one 64-bit word where a float compare and
-// its tie-break took three branches.
+// beside an end's id, so that its heap compares one 64-bit word, not a float and then an id,
+// each with its own branch.
 #pragma once
 
 #include <bit>
