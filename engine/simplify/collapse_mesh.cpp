@@ -94,7 +94,6 @@ std::vector<FaceId> CollapseMesh::twin_faces(ChunkedLoops& loops) const {
         const int i = corner_of(faces_[f], VertexId(a));
         const VertexId next = faces_[f][(i + 1) % 3];
         // The face holding next -> a: next comes before a there (the last one, as edge_faces).
-        // Chosen without a branch: which of the fan's faces it is follows no pattern.
         FaceId across = kNoId;
         for (const auto& [before, g] : fan) across = before == next ? g : across;
         twin[3 * size_t(f) + size_t(i)] = across;
