@@ -94,6 +94,7 @@ nlohmann::json parallel_json(const ParallelStats& stats) {
           {"round_stats", rounds},
           {"setup_seconds", stats.setup_seconds},
           {"final_pass_collapses", stats.final_pass_collapses},
+          {"final_pass_on_live_copy", stats.final_pass_on_live_copy},
           {"final_pass_seconds", stats.final_pass_seconds},
           {"final_work_seconds", stats.final_work_seconds},
           {"final_append_seconds", stats.final_append_seconds},

@@ -86,6 +86,10 @@ struct ParallelOptions {
   // fewer than p subsets on a team of p / subsets chunks (ThreadPoolRunner) (the same PM: fewer
   // take less time than waking the team does); 0: none.
   uint32_t team_min_points = JobTeam::kDefaultMinItems;
+  // The quadric's final pass on a compact copy of the live mesh (live_pass.h), the PM's base
+  // read from the copy; off (for measuring and the tests): on the whole mesh's arrays. The same
+  // PM either way.
+  bool final_pass_on_live_copy = true;
   // Tests only: the master follows each round by re-running its module's collapsed() on every
   // merged record (the first step's path) instead of importing the jobs' returned states.
   bool replay_state = false;
@@ -163,6 +167,8 @@ struct ParallelStats {
   std::vector<RoundStats> round_stats;
   double setup_seconds = 0;  // the master's metric, initialised once on the whole mesh
   uint64_t final_pass_collapses = 0;
+  // Whether it ran on a compact copy of the live mesh (ParallelOptions::final_pass_on_live_copy).
+  bool final_pass_on_live_copy = false;
   double final_pass_seconds = 0;    // its set-up and its collapses
   double final_work_seconds = 0;    // its collapses
   double final_append_seconds = 0;  // the last round's records appended, beside the final pass

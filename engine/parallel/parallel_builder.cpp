@@ -14,6 +14,7 @@
 #include "parallel/collapse_merge.h"
 #include "parallel/edge_keys.h"
 #include "parallel/job_state.h"
+#include "parallel/live_pass.h"
 #include "parallel/round_shares.h"
 #include "parallel/simplify_subset.h"
 #include "parallel/subset_job.h"
@@ -22,6 +23,7 @@
 #include "simplify/energy_priority.h"
 #include "simplify/modules.h"
 #include "simplify/pm_builder.h"
+#include "simplify/quadric_priority.h"
 #include "simplify/simplifier.h"
 #include "simplify/surface_samples.h"
 #include "util/clock.h"
@@ -1086,18 +1088,45 @@ void ParallelBuilder::final_pass() {
     const uint64_t total = input_faces_ - target_;
     if (progress_) progress_(std::min<uint64_t>(done_before + done, total), total);
   };
+  // The quadric's pass runs on a compact copy of the live mesh (live_pass.h) where it can.
+  const auto* quadric = dynamic_cast<const QuadricPriority*>(master_.get());
+  const bool on_live_copy =
+      parallel_.final_pass_on_live_copy && quadric && master_queue_ == master_.get();
+  std::optional<LivePass>& live = live_;
+  auto run_pass = [&] {
+    if (on_live_copy) {
+      LivePassInputs inputs;
+      inputs.layout = &mesh_.layout;
+      inputs.wedge_values = &mesh_.wedge_values;
+      inputs.positions_are_float = mesh_.positions_are_float;
+      inputs.locked = &locked_;
+      inputs.groups = &copy_groups_;
+      inputs.components = whole_components();
+      inputs.components_may_vanish = !options_.keep_components;
+      inputs.on_membrane = &on_membrane_;
+      live = run_on_live_copy(whole, *quadric, inputs, limits, progress, cancel_, master_loops_);
+    }
+    if (live)
+      final_records = std::move(live->records);  // (the PM reads the live copy's end)
+    else
+      final_records = pass.run(limits, progress, cancel_);
+  };
   // The last round's records go into records_ beside it (append_pending).
   const double team_before = team_saving();
-  const Beside timed =
-      run_beside(parallel_.threads, [&] { final_records = pass.run(limits, progress, cancel_); },
-                 {[this] { append_pending(); }});
-  st_.final_work_seconds = timed.work_seconds - (team_saving() - team_before);
+  const double loops_before = master_loops_.seconds() - master_loops_.critical_seconds();
+  const Beside timed = run_beside(parallel_.threads, run_pass, {[this] { append_pending(); }});
+  // (the live copy's listing counted at its loops' critical path)
+  const double loops_saved =
+      master_loops_.seconds() - master_loops_.critical_seconds() - loops_before;
+  st_.final_work_seconds = timed.work_seconds - (team_saving() - team_before) - loops_saved;
   st_.final_pass_collapses = final_records.size();
+  st_.final_pass_on_live_copy = live.has_value();
   st_.final_pass_seconds = setup_seconds + st_.final_work_seconds;
   st_.final_append_seconds = timed.side_seconds[0];
   subsets_cpu_ += timed.side_cpu_elsewhere;
-  st_.stop_reason = pass.stats().stop_reason;
-  const SimplifierStats& fs = pass.stats();
+  const SimplifierStats& fs = live ? live->stats : pass.stats();
+  if (live) final_costings_ = live->costings;
+  st_.stop_reason = fs.stop_reason;
   spdlog::debug(
       "final pass: {} keys carried in, {} answered from them; {} evaluations, {} vetoed, {} "
       "screened, {} requeued, {} stale, {} seam collapses ({} split)",
@@ -1114,7 +1143,9 @@ ProgressiveMesh ParallelBuilder::progressive_mesh() {
   PmBuildOptions build_options;
   build_options.keep_order = options_.keep_order;
   build_options.loops = &master_loops_;
-  ProgressiveMesh pm = build_pm_from_collapses(repaired_, *whole_, records_, build_options);
+  ProgressiveMesh pm = live_ ? build_pm_from_collapses(repaired_, live_->final_mesh(*whole_),
+                                                       records_, build_options)
+                             : build_pm_from_collapses(repaired_, *whole_, records_, build_options);
   pm.info.metric = master_->name();
   st_.pm_build_seconds = clock.critical_seconds();
   st_.collapses = records_.size();
@@ -1123,7 +1154,7 @@ ProgressiveMesh ParallelBuilder::progressive_mesh() {
   st_.cpu_seconds = subsets_cpu_ + (team_ ? team_->worker_cpu_seconds() : 0) +
                     (thread_cpu_seconds() - master_cpu_start_);
   // The master's: band passes and final pass.
-  const uint64_t master_costings = master_->costings() - master_sample_costings_;
+  const uint64_t master_costings = master_->costings() - master_sample_costings_ + final_costings_;
   st_.costings = job_costings_ + sample_costings_ + master_costings;
   pm.info.seconds = st_.seconds;
   spdlog::debug(

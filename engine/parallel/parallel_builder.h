@@ -19,6 +19,7 @@
 
 #include "parallel/collapse_merge.h"
 #include "parallel/edge_keys.h"
+#include "parallel/live_pass.h"
 #include "parallel/parallel_build.h"
 #include "simplify/collapse_mesh.h"
 #include "simplify/copy_groups.h"
@@ -164,6 +165,10 @@ class ParallelBuilder {
 
   uint64_t job_costings_ = 0, sample_costings_ = 0;  // (ParallelStats::costings)
   uint64_t master_sample_costings_ = 0;  // of those, the master's own (sample_on_master)
+  uint64_t final_costings_ = 0;          // the final pass's on a live copy (live_pass.h)
+  // The quadric's final pass on a copy of the live mesh: whole_ stays as the rounds left it,
+  // the PM's base is the copy's.
+  std::optional<LivePass> live_;
   // The edges jobs left deferred (global ids, sorted), kept until a collapse changes an end:
   // the next round's jobs and the final pass queue them deferred (SubsetJob::deferred).
   std::vector<DeferredEdge> deferred_;

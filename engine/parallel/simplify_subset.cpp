@@ -19,21 +19,6 @@
 namespace parapm {
 namespace {
 
-// Local ids to global ids, in place.
-void globalise(CollapseRecord& r, const SubsetJob& job) {
-  auto vertex = [&](VertexId v) { return v == kNoId ? kNoId : job.global_vertex[v]; };
-  auto face = [&](FaceId f) { return f == kNoId ? kNoId : job.global_face[f]; };
-  auto wedge = [&](WedgeId w) { return w == kNoId ? kNoId : job.global_wedge[w]; };
-  r.vs = vertex(r.vs);
-  r.vt = vertex(r.vt);
-  r.vl = vertex(r.vl);
-  r.vr = vertex(r.vr);
-  r.fl = face(r.fl);
-  r.fr = face(r.fr);
-  for (WedgeId& w : r.corner_wedges) w = wedge(w);
-  for (WedgeId& w : r.changed_wedges) w = wedge(w);
-}
-
 // Still sorted: local ids follow the global order.
 std::vector<EdgeKey> current_keys_in_global_ids(const KeyMemo& memo, const CollapseMesh& mesh,
                                                 const SubsetJob& job) {
@@ -182,7 +167,7 @@ SubsetResult simplify(const SubsetJob& job, SubsetJob* release, const ProgressCa
       v = job.global_vertex[v];
     }
   }
-  for (CollapseRecord& r : result.records) globalise(r, job);
+  for (CollapseRecord& r : result.records) to_global_ids(r, job);
   result.costings = metric->costings() - costings_before;
   result.wall_seconds = seconds_since(start);
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;

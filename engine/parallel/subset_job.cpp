@@ -46,6 +46,20 @@ class Marks {
 
 }  // namespace
 
+void to_global_ids(CollapseRecord& r, const SubsetJob& job) {
+  auto vertex = [&](VertexId v) { return v == kNoId ? kNoId : job.global_vertex[v]; };
+  auto face = [&](FaceId f) { return f == kNoId ? kNoId : job.global_face[f]; };
+  auto wedge = [&](WedgeId w) { return w == kNoId ? kNoId : job.global_wedge[w]; };
+  r.vs = vertex(r.vs);
+  r.vt = vertex(r.vt);
+  r.vl = vertex(r.vl);
+  r.vr = vertex(r.vr);
+  r.fl = face(r.fl);
+  r.fr = face(r.fr);
+  for (WedgeId& w : r.corner_wedges) w = wedge(w);
+  for (WedgeId& w : r.changed_wedges) w = wedge(w);
+}
+
 SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout,
                          const std::vector<float>& wedge_values, bool positions_are_float,
                          const std::vector<uint8_t>& locked,

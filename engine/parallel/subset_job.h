@@ -134,6 +134,9 @@ SubsetJob extract_subset(const CollapseMesh& mesh, const AttributeLayout& layout
                          const std::vector<VertexId>& owned, uint32_t subset, uint32_t round,
                          const SubsetOptions& options, const CopyGroups* groups = nullptr);
 
+// A record of the job's simplification (its ids local) in the whole mesh's ids, in place.
+void to_global_ids(CollapseRecord& record, const SubsetJob& job);
+
 // Checks what a job can check on its own: sizes agree, local ids in range, global ids
 // strictly increasing, every face touches an owned vertex. Throws Error(kInvalidInput)
 // naming the first violation. A worker calls it on a job that came over the network.

@@ -126,8 +126,8 @@ std::vector<float> replay_wedge_changes(const Mesh& mesh, const Records& records
   return values;
 }
 
-template <typename Records>
-ProgressiveMesh build_pm(const RepairedMesh& repaired, const CollapseMesh& final_mesh,
+template <typename Records, typename FinalMesh>
+ProgressiveMesh build_pm(const RepairedMesh& repaired, const FinalMesh& final_mesh,
                          const Records& records, const PmBuildOptions& options) {
   ChunkedLoops one_thread;
   ChunkedLoops& loops = options.loops ? *options.loops : one_thread;
@@ -299,6 +299,13 @@ ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
 
 ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
                                         const CollapseMesh& final_mesh,
+                                        std::span<const CollapseRecord* const> records,
+                                        const PmBuildOptions& options) {
+  return build_pm(repaired, final_mesh, RecordAddresses{records}, options);
+}
+
+ProgressiveMesh build_pm_from_collapses(const RepairedMesh& repaired,
+                                        const PartlyCopiedMesh& final_mesh,
                                         std::span<const CollapseRecord* const> records,
                                         const PmBuildOptions& options) {
   return build_pm(repaired, final_mesh, RecordAddresses{records}, options);

@@ -94,6 +94,7 @@ class QuadricPriority : public PriorityModule {
   // collapsed()'s change of every record, in order (check_records first).
   void follow_records(const std::vector<CollapseRecord>& records);
   const Quadric& quadric(VertexId v) const { return quadrics_[v]; }
+  const QuadricOptions& options() const { return options_; }
 
  private:
   // Face f's planes, given to add(vertex, quadric) in the order a pass over the faces sums

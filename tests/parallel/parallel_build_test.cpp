@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "drawn_meshes.h"
 #include "mesh/repaired_input.h"
 #include "parallel/border_band.h"
 #include "parallel/parallel_build.h"
@@ -398,6 +399,44 @@ TEST(ParallelBuild, PartitionsAreDrawnAhead) {
 // exactly up to the handover, the energy's only without deferred re-costing (with it they
 // part after a few hundred collapses on the airplane: the job's cost ceiling refuses edges
 // that the sequential build keys, so the two defer different edges).
+// The quadric's final pass on a compact copy of the live mesh (live_pass.h) makes the PM the
+// pass on the whole mesh's arrays makes: on a mesh with attributes, on one whose repair made
+// copies (seam collapses, its rims' copies locked), and on a scene whose small parts vanish in
+// the final pass.
+TEST(ParallelBuild, TheFinalPassOnALiveCopyChangesNoByte) {
+  struct Case {
+    const char* what;
+    RepairedMesh repaired;
+    uint64_t target_faces;
+  };
+  std::vector<Case> cases;
+  cases.push_back(
+      {"airplane", testing::repaired_test_mesh("pymeshlab-colored-airplane-11k.ply"), 200});
+  cases.push_back({"double-sided sheet",
+                   repair_mesh(testing::double_sided(testing::book_of_sheets(1, 24, 6))), 40});
+  cases.push_back({"ground with patches", repair_mesh(testing::ground_with_patches(150)), 40});
+  ASSERT_GT(cases[1].repaired.report.vertex_copies_added, 0u);
+  for (const Case& c : cases) {
+    SimplifyOptions options = metric_options("quadric");
+    options.target_faces = c.target_faces;
+    ParallelOptions parallel = with_p(4);
+    ParallelStats on_copy, on_whole;
+    const std::string copied =
+        testing::pm_bytes(build_progressive_mesh_parallel(c.repaired, options, parallel, &on_copy));
+    parallel.final_pass_on_live_copy = false;
+    const ProgressiveMesh whole =
+        build_progressive_mesh_parallel(c.repaired, options, parallel, &on_whole);
+    EXPECT_TRUE(on_copy.final_pass_on_live_copy) << c.what;
+    EXPECT_FALSE(on_whole.final_pass_on_live_copy) << c.what;
+    EXPECT_GT(on_copy.final_pass_collapses, 0u) << c.what;
+    EXPECT_EQ(on_copy.final_pass_collapses, on_whole.final_pass_collapses) << c.what;
+    EXPECT_TRUE(copied == testing::pm_bytes(whole)) << c.what << ": the PMs differ";
+    std::printf("%s: %zu faces, final pass %llu collapses to %zu faces\n", c.what,
+                c.repaired.mesh.face_count(), (unsigned long long)on_copy.final_pass_collapses,
+                whole.base.face_count());
+  }
+}
+
 TEST(ParallelBuild, OneSubsetGivesTheSequentialPmUpToTheHandover) {
   for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"})
     for (const char* metric : {"quadric", "energy"}) {

@@ -1,0 +1,141 @@
+#include "parallel/live_pass.h"
+
+#include <algorithm>
+#include <atomic>
+#include <utility>
+
+#include "parallel/job_state.h"
+#include "parallel/subset_job.h"
+#include "simplify/modules.h"
+#include "util/fresh_pages.h"
+
+namespace parapm {
+namespace {
+
+// Per vertex of the copy, the whole mesh's value of its vertex (empty stays empty).
+template <typename T>
+std::vector<T> of_copy(const std::vector<T>& whole, const std::vector<VertexId>& global) {
+  std::vector<T> out;
+  if (whole.empty()) return out;
+  out.reserve(global.size());
+  for (VertexId g : global) out.push_back(whole[g]);
+  return out;
+}
+
+// The live part of `whole` as a job of one subset owning it all, without a halo (subset_job.h:
+// local ids in the global order), its passes in `loops`' chunks; false when a live vertex holds
+// no face. Only what the pass reads is filled: the mesh, the maps, the locks and the groups.
+bool copy_live_part(const CollapseMesh& whole, const LivePassInputs& inputs, ChunkedLoops& loops,
+                    SubsetJob& copy, KeptItems& vertices, KeptItems& faces) {
+  vertices = number_kept(loops, whole.vertex_capacity(),
+                         [&](size_t v) { return whole.vertex_alive(VertexId(v)); });
+  faces = number_kept(loops, whole.face_capacity(),
+                      [&](size_t f) { return whole.face_alive(FaceId(f)); });
+  Mesh& mesh = copy.mesh;
+  mesh.positions_are_float = inputs.positions_are_float;
+  resize_touched(mesh.positions, vertices.old_id.size(), loops);
+  loops.run(vertices.old_id.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) mesh.positions[i] = whole.position(vertices.old_id[i]);
+  });
+  std::vector<uint8_t> held(vertices.old_id.size(), 0);
+  resize_touched(mesh.faces, faces.old_id.size(), loops);
+  loops.run(faces.old_id.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const Triangle& t = whole.face(faces.old_id[i]);
+      for (int k = 0; k < 3; ++k) {
+        mesh.faces[i][k] = vertices.new_id[t[k]];
+        std::atomic_ref<uint8_t>(held[mesh.faces[i][k]]).store(1, std::memory_order_relaxed);
+      }
+    }
+  });
+  if (std::find(held.begin(), held.end(), 0) != held.end()) return false;
+  copy.global_vertex = vertices.old_id;
+  copy.global_face = faces.old_id;
+  if (inputs.locked) copy.locked = of_copy(*inputs.locked, copy.global_vertex);
+  copy.locked.resize(copy.global_vertex.size(), 0);
+  const CopyGroups* groups = inputs.groups;
+  if (groups && !groups->empty()) {
+    // Every live copy is here: a group is named by its first live copy's local id.
+    copy.copy_group.assign(copy.global_vertex.size(), kNoId);
+    for (size_t i = 0; i < copy.global_vertex.size(); ++i) {
+      const VertexId g = copy.global_vertex[i];
+      if (!groups->is_copy(g)) continue;
+      for (VertexId member : groups->of(groups->group[g]))
+        if (whole.vertex_alive(member)) {
+          copy.copy_group[i] = vertices.new_id[member];
+          break;
+        }
+    }
+  }
+  const size_t floats = size_t(inputs.layout->floats_per_wedge());
+  if (inputs.layout->any() && whole.has_wedges() && floats > 0) {
+    // The wedges of the live faces' corners, numbered in order.
+    std::vector<uint8_t> used(inputs.wedge_values->size() / floats, 0);
+    loops.run(faces.old_id.size(), [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i)
+        for (WedgeId w : whole.corner_wedges(faces.old_id[i]))
+          std::atomic_ref<uint8_t>(used[w]).store(1, std::memory_order_relaxed);
+    });
+    const KeptItems wedges = number_kept(loops, used.size(), [&](size_t w) { return used[w]; });
+    copy.global_wedge = wedges.old_id;
+    mesh.layout = *inputs.layout;
+    mesh.wedge_values.resize(wedges.old_id.size() * floats);
+    for (size_t i = 0; i < wedges.old_id.size(); ++i)
+      std::copy_n(inputs.wedge_values->begin() + ptrdiff_t(wedges.old_id[i] * floats), floats,
+                  mesh.wedge_values.begin() + ptrdiff_t(i * floats));
+    mesh.wedge_vertex.assign(wedges.old_id.size(), kNoId);
+    mesh.face_wedges.resize(faces.old_id.size());
+    for (size_t i = 0; i < faces.old_id.size(); ++i) {
+      const auto& w = whole.corner_wedges(faces.old_id[i]);
+      for (int k = 0; k < 3; ++k) {
+        mesh.face_wedges[i][k] = wedges.new_id[w[k]];
+        mesh.wedge_vertex[mesh.face_wedges[i][k]] = mesh.faces[i][k];
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<LivePass> run_on_live_copy(const CollapseMesh& whole, const QuadricPriority& master,
+                                         const LivePassInputs& inputs,
+                                         const SimplifierLimits& limits,
+                                         const ProgressCallback& progress,
+                                         const CancelToken* cancel, ChunkedLoops& loops) {
+  SubsetJob copy;
+  KeptItems vertices, faces;
+  if (!copy_live_part(whole, inputs, loops, copy, vertices, faces)) return std::nullopt;
+
+  LivePass out;
+  out.mesh = std::make_unique<CollapseMesh>(copy.mesh);
+  CollapseMesh& mesh = *out.mesh;
+  copy.mesh = Mesh{};  // (the working mesh holds it)
+  QuadricPriority quadrics(copy.locked, master.options());
+  const IdMaps maps{&copy.global_vertex, &copy.global_face, &copy.global_wedge};
+  quadrics.import_local(mesh, master.export_local(maps));
+  const std::unique_ptr<PriorityModule> imported = without_initialize(quadrics);
+
+  std::shared_ptr<const std::vector<uint32_t>> components;
+  if (inputs.components)
+    components = std::make_shared<const std::vector<uint32_t>>(
+        of_copy(*inputs.components, copy.global_vertex));
+  Simplifier pass(
+      mesh, *imported,
+      standard_constraints(copy.locked, std::move(components), inputs.components_may_vanish,
+                           inputs.on_membrane ? of_copy(*inputs.on_membrane, copy.global_vertex)
+                                              : std::vector<uint8_t>{}));
+  const CopyGroups groups = copy_groups_of(copy.copy_group);
+  if (!groups.empty()) pass.join_copies(&groups);
+
+  out.records = pass.run(limits, progress, cancel);
+  for (CollapseRecord& r : out.records) to_global_ids(r, copy);
+  out.stats = pass.stats();
+  out.costings = quadrics.costings();
+  out.vertex_in_copy = std::move(vertices.new_id);
+  out.face_in_copy = std::move(faces.new_id);
+  out.vertex_of_copy = std::move(copy.global_vertex);
+  return out;
+}
+
+}  // namespace parapm
