@@ -96,6 +96,18 @@ bool copy_live_part(const CollapseMesh& whole, const LivePassInputs& inputs, Chu
   return true;
 }
 
+// `master`'s quadrics over the copy, with the master's options (its free placement's line is
+// the input's face count's), carried over as a job's are.
+std::unique_ptr<QuadricPriority> module_of_copy(const QuadricPriority& master, SubsetJob& copy,
+                                                const CollapseMesh& mesh) {
+  auto module = std::make_unique<QuadricPriority>(copy.locked, master.options());
+  copy.owned.assign(copy.global_vertex.size(), 1);
+  copy.state = export_job_state(master, copy);
+  import_job_state(*module, mesh, copy);
+  copy.state = MetricState{};
+  return module;
+}
+
 }  // namespace
 
 std::optional<LivePass> run_on_live_copy(const CollapseMesh& whole, const QuadricPriority& master,
@@ -108,13 +120,20 @@ std::optional<LivePass> run_on_live_copy(const CollapseMesh& whole, const Quadri
   if (!copy_live_part(whole, inputs, loops, copy, vertices, faces)) return std::nullopt;
 
   LivePass out;
-  out.mesh = std::make_unique<CollapseMesh>(copy.mesh);
+  out.mesh = std::make_unique<CollapseMesh>(copy.mesh, loops);
   CollapseMesh& mesh = *out.mesh;
+  // Each fan in the whole mesh's order (the collapses' order, not the faces' ids).
+  loops.run(copy.global_vertex.size(), [&](size_t begin, size_t end) {
+    std::vector<FaceId> fan;
+    for (size_t v = begin; v < end; ++v) {
+      fan.clear();
+      for (FaceId f : whole.faces_of(copy.global_vertex[v])) fan.push_back(faces.new_id[f]);
+      mesh.order_faces_of(VertexId(v), fan);
+    }
+  });
+  const std::unique_ptr<QuadricPriority> module = module_of_copy(master, copy, mesh);
   copy.mesh = Mesh{};  // (the working mesh holds it)
-  QuadricPriority quadrics(copy.locked, master.options());
-  const IdMaps maps{&copy.global_vertex, &copy.global_face, &copy.global_wedge};
-  quadrics.import_local(mesh, master.export_local(maps));
-  const std::unique_ptr<PriorityModule> imported = without_initialize(quadrics);
+  const std::unique_ptr<PriorityModule> imported = without_initialize(*module);
 
   std::shared_ptr<const std::vector<uint32_t>> components;
   if (inputs.components)
@@ -127,11 +146,13 @@ std::optional<LivePass> run_on_live_copy(const CollapseMesh& whole, const Quadri
                                               : std::vector<uint8_t>{}));
   const CopyGroups groups = copy_groups_of(copy.copy_group);
   if (!groups.empty()) pass.join_copies(&groups);
+  SimplifierLimits copy_limits = limits;
+  copy_limits.first_deferred = nullptr;  // (the quadric defers none)
 
-  out.records = pass.run(limits, progress, cancel);
+  out.records = pass.run(copy_limits, progress, cancel);
   for (CollapseRecord& r : out.records) to_global_ids(r, copy);
   out.stats = pass.stats();
-  out.costings = quadrics.costings();
+  out.costings = module->costings();
   out.vertex_in_copy = std::move(vertices.new_id);
   out.face_in_copy = std::move(faces.new_id);
   out.vertex_of_copy = std::move(copy.global_vertex);

@@ -1,9 +1,10 @@
 // The parallel build's final pass for the quadric, run on a compact copy of the live mesh. By
 // the final pass a tenth of the input's faces are left, scattered over the whole mesh's arrays
 // (each live vertex and face on a cache line of its own, beside dead ones); on a copy of just
-// them, whose local ids follow the global order (subset_job.h: ties fall as on the whole mesh),
-// the same collapses cost fewer cache misses. The records come back in the whole mesh's ids,
-// the same records the pass on the whole mesh makes.
+// them, whose local ids follow the global order (subset_job.h: ties fall as on the whole mesh)
+// and whose fans list their faces in the whole mesh's order, the same collapses cost fewer
+// cache misses. The master's quadrics are carried over as a job's are (job_state.h); the
+// records come back in the whole mesh's ids, the same records the pass on the whole mesh makes.
 #pragma once
 
 #include <cstdint>

@@ -1090,11 +1090,9 @@ void ParallelBuilder::final_pass() {
   };
   // The quadric's pass runs on a compact copy of the live mesh (live_pass.h) where it can.
   const auto* quadric = dynamic_cast<const QuadricPriority*>(master_.get());
-  const bool on_live_copy =
-      parallel_.final_pass_on_live_copy && quadric && master_queue_ == master_.get();
   std::optional<LivePass>& live = live_;
   auto run_pass = [&] {
-    if (on_live_copy) {
+    if (parallel_.final_pass_on_live_copy && quadric && master_queue_ == master_.get()) {
       LivePassInputs inputs;
       inputs.layout = &mesh_.layout;
       inputs.wedge_values = &mesh_.wedge_values;

@@ -51,6 +51,12 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
   live_vertices_ = size_t(std::count(vertex_alive_.begin(), vertex_alive_.end(), 1));
 }
 
+void CollapseMesh::order_faces_of(VertexId v, std::span<const FaceId> faces) {
+  if (faces.size() != faces_of(v).size())
+    throw_internal("order_faces_of: another count of faces than the vertex has");
+  faces_of_.assign(v, faces);
+}
+
 EdgeFaces CollapseMesh::edge_faces(VertexId a, VertexId b) const {
   // Read off the shorter face list (a fan's hub holds hundreds).
   const bool from_a = faces_of(a).size() <= faces_of(b).size();

@@ -103,6 +103,10 @@ class CollapseMesh {
   void collapse(VertexId vs, VertexId vt, const Vec3& position, const EdgeFaces& edge,
                 RemovedCounts* removed = nullptr);
   void count_removed(const RemovedCounts& removed);
+  // Lists v's faces in the order given, which must be the faces v has: the order another mesh
+  // lists them in, for a copy of part of it (parallel/live_pass.h) whose run follows fan order
+  // where that mesh's run does (the order the edges around a collapse are queued in).
+  void order_faces_of(VertexId v, std::span<const FaceId> faces);
 
  private:
   void build(const Mesh& mesh, ChunkedLoops& loops);

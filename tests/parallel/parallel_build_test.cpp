@@ -391,18 +391,10 @@ TEST(ParallelBuild, PartitionsAreDrawnAhead) {
   EXPECT_TRUE(guitar_diff.equal) << guitar_diff.first_difference;
 }
 
-// With one subset nothing is a border: the job is the whole mesh and runs the sequential
-// queue to the handover; the final pass then continues from the same metric state with a
-// fresh queue. Both metrics' costs depend on the star around the edge (the quadric's through
-// the constraints its placement meets): the sequential queue keeps entries whose stars changed
-// since (a known approximation of the driver), the fresh queue re-costs them, so the PMs agree
-// exactly up to the handover, the energy's only without deferred re-costing (with it they
-// part after a few hundred collapses on the airplane: the job's cost ceiling refuses edges
-// that the sequential build keys, so the two defer different edges).
-// The quadric's final pass on a compact copy of the live mesh (live_pass.h) makes the PM the
-// pass on the whole mesh's arrays makes: on a mesh with attributes, on one whose repair made
-// copies (seam collapses, its rims' copies locked), and on a scene whose small parts vanish in
-// the final pass.
+// The quadric's final pass on a compact copy of the live mesh (live_pass.h) makes the PM and
+// the costings the pass on the whole mesh's arrays makes: on a mesh with attributes, on one
+// whose repair made copies (seam collapses, its rims' copies locked), and on a scene whose small
+// parts vanish in the final pass.
 TEST(ParallelBuild, TheFinalPassOnALiveCopyChangesNoByte) {
   struct Case {
     const char* what;
@@ -430,6 +422,7 @@ TEST(ParallelBuild, TheFinalPassOnALiveCopyChangesNoByte) {
     EXPECT_FALSE(on_whole.final_pass_on_live_copy) << c.what;
     EXPECT_GT(on_copy.final_pass_collapses, 0u) << c.what;
     EXPECT_EQ(on_copy.final_pass_collapses, on_whole.final_pass_collapses) << c.what;
+    EXPECT_EQ(on_copy.costings, on_whole.costings) << c.what;
     EXPECT_TRUE(copied == testing::pm_bytes(whole)) << c.what << ": the PMs differ";
     std::printf("%s: %zu faces, final pass %llu collapses to %zu faces\n", c.what,
                 c.repaired.mesh.face_count(), (unsigned long long)on_copy.final_pass_collapses,
@@ -437,6 +430,14 @@ TEST(ParallelBuild, TheFinalPassOnALiveCopyChangesNoByte) {
   }
 }
 
+// With one subset nothing is a border: the job is the whole mesh and runs the sequential
+// queue to the handover; the final pass then continues from the same metric state with a
+// fresh queue. Both metrics' costs depend on the star around the edge (the quadric's through
+// the constraints its placement meets): the sequential queue keeps entries whose stars changed
+// since (a known approximation of the driver), the fresh queue re-costs them, so the PMs agree
+// exactly up to the handover, the energy's only without deferred re-costing (with it they
+// part after a few hundred collapses on the airplane: the job's cost ceiling refuses edges
+// that the sequential build keys, so the two defer different edges).
 TEST(ParallelBuild, OneSubsetGivesTheSequentialPmUpToTheHandover) {
   for (const char* name : {"stratocaster-9k.ply", "pymeshlab-colored-airplane-11k.ply"})
     for (const char* metric : {"quadric", "energy"}) {
