@@ -6,7 +6,10 @@
 
 #include "parallel/job_state.h"
 #include "parallel/subset_job.h"
+#include "simplify/energy_priority.h"
 #include "simplify/modules.h"
+#include "simplify/quadric_priority.h"
+#include "util/error.h"
 #include "util/fresh_pages.h"
 
 namespace parapm {
@@ -96,25 +99,65 @@ bool copy_live_part(const CollapseMesh& whole, const LivePassInputs& inputs, Chu
   return true;
 }
 
-// `master`'s quadrics over the copy, with the master's options (its free placement's line is
-// the input's face count's), carried over as a job's are.
-std::unique_ptr<QuadricPriority> module_of_copy(const QuadricPriority& master, SubsetJob& copy,
-                                                const CollapseMesh& mesh) {
-  auto module = std::make_unique<QuadricPriority>(copy.locked, master.options());
+// `master`'s state over the copy, carried over as a job's is, in a module of the master's
+// options: the quadric's (its free placement's line is the input's face count's), the energy's
+// with its faces' drifts. `loops`: the energy's points' passes.
+std::unique_ptr<PriorityModule> module_of_copy(const PriorityModule& master,
+                                               const LivePassInputs& inputs, SubsetJob& copy,
+                                               const CollapseMesh& mesh, ChunkedLoops& loops) {
   copy.owned.assign(copy.global_vertex.size(), 1);
-  copy.state = export_job_state(master, copy);
-  import_job_state(*module, mesh, copy);
+  if (const auto* quadric = dynamic_cast<const QuadricPriority*>(&master)) {
+    auto module = std::make_unique<QuadricPriority>(copy.locked, quadric->options());
+    copy.state = export_job_state(master, copy);
+    import_job_state(*module, mesh, copy);
+    copy.state = MetricState{};
+    return module;
+  }
+  const auto& energy = dynamic_cast<const EnergyPriority&>(master);
+  std::unique_ptr<PriorityModule> made =
+      make_priority_module(*inputs.options, copy.mesh, copy.locked, inputs.reference_diagonal);
+  auto& module = dynamic_cast<EnergyPriority&>(*made);
+  std::vector<double> drifts;
+  copy.state.metric = energy.name();
+  copy.state.energy = energy.export_with_drifts(
+      {&copy.global_vertex, &copy.global_face, &copy.global_wedge}, loops, drifts);
+  module.import_local(mesh, copy.state.energy, loops);
+  module.set_drifts(drifts);
   copy.state = MetricState{};
-  return module;
+  return made;
+}
+
+// The whole mesh's edges (global ids, sorted) in the copy's ids, those with an end outside it
+// left out (still sorted: local ids follow the global order).
+template <typename Edge>
+std::vector<Edge> edges_in_copy(const std::vector<Edge>* edges,
+                                const std::vector<uint32_t>& vertex_in_copy) {
+  std::vector<Edge> out;
+  if (!edges) return out;
+  out.reserve(edges->size());
+  for (Edge e : *edges) {
+    if (e.a >= vertex_in_copy.size() || e.b >= vertex_in_copy.size()) continue;
+    e.a = vertex_in_copy[e.a];
+    e.b = vertex_in_copy[e.b];
+    if (e.a != kNoKey && e.b != kNoKey) out.push_back(e);
+  }
+  return out;
 }
 
 }  // namespace
 
-std::optional<LivePass> run_on_live_copy(const CollapseMesh& whole, const QuadricPriority& master,
+bool runs_on_live_copy(const PriorityModule& master) {
+  return dynamic_cast<const QuadricPriority*>(&master) ||
+         dynamic_cast<const EnergyPriority*>(&master);
+}
+
+std::optional<LivePass> run_on_live_copy(const CollapseMesh& whole, const PriorityModule& master,
                                          const LivePassInputs& inputs,
                                          const SimplifierLimits& limits,
                                          const ProgressCallback& progress,
                                          const CancelToken* cancel, ChunkedLoops& loops) {
+  if (!runs_on_live_copy(master))
+    throw_internal("run_on_live_copy: no copy of metric " + master.name());
   SubsetJob copy;
   KeptItems vertices, faces;
   if (!copy_live_part(whole, inputs, loops, copy, vertices, faces)) return std::nullopt;
@@ -131,28 +174,39 @@ std::optional<LivePass> run_on_live_copy(const CollapseMesh& whole, const Quadri
       mesh.order_faces_of(VertexId(v), fan);
     }
   });
-  const std::unique_ptr<QuadricPriority> module = module_of_copy(master, copy, mesh);
+  const std::unique_ptr<PriorityModule> module = module_of_copy(master, inputs, copy, mesh, loops);
   copy.mesh = Mesh{};  // (the working mesh holds it)
+  if (inputs.team) module->use_team(inputs.team);
   const std::unique_ptr<PriorityModule> imported = without_initialize(*module);
+  std::optional<KeyMemo> memo;
+  if (inputs.keys) {
+    memo.emplace(*imported, mesh.vertex_capacity());
+    memo->reset(edges_in_copy(inputs.keys, vertices.new_id));
+  }
+  std::unique_ptr<PriorityModule> continued =
+      memo ? without_initialize(*memo) : std::unique_ptr<PriorityModule>{};
+  PriorityModule& priority = continued ? *continued : *imported;
 
   std::shared_ptr<const std::vector<uint32_t>> components;
   if (inputs.components)
     components = std::make_shared<const std::vector<uint32_t>>(
         of_copy(*inputs.components, copy.global_vertex));
   Simplifier pass(
-      mesh, *imported,
+      mesh, priority,
       standard_constraints(copy.locked, std::move(components), inputs.components_may_vanish,
                            inputs.on_membrane ? of_copy(*inputs.on_membrane, copy.global_vertex)
                                               : std::vector<uint8_t>{}));
   const CopyGroups groups = copy_groups_of(copy.copy_group);
   if (!groups.empty()) pass.join_copies(&groups);
+  const std::vector<DeferredEdge> deferred = edges_in_copy(inputs.deferred, vertices.new_id);
   SimplifierLimits copy_limits = limits;
-  copy_limits.first_deferred = nullptr;  // (the quadric defers none)
+  copy_limits.first_deferred = &deferred;
 
   out.records = pass.run(copy_limits, progress, cancel);
   for (CollapseRecord& r : out.records) to_global_ids(r, copy);
   out.stats = pass.stats();
   out.costings = module->costings();
+  out.keys_reused = memo ? memo->reused() : 0;
   out.vertex_in_copy = std::move(vertices.new_id);
   out.face_in_copy = std::move(faces.new_id);
   out.vertex_of_copy = std::move(copy.global_vertex);

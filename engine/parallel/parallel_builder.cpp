@@ -1088,11 +1088,10 @@ void ParallelBuilder::final_pass() {
     const uint64_t total = input_faces_ - target_;
     if (progress_) progress_(std::min<uint64_t>(done_before + done, total), total);
   };
-  // The quadric's pass runs on a compact copy of the live mesh (live_pass.h) where it can.
-  const auto* quadric = dynamic_cast<const QuadricPriority*>(master_.get());
+  // The pass runs on a compact copy of the live mesh (live_pass.h) where it can.
   std::optional<LivePass>& live = live_;
   auto run_pass = [&] {
-    if (parallel_.final_pass_on_live_copy && quadric && master_queue_ == master_.get()) {
+    if (parallel_.final_pass_on_live_copy && runs_on_live_copy(*master_)) {
       LivePassInputs inputs;
       inputs.layout = &mesh_.layout;
       inputs.wedge_values = &mesh_.wedge_values;
@@ -1102,7 +1101,12 @@ void ParallelBuilder::final_pass() {
       inputs.components = whole_components();
       inputs.components_may_vanish = !options_.keep_components;
       inputs.on_membrane = &on_membrane_;
-      live = run_on_live_copy(whole, *quadric, inputs, limits, progress, cancel_, master_loops_);
+      inputs.options = &options_;
+      inputs.reference_diagonal = subset_options_.reference_diagonal;
+      inputs.keys = carry_keys_ ? &carried : nullptr;
+      inputs.deferred = &deferred_;
+      inputs.team = team_ ? &*team_ : nullptr;
+      live = run_on_live_copy(whole, *master_, inputs, limits, progress, cancel_, master_loops_);
     }
     if (live)
       final_records = std::move(live->records);  // (the PM reads the live copy's end)
@@ -1128,8 +1132,8 @@ void ParallelBuilder::final_pass() {
   spdlog::debug(
       "final pass: {} keys carried in, {} answered from them; {} evaluations, {} vetoed, {} "
       "screened, {} requeued, {} stale, {} seam collapses ({} split)",
-      carried.size(), keys_->reused() - reused_before, fs.evaluations, fs.rejected, fs.screened,
-      fs.requeued, fs.stale, fs.seam_collapses, fs.seams_split);
+      carried.size(), live ? live->keys_reused : keys_->reused() - reused_before, fs.evaluations,
+      fs.rejected, fs.screened, fs.requeued, fs.stale, fs.seam_collapses, fs.seams_split);
   if (events_.final_pass_done)
     events_.final_pass_done(st_.final_pass_collapses, st_.final_pass_seconds);
   append_list(std::move(final_records));

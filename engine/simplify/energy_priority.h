@@ -225,6 +225,16 @@ class EnergyPriority : public PriorityModule {
     return export_global(mesh, maps, changed, plain);
   }
   void import_global(const EnergyState& state);  // checks the state first (kInvalidInput)
+  // For a compact copy of the whole live mesh that runs in-process as the master would run on
+  // the whole mesh (parallel/live_pass.h): export_local with the faces' stored distances, not
+  // their bounds, and each face's drift (per face of maps.face) in `drifts`; the copy's module
+  // imports the state (import_local), then takes the drifts (set_drifts). A job's state folds
+  // the drift into its distances instead: its costings see bounds where the master's see the
+  // points measured again.
+  EnergyState export_with_drifts(const IdMaps& maps, ChunkedLoops& loops,
+                                 std::vector<double>& drifts) const;
+  // Throws Error(kInvalidInput) unless `drifts` holds a finite, non-negative drift per face.
+  void set_drifts(const std::vector<double>& drifts);
 
   // Several jobs' states at once (job_state.h, import_result_states), side by side:
   // begin_global_imports() once; check_global() of every state, each on its own thread if
@@ -328,7 +338,8 @@ class EnergyPriority : public PriorityModule {
   void reset_point_lists(const CollapseMesh& mesh);
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
-                    EnergyState& out, ChunkedLoops& loops) const;
+                    EnergyState& out, ChunkedLoops& loops,
+                    std::vector<double>* drifts = nullptr) const;
 
   std::vector<uint8_t> locked_;
   EnergyOptions options_;

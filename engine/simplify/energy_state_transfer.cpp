@@ -4,6 +4,7 @@
 // from the metric itself (energy_priority.cpp), which prices and performs collapses.
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <string>
 
 #include "simplify/energy_priority.h"
@@ -43,13 +44,15 @@ void for_each_run(ChunkedLoops& loops, const std::vector<EnergyState::Point>& po
 void EnergyPriority::export_state(const std::vector<FaceId>& faces,
                                   const std::vector<VertexId>& vertices,
                                   const std::vector<WedgeId>& wedges, const IdMaps& maps,
-                                  bool to_local, EnergyState& out, ChunkedLoops& loops) const {
+                                  bool to_local, EnergyState& out, ChunkedLoops& loops,
+                                  std::vector<double>* drifts) const {
   const IdTranslation to_face{maps.face, to_local}, to_vertex{maps.vertex, to_local};
   const int floats = scalar_.enabled() ? scalar_.floats() : 0;
   const bool values = floats && to_local;
   // A job's returned state (to global ids) leaves out what never changes (EnergyState::positions).
   out.positions = to_local;
-  // A face's drift goes into its points' distances: the state holds bounds, and no drift.
+  // A face's drift goes into its points' distances: the state holds bounds, and no drift
+  // (unless `drifts` takes the drifts apart: then the stored distances).
   auto write_point = [&](size_t at, const FacePoint& p, FaceId face, VertexId vertex,
                          double distance_sq) {
     const uint32_t id = p.id;
@@ -77,6 +80,7 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
   resize_touched(out.points, points, loops);
   if (values) resize_touched(out.point_values, points * size_t(floats), loops);
   resize_touched(out.faces, faces.size(), loops);
+  if (drifts) resize_touched(*drifts, faces.size(), loops);
   // (Each id translated near its own position in the list: exact when the list is the map
   // itself, a job's export_local.)
   loops.run(faces.size(), [&](size_t begin, size_t end) {
@@ -85,8 +89,9 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
       const FaceId written = to_face.near(f, i);
       out.faces[i] = written;
       size_t at = first_point[i];
+      if (drifts) (*drifts)[i] = drift_[f];
       for (const FacePoint& p : face_points_[f])
-        write_point(at++, p, written, kNoId, bounded_distance_sq(f, p));
+        write_point(at++, p, written, kNoId, drifts ? p.distance_sq : bounded_distance_sq(f, p));
     }
   });
   out.vertices.reserve(vertices.size());
@@ -107,6 +112,24 @@ EnergyState EnergyPriority::export_local(const IdMaps& maps, ChunkedLoops& loops
   const std::vector<WedgeId> none;
   export_state(*maps.face, *maps.vertex, maps.wedge ? *maps.wedge : none, maps, true, state, loops);
   return state;
+}
+
+EnergyState EnergyPriority::export_with_drifts(const IdMaps& maps, ChunkedLoops& loops,
+                                               std::vector<double>& drifts) const {
+  EnergyState state;
+  const std::vector<WedgeId> none;
+  export_state(*maps.face, *maps.vertex, maps.wedge ? *maps.wedge : none, maps, true, state, loops,
+               &drifts);
+  return state;
+}
+
+void EnergyPriority::set_drifts(const std::vector<double>& drifts) {
+  if (drifts.size() != drift_.size())
+    throw_invalid("energy state: " + std::to_string(drifts.size()) + " drifts for " +
+                  std::to_string(drift_.size()) + " faces");
+  for (double d : drifts)
+    if (!(d >= 0) || !std::isfinite(d)) throw_invalid("energy state: a face's drift is not finite");
+  drift_ = drifts;
 }
 
 EnergyState EnergyPriority::export_global(const CollapseMesh& mesh, const IdMaps& maps,

@@ -84,13 +84,25 @@ void ScalarAttributes::join(WedgeId a, WedgeId b) {
 }
 
 WedgeId ScalarAttributes::joined_root(WedgeId root) const {
-  // Each pair maps its larger root to its smaller, so the walk ends.
+  // The smallest root linked to `root` by the pairs, each pair a link both ways: two pairs may
+  // share either end (a seam's two sides both joined to one class), and all their roots are
+  // then one group, whatever the order of their ids.
+  std::array<WedgeId, 1 + 2 * std::tuple_size_v<decltype(joined_)>> reached{root};
+  size_t count = 1;
+  auto has = [&](WedgeId w) {
+    return std::find(reached.begin(), reached.begin() + ptrdiff_t(count), w) !=
+           reached.begin() + ptrdiff_t(count);
+  };
   for (bool changed = true; changed;) {
     changed = false;
-    for (int i = 0; i < joined_count_; ++i)
-      if (root == joined_[i].second) root = joined_[i].first, changed = true;
+    for (int i = 0; i < joined_count_; ++i) {
+      const auto [a, b] = joined_[i];
+      if (has(a) == has(b)) continue;
+      reached[count++] = has(a) ? b : a;
+      changed = true;
+    }
   }
-  return root;
+  return *std::min_element(reached.begin(), reached.begin() + ptrdiff_t(count));
 }
 
 void ScalarAttributes::begin_star(const std::array<std::pair<WedgeId, WedgeId>, 2>& joined,

@@ -391,10 +391,11 @@ TEST(ParallelBuild, PartitionsAreDrawnAhead) {
   EXPECT_TRUE(guitar_diff.equal) << guitar_diff.first_difference;
 }
 
-// The quadric's final pass on a compact copy of the live mesh (live_pass.h) makes the PM and
-// the costings the pass on the whole mesh's arrays makes: on a mesh with attributes, on one
-// whose repair made copies (seam collapses, its rims' copies locked), and on a scene whose small
-// parts vanish in the final pass.
+// The final pass on a compact copy of the live mesh (live_pass.h) makes the PM and the
+// costings the pass on the whole mesh's arrays makes, with either metric (the energy's points,
+// keys and deferred edges carried over): on a mesh with attributes, on one whose repair made
+// copies (seam collapses, its rims' copies locked), and on a scene whose small parts vanish in
+// the final pass.
 TEST(ParallelBuild, TheFinalPassOnALiveCopyChangesNoByte) {
   struct Case {
     const char* what;
@@ -408,26 +409,29 @@ TEST(ParallelBuild, TheFinalPassOnALiveCopyChangesNoByte) {
                    repair_mesh(testing::double_sided(testing::book_of_sheets(1, 24, 6))), 40});
   cases.push_back({"ground with patches", repair_mesh(testing::ground_with_patches(150)), 40});
   ASSERT_GT(cases[1].repaired.report.vertex_copies_added, 0u);
-  for (const Case& c : cases) {
-    SimplifyOptions options = metric_options("quadric");
-    options.target_faces = c.target_faces;
-    ParallelOptions parallel = with_p(4);
-    ParallelStats on_copy, on_whole;
-    const std::string copied =
-        testing::pm_bytes(build_progressive_mesh_parallel(c.repaired, options, parallel, &on_copy));
-    parallel.final_pass_on_live_copy = false;
-    const ProgressiveMesh whole =
-        build_progressive_mesh_parallel(c.repaired, options, parallel, &on_whole);
-    EXPECT_TRUE(on_copy.final_pass_on_live_copy) << c.what;
-    EXPECT_FALSE(on_whole.final_pass_on_live_copy) << c.what;
-    EXPECT_GT(on_copy.final_pass_collapses, 0u) << c.what;
-    EXPECT_EQ(on_copy.final_pass_collapses, on_whole.final_pass_collapses) << c.what;
-    EXPECT_EQ(on_copy.costings, on_whole.costings) << c.what;
-    EXPECT_TRUE(copied == testing::pm_bytes(whole)) << c.what << ": the PMs differ";
-    std::printf("%s: %zu faces, final pass %llu collapses to %zu faces\n", c.what,
-                c.repaired.mesh.face_count(), (unsigned long long)on_copy.final_pass_collapses,
-                whole.base.face_count());
-  }
+  for (const char* metric : {"quadric", "energy"})
+    for (const Case& c : cases) {
+      SimplifyOptions options = metric_options(metric);
+      options.target_faces = c.target_faces;
+      ParallelOptions parallel = with_p(4);
+      ParallelStats on_copy, on_whole;
+      const std::string copied = testing::pm_bytes(
+          build_progressive_mesh_parallel(c.repaired, options, parallel, &on_copy));
+      parallel.final_pass_on_live_copy = false;
+      const ProgressiveMesh whole =
+          build_progressive_mesh_parallel(c.repaired, options, parallel, &on_whole);
+      EXPECT_TRUE(on_copy.final_pass_on_live_copy) << metric << " " << c.what;
+      EXPECT_FALSE(on_whole.final_pass_on_live_copy) << metric << " " << c.what;
+      EXPECT_GT(on_copy.final_pass_collapses, 0u) << metric << " " << c.what;
+      EXPECT_EQ(on_copy.final_pass_collapses, on_whole.final_pass_collapses)
+          << metric << " " << c.what;
+      EXPECT_EQ(on_copy.costings, on_whole.costings) << metric << " " << c.what;
+      EXPECT_TRUE(copied == testing::pm_bytes(whole))
+          << metric << " " << c.what << ": the PMs differ";
+      std::printf("%s, %s: %zu faces, final pass %llu collapses to %zu faces\n", metric, c.what,
+                  c.repaired.mesh.face_count(), (unsigned long long)on_copy.final_pass_collapses,
+                  whole.base.face_count());
+    }
 }
 
 // With one subset nothing is a border: the job is the whole mesh and runs the sequential

@@ -21,6 +21,8 @@
 #include "simplify/simplifier.h"
 #include "simplify/simplify.h"
 #include "test_support.h"
+#include "util/chunked_loops.h"
+#include "util/error.h"
 #include "util/thread_team.h"
 
 namespace parapm {
@@ -230,6 +232,86 @@ TEST(EnergyCosting, PointsLeftOnTheirFacesKeepUpperBoundsOfTheirDistances) {
   EXPECT_GT(kept.above, 100u);  // the path is exercised
   EXPECT_EQ(moved.above, 0u);
   EXPECT_LT(kept.rms, 1.4 * moved.rms);
+}
+
+// A copy of the live mesh whose module imports the master's state with the faces' drifts
+// (export_with_drifts, set_drifts: the parallel build's final pass on a copy, live_pass.h)
+// costs every edge as the master does; with a job's state, whose distances are the drifted
+// bounds, some edges cost otherwise (the path is exercised). The stratocaster at 20% with a
+// reprojection cap of 16, so that faces drift on a small mesh.
+TEST(EnergyCosting, ACopyWithItsDriftsCostsAsTheMasterDoes) {
+  const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("stratocaster-9k.ply")));
+  EnergyOptions options;
+  options.max_points_per_reprojection = 16;
+  options.reference_diagonal = bounding_box(repaired.mesh).diagonal();
+  const std::vector<uint8_t> locked = locked_vertices(repaired);
+  CollapseMesh whole(repaired.mesh);
+  EnergyPriority master(locked, options);  // (without attributes: the copy carries no wedges)
+  {
+    Simplifier simplifier(whole, master, standard_constraints(locked));
+    SimplifierLimits limits;
+    limits.target_faces = repaired.mesh.face_count() / 5;
+    simplifier.run(limits, {}, nullptr);
+  }
+  // The live part, numbered in order, each fan in the whole mesh's order.
+  std::vector<VertexId> vertex_of_copy, copy_of_vertex(whole.vertex_capacity(), kNoId);
+  std::vector<FaceId> face_of_copy, copy_of_face(whole.face_capacity(), kNoId);
+  Mesh part;
+  for (VertexId v = 0; v < whole.vertex_capacity(); ++v)
+    if (whole.vertex_alive(v)) {
+      copy_of_vertex[v] = VertexId(vertex_of_copy.size());
+      vertex_of_copy.push_back(v);
+      part.positions.push_back(whole.position(v));
+    }
+  for (FaceId f = 0; f < whole.face_capacity(); ++f)
+    if (whole.face_alive(f)) {
+      copy_of_face[f] = FaceId(face_of_copy.size());
+      face_of_copy.push_back(f);
+      const Triangle& t = whole.face(f);
+      part.faces.push_back({copy_of_vertex[t[0]], copy_of_vertex[t[1]], copy_of_vertex[t[2]]});
+    }
+  CollapseMesh copy(part);
+  for (VertexId v = 0; v < vertex_of_copy.size(); ++v) {
+    std::vector<FaceId> fan;
+    for (FaceId f : whole.faces_of(vertex_of_copy[v])) fan.push_back(copy_of_face[f]);
+    copy.order_faces_of(v, fan);
+  }
+  std::vector<uint8_t> copy_locked;
+  for (VertexId g : vertex_of_copy) copy_locked.push_back(locked.empty() ? 0 : locked[g]);
+  const std::vector<WedgeId> no_wedges;
+  const IdMaps maps{&vertex_of_copy, &face_of_copy, &no_wedges};
+  ChunkedLoops loops;
+  std::vector<double> drifts;
+  EnergyPriority with_drifts(copy_locked, options), with_bounds(copy_locked, options);
+  with_drifts.import_local(copy, master.export_with_drifts(maps, loops, drifts));
+  with_drifts.set_drifts(drifts);
+  with_bounds.import_local(copy, master.export_local(maps));
+  const size_t drifted =
+      size_t(std::count_if(drifts.begin(), drifts.end(), [](double d) { return d > 0; }));
+
+  size_t edges = 0, same_with_drifts = 0, same_with_bounds = 0;
+  for_each_edge(whole, [&](VertexId a, VertexId b) {
+    CollapseCandidate m, d, u;
+    const bool placed = master.evaluate(whole, a, b, m, Costing::kQueue);
+    const bool placed_d =
+        with_drifts.evaluate(copy, copy_of_vertex[a], copy_of_vertex[b], d, Costing::kQueue);
+    const bool placed_u =
+        with_bounds.evaluate(copy, copy_of_vertex[a], copy_of_vertex[b], u, Costing::kQueue);
+    ++edges;
+    if (placed == placed_d && (!placed || m.cost == d.cost)) ++same_with_drifts;
+    if (placed == placed_u && (!placed || m.cost == u.cost)) ++same_with_bounds;
+  });
+  std::printf(
+      "stratocaster-9k at 20%%, cap 16: %zu of %zu faces drifted; of %zu edges, %zu cost as the "
+      "master's with the drifts, %zu with the bounds\n",
+      drifted, drifts.size(), edges, same_with_drifts, same_with_bounds);
+  EXPECT_GT(drifted, 100u);
+  EXPECT_EQ(same_with_drifts, edges);
+  EXPECT_LT(same_with_bounds, edges);
+  std::vector<double> short_list(drifts.size() - 1, 0.0);
+  EXPECT_THROW(with_drifts.set_drifts(short_list), Error);
+  drifts[0] = -1;
+  EXPECT_THROW(with_drifts.set_drifts(drifts), Error);
 }
 
 // Hoppe's spring constants with one point per vertex let a young star's springs outweigh its

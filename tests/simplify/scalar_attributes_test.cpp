@@ -3,6 +3,7 @@
 // input's colours exactly; on a real mesh, the lossless round trip with wedge changes.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "pm/levels.h"
 #include "pm/mesh_compare.h"
 #include "pm/pm_restore.h"
+#include "simplify/scalar_attributes.h"
 #include "simplify/simplify.h"
 #include "test_support.h"
 
@@ -75,6 +77,31 @@ Mesh energy_level(const Mesh& input, double ratio, double weight,
 
 float corner_red(const Mesh& m, FaceId f, int k) {
   return m.wedge(m.face_wedges[f][k])[m.layout.color_offset()];
+}
+
+// A costed collapse that joins both sides of a seam to one class (its two pairs share a class)
+// solves the three classes as one group, as the performed collapse does once it has joined
+// them, whichever of the three has the smallest root: a parallel job or a copy of the live
+// mesh numbers the wedges otherwise than the master and must group them alike.
+TEST(ScalarAttributes, TwoJoinedPairsSharingAClassMakeOneGroup) {
+  AttributeLayout layout;
+  layout.colors = true;
+  ScalarAttributes scalar;
+  scalar.initialize(layout, std::vector<float>(4 * 4, 0.5f), 1.0);
+  using Pairs = std::array<std::pair<WedgeId, WedgeId>, 2>;
+  for (const Pairs& pairs : {Pairs{{{0, 2}, {1, 2}}}, Pairs{{{0, 1}, {0, 2}}},
+                             Pairs{{{2, 0}, {1, 0}}}, Pairs{{{1, 2}, {0, 1}}}}) {
+    scalar.begin_star(pairs, 2);
+    const int group = scalar.group_of(0);
+    EXPECT_EQ(scalar.group_of(1), group) << pairs[0].first << pairs[0].second << pairs[1].first;
+    EXPECT_EQ(scalar.group_of(2), group) << pairs[0].first << pairs[0].second << pairs[1].first;
+    EXPECT_NE(scalar.group_of(3), group);  // (not joined)
+  }
+  // One pair: its two classes, and the others apart.
+  scalar.begin_star(Pairs{{{3, 1}, {0, 0}}}, 1);
+  EXPECT_EQ(scalar.group_of(1), scalar.group_of(3));
+  EXPECT_NE(scalar.group_of(0), scalar.group_of(1));
+  EXPECT_NE(scalar.group_of(2), scalar.group_of(1));
 }
 
 TEST(ScalarAttributes, ALinearColourFieldIsReproducedAtACoarseLevel) {
