@@ -1066,8 +1066,7 @@ void ParallelBuilder::final_pass() {
   // The band pass's keys too, so that the final pass starts from the queue as it is.
   const std::vector<EdgeKey> carried =
       carry_keys_ ? keys_->current_keys(whole) : std::vector<EdgeKey>{};
-  keys_->reset(carried);
-  const uint64_t reused_before = keys_->reused();
+  uint64_t reused_before = 0;
   std::unique_ptr<PriorityModule> continued = without_initialize(*master_queue_);
   // Components vanish here only: in the jobs and the band passes a lone triangle waits for
   // this pass, which costs it against the whole mesh's coarse collapses.
@@ -1108,10 +1107,13 @@ void ParallelBuilder::final_pass() {
       inputs.team = team_ ? &*team_ : nullptr;
       live = run_on_live_copy(whole, *master_, inputs, limits, progress, cancel_, master_loops_);
     }
-    if (live)
+    if (live) {
       final_records = std::move(live->records);  // (the PM reads the live copy's end)
-    else
-      final_records = pass.run(limits, progress, cancel_);
+      return;
+    }
+    keys_->reset(carried);  // (the copy's memo takes them otherwise)
+    reused_before = keys_->reused();
+    final_records = pass.run(limits, progress, cancel_);
   };
   // The last round's records go into records_ beside it (append_pending).
   const double team_before = team_saving();
