@@ -118,12 +118,12 @@ std::unique_ptr<PriorityModule> module_of_copy(const PriorityModule& master,
       make_priority_module(*inputs.options, copy.mesh, copy.locked, inputs.reference_diagonal);
   auto& module = dynamic_cast<EnergyPriority&>(*made);
   std::vector<double> drifts;
-  copy.state.metric = energy.name();
-  copy.state.energy = energy.export_with_drifts(
-      {&copy.global_vertex, &copy.global_face, &copy.global_wedge}, loops, drifts);
-  module.import_local(mesh, copy.state.energy, loops);
+  module.import_local(
+      mesh,
+      energy.export_with_drifts({&copy.global_vertex, &copy.global_face, &copy.global_wedge}, loops,
+                                drifts),
+      loops);
   module.set_drifts(drifts);
-  copy.state = MetricState{};
   return made;
 }
 
