@@ -81,6 +81,21 @@ void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const Su
   }
 }
 
+bool imports_from_master(const PriorityModule& master, const SubsetJob& job) {
+  const auto* energy = dynamic_cast<const EnergyPriority*>(&master);
+  return energy && !energy->carries_attributes() && !job.mesh.layout.any();
+}
+
+void import_from_master(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job,
+                        const PriorityModule& master, ChunkedLoops* loops) {
+  ChunkedLoops plain;
+  auto* energy = dynamic_cast<EnergyPriority*>(&module);
+  const auto* from = dynamic_cast<const EnergyPriority*>(&master);
+  if (!energy || !from)
+    throw_internal("import_from_master: no direct import of metric " + master.name());
+  energy->import_from(*from, mesh, maps_of(job), false, loops ? *loops : plain);
+}
+
 MetricState export_result_state(const PriorityModule& module, const CollapseMesh& mesh,
                                 const SubsetJob& job, const std::vector<CollapseRecord>& records,
                                 ChunkedLoops* loops) {

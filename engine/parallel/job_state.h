@@ -43,6 +43,13 @@ MetricState export_job_state(const PriorityModule& master, const SubsetJob& job,
 void import_job_state(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job,
                       ChunkedLoops* loops = nullptr);
 
+// Whether a job's module may read its state straight from `master`, in this process (energy
+// without attributes: EnergyPriority::import_from), instead of through export_job_state and
+// import_job_state; import_from_master does, to the same module, without the state's copy.
+bool imports_from_master(const PriorityModule& master, const SubsetJob& job);
+void import_from_master(PriorityModule& module, const CollapseMesh& mesh, const SubsetJob& job,
+                        const PriorityModule& master, ChunkedLoops* loops = nullptr);
+
 // The job's module state at its end, in global ids: what its collapses `records` (in local
 // ids) changed, the rest being as the master has it (the energy's faces around them, their
 // corners and wedges); for a metric that returns none (returns_state), an empty state.

@@ -101,7 +101,8 @@ bool copy_live_part(const CollapseMesh& whole, const LivePassInputs& inputs, Chu
 
 // `master`'s state over the copy, carried over as a job's is, in a module of the master's
 // options: the quadric's (its free placement's line is the input's face count's), the energy's
-// with its faces' drifts. `loops`: the energy's points' passes.
+// with its faces' drifts (read straight from the master where no attributes travel with the
+// points: EnergyPriority::import_from). `loops`: the energy's points' passes.
 std::unique_ptr<PriorityModule> module_of_copy(const PriorityModule& master,
                                                const LivePassInputs& inputs, SubsetJob& copy,
                                                const CollapseMesh& mesh, ChunkedLoops& loops) {
@@ -117,12 +118,13 @@ std::unique_ptr<PriorityModule> module_of_copy(const PriorityModule& master,
   std::unique_ptr<PriorityModule> made =
       make_priority_module(*inputs.options, copy.mesh, copy.locked, inputs.reference_diagonal);
   auto& module = dynamic_cast<EnergyPriority&>(*made);
+  const IdMaps maps{&copy.global_vertex, &copy.global_face, &copy.global_wedge};
+  if (!energy.carries_attributes() && !copy.mesh.layout.any()) {
+    module.import_from(energy, mesh, maps, true, loops);
+    return made;
+  }
   std::vector<double> drifts;
-  module.import_local(
-      mesh,
-      energy.export_with_drifts({&copy.global_vertex, &copy.global_face, &copy.global_wedge}, loops,
-                                drifts),
-      loops);
+  module.import_local(mesh, energy.export_with_drifts(maps, loops, drifts), loops);
   module.set_drifts(drifts);
   return made;
 }

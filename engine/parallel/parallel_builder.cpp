@@ -703,6 +703,9 @@ void ParallelBuilder::extract_jobs(Round& r) {
   // state then goes: the metric holds it).
   const bool jobs_here = runner_ == &pool_;
   std::vector<PreparedSubset> prepared(sample_in_tasks && jobs_here ? subsets : 0);
+  // Such a job's metric reads its state straight from the master where it can, without a
+  // state's copy of its points in between (imports_from_master).
+  const bool state_needed = job_state_needed(*master_, rs.round);
   // Per face, the subset whose job owns its three corners: the only state that may list it.
   face_subset_.assign(whole.face_capacity(), kNoId);
   // The master's own steps, before the jobs' extraction and after it, are on the critical path.
@@ -719,7 +722,9 @@ void ParallelBuilder::extract_jobs(Round& r) {
     jobs[i] = extract_subset(whole, mesh_.layout, mesh_.wedge_values, mesh_.positions_are_float,
                              locked_, r.vertex_subset, owned[i], uint32_t(i), rs.round,
                              subset_options_, &copy_groups_);
-    if (job_state_needed(*master_, rs.round))
+    if (state_needed && !prepared.empty() && imports_from_master(*master_, jobs[i]))
+      prepared[i] = prepare_subset(jobs[i], &state_loops, master_.get());
+    else if (state_needed)
       jobs[i].state = export_job_state(*master_, jobs[i], &state_loops);
     for (FaceId f = 0; f < jobs[i].mesh.face_count(); ++f) {
       const Triangle& c = jobs[i].mesh.faces[f];

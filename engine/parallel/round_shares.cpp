@@ -38,12 +38,14 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
                            std::vector<EdgeKey>& keys, PreparedSubset* prepared,
                            ChunkedLoops* loops) {
-  if (job.state.empty()) throw_internal("sample_subset: a job without the master's state");
+  const bool made_before = prepared && prepared->metric;
+  if (job.state.empty() && !made_before)
+    throw_internal("sample_subset: a job without the master's state");
   const SampledEdges sampled = sampled_edges(job, free);
   SubsetSample out;
   out.inner_edges = sampled.inner_edges;
   if (sampled.edges.empty()) return out;
-  PreparedSubset made = prepare_subset(job, loops);
+  PreparedSubset made = made_before ? std::move(*prepared) : prepare_subset(job, loops);
   CollapseMesh& local = *made.mesh;
   PriorityModule* module = made.metric.get();
   std::optional<KeyMemo> memo;

@@ -72,6 +72,8 @@ SampledEdges sampled_edges(const SubsetJob& job, const std::vector<uint8_t>& fre
 // Costing::kEstimate, or with carry_keys as kQueue: those costs become the job's queue keys.
 // `prepared` (may be null): given the job's mesh and metric the sample was costed on, for a job
 // run in the same process (simplify_subset takes them); left as it was when no edge is sampled.
+// One that holds them already (prepare_subset's, its state read from the master) is costed on
+// and given back; the job then needs no state.
 // `loops` (null: one thread): the state's import in its chunks.
 SubsetSample sample_subset(const SubsetJob& job, const std::vector<uint8_t>& free, bool carry_keys,
                            std::vector<EdgeKey>& keys, PreparedSubset* prepared = nullptr,

@@ -41,10 +41,13 @@ SimplifyOptions simplify_options_of(const SubsetOptions& subset) {
 }
 
 std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseMesh& working,
-                                           ChunkedLoops* loops) {
+                                           ChunkedLoops* loops, const PriorityModule* master) {
   std::unique_ptr<PriorityModule> module = make_priority_module(
       simplify_options_of(job.options), job.mesh, job.locked, job.options.reference_diagonal);
-  if (!job.state.empty()) import_job_state(*module, working, job, loops);
+  if (master)
+    import_from_master(*module, working, job, *master, loops);
+  else if (!job.state.empty())
+    import_job_state(*module, working, job, loops);
   return module;
 }
 
@@ -62,11 +65,12 @@ ChunkedLoops state_loops_of(const JobTeam& team) {
                          : ChunkedLoops();
 }
 
-PreparedSubset prepare_subset(const SubsetJob& job, ChunkedLoops* loops) {
+PreparedSubset prepare_subset(const SubsetJob& job, ChunkedLoops* loops,
+                              const PriorityModule* master) {
   PreparedSubset prepared;
   prepared.mesh = std::make_unique<CollapseMesh>(job.mesh);
-  prepared.metric = job_module(job, *prepared.mesh, loops);
-  prepared.imported = !job.state.empty();
+  prepared.metric = job_module(job, *prepared.mesh, loops, master);
+  prepared.imported = master || !job.state.empty();
   return prepared;
 }
 

@@ -75,7 +75,8 @@ struct PreparedSubset {
   std::unique_ptr<PriorityModule> metric;
   bool imported = false;  // the metric holds the job's state
 };
-PreparedSubset prepare_subset(const SubsetJob& job, ChunkedLoops* loops = nullptr);
+PreparedSubset prepare_subset(const SubsetJob& job, ChunkedLoops* loops = nullptr,
+                              const PriorityModule* master = nullptr);
 
 // Throws Error(kInvalidInput) for an invalid job or options, Error(kCancelled /
 // kDeadlineExceeded) when `cancel` fires. Thread-safe: jobs share nothing. With
@@ -98,8 +99,10 @@ SimplifyOptions simplify_options_of(const SubsetOptions& subset);
 
 // The job's metric module over `working` (a CollapseMesh of job.mesh), as simplify_subset
 // makes it: with a job state, the master's state imported (not yet initialised otherwise), in
-// `loops`' chunks (null: one thread).
+// `loops`' chunks (null: one thread). With `master` (in this process, where
+// imports_from_master(*master, job)), the state is read from it instead of job.state.
 std::unique_ptr<PriorityModule> job_module(const SubsetJob& job, const CollapseMesh& working,
-                                           ChunkedLoops* loops = nullptr);
+                                           ChunkedLoops* loops = nullptr,
+                                           const PriorityModule* master = nullptr);
 
 }  // namespace parapm

@@ -235,6 +235,14 @@ class EnergyPriority : public PriorityModule {
                                  std::vector<double>& drifts) const;
   // Throws Error(kInvalidInput) unless `drifts` holds a finite, non-negative drift per face.
   void set_drifts(const std::vector<double>& drifts);
+  // A job's module (or a live copy's, `drifts`) read straight from a master in this process:
+  // the module import_local(mesh, master.export_local(maps)) makes (with `drifts`, also
+  // export_with_drifts' and set_drifts'), without the state's copy of every point in between.
+  // Only without attributes, in either module (carries_attributes; a job's from its mesh):
+  // their point values travel in the state.
+  bool carries_attributes() const { return scalar_.enabled(); }
+  void import_from(const EnergyPriority& master, const CollapseMesh& mesh, const IdMaps& maps,
+                   bool drifts, ChunkedLoops& loops);
 
   // Several jobs' states at once (job_state.h, import_result_states), side by side:
   // begin_global_imports() once; check_global() of every state, each on its own thread if

@@ -208,6 +208,71 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   });
 }
 
+void EnergyPriority::import_from(const EnergyPriority& master, const CollapseMesh& mesh,
+                                 const IdMaps& maps, bool drifts, ChunkedLoops& loops) {
+  if (master.carries_attributes() || (mesh.has_wedges() && attributes_.layout.any()))
+    throw_internal("EnergyPriority::import_from: a module with attributes");
+  const std::vector<FaceId>& faces = *maps.face;
+  const std::vector<VertexId>& vertices = *maps.vertex;
+  const IdTranslation to_face{maps.face, true}, to_vertex{maps.vertex, true};
+  // The state without its points: the vertices' curves, which import_local reads from it.
+  EnergyState curves;
+  curves.vertices.reserve(vertices.size());
+  for (size_t i = 0; i < vertices.size(); ++i)
+    curves.vertices.push_back(to_vertex.near(vertices[i], i));
+  master.curves_.export_state(vertices, to_vertex, curves);
+  const double diagonal = diagonal_of(mesh);
+  topology_price_ = topology_price(diagonal);
+  scalar_.import_local(AttributeLayout{}, options_.attribute_weight * diagonal, curves);
+  if (options_.discontinuities) {
+    curves_.import_local(mesh, curves);
+  } else {
+    curves_ = SharpCurves{};
+    curves_.initialize_empty(mesh);
+  }
+  // The points as export_local lists them: each face's in its order, then the parked ones.
+  std::vector<size_t> first_point(faces.size() + 1);
+  size_t points = 0;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    first_point[i] = points;
+    points += master.face_points_[faces[i]].size();
+  }
+  first_point[faces.size()] = points;
+  for (const VertexId v : vertices) points += master.parked_point_[v] != kNoPoint ? 1 : 0;
+  resize_touched(positions_, points, loops);
+  resize_touched(point_id_, points, loops);
+  reset_point_lists(mesh);
+  auto master_id = [&](uint32_t id) {
+    return master.point_id_.empty() ? id : master.point_id_[id];
+  };
+  loops.run(faces.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const FaceId f = faces[i];
+      const FaceId local = to_face.near(f, i);
+      const std::vector<FacePoint>& from = master.face_points_[f];
+      std::vector<FacePoint>& list = face_points_[local];
+      list.reserve(from.size());
+      size_t at = first_point[i];
+      for (const FacePoint& p : from) {
+        point_id_[at] = master_id(p.id);
+        positions_[at] = p.position;
+        list.push_back(
+            {p.position, drifts ? p.distance_sq : master.bounded_distance_sq(f, p), uint32_t(at)});
+        ++at;
+      }
+      if (drifts) drift_[local] = master.drift_[f];
+    }
+  });
+  size_t at = first_point[faces.size()];
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const uint32_t id = master.parked_point_[vertices[i]];
+    if (id == kNoPoint) continue;
+    point_id_[at] = master_id(id);
+    positions_[at] = master.positions_[id];
+    parked_point_[curves.vertices[i]] = uint32_t(at++);
+  }
+}
+
 void EnergyPriority::import_global(const EnergyState& state) {
   begin_global_imports();
   const GlobalImport import = check_global(state, 0, GlobalOwners{});

@@ -237,7 +237,8 @@ TEST(EnergyCosting, PointsLeftOnTheirFacesKeepUpperBoundsOfTheirDistances) {
 // A copy of the live mesh whose module imports the master's state with the faces' drifts
 // (export_with_drifts, set_drifts: the parallel build's final pass on a copy, live_pass.h)
 // costs every edge as the master does; with a job's state, whose distances are the drifted
-// bounds, some edges cost otherwise (the path is exercised). The stratocaster at 20% with a
+// bounds, some edges cost otherwise (the path is exercised). Each module read straight from the
+// master (import_from) is the one its state makes. The stratocaster at 20% with a
 // reprojection cap of 16, so that faces drift on a small mesh.
 TEST(EnergyCosting, ACopyWithItsDriftsCostsAsTheMasterDoes) {
   const RepairedMesh repaired = repair_mesh(read_mesh(testing::test_data("stratocaster-9k.ply")));
@@ -286,12 +287,16 @@ TEST(EnergyCosting, ACopyWithItsDriftsCostsAsTheMasterDoes) {
   with_drifts.import_local(copy, master.export_with_drifts(maps, loops, drifts));
   with_drifts.set_drifts(drifts);
   with_bounds.import_local(copy, master.export_local(maps));
+  // The same two modules read straight from the master (in-process: no state in between).
+  EnergyPriority direct_drifts(copy_locked, options), direct_bounds(copy_locked, options);
+  direct_drifts.import_from(master, copy, maps, true, loops);
+  direct_bounds.import_from(master, copy, maps, false, loops);
   const size_t drifted =
       size_t(std::count_if(drifts.begin(), drifts.end(), [](double d) { return d > 0; }));
 
-  size_t edges = 0, same_with_drifts = 0, same_with_bounds = 0;
+  size_t edges = 0, same_with_drifts = 0, same_with_bounds = 0, same_direct = 0;
   for_each_edge(whole, [&](VertexId a, VertexId b) {
-    CollapseCandidate m, d, u;
+    CollapseCandidate m, d, u, dd, du;
     const bool placed = master.evaluate(whole, a, b, m, Costing::kQueue);
     const bool placed_d =
         with_drifts.evaluate(copy, copy_of_vertex[a], copy_of_vertex[b], d, Costing::kQueue);
@@ -300,6 +305,13 @@ TEST(EnergyCosting, ACopyWithItsDriftsCostsAsTheMasterDoes) {
     ++edges;
     if (placed == placed_d && (!placed || m.cost == d.cost)) ++same_with_drifts;
     if (placed == placed_u && (!placed || m.cost == u.cost)) ++same_with_bounds;
+    const bool placed_dd =
+        direct_drifts.evaluate(copy, copy_of_vertex[a], copy_of_vertex[b], dd, Costing::kQueue);
+    const bool placed_du =
+        direct_bounds.evaluate(copy, copy_of_vertex[a], copy_of_vertex[b], du, Costing::kQueue);
+    if (placed_dd == placed_d && (!placed_d || dd.cost == d.cost) && placed_du == placed_u &&
+        (!placed_u || du.cost == u.cost))
+      ++same_direct;
   });
   std::printf(
       "stratocaster-9k at 20%%, cap 16: %zu of %zu faces drifted; of %zu edges, %zu cost as the "
@@ -308,6 +320,19 @@ TEST(EnergyCosting, ACopyWithItsDriftsCostsAsTheMasterDoes) {
   EXPECT_GT(drifted, 100u);
   EXPECT_EQ(same_with_drifts, edges);
   EXPECT_LT(same_with_bounds, edges);
+  EXPECT_EQ(same_direct, edges);
+  // Point by point, the same ids, places, distances, faces and parked samples.
+  auto same_points = [](const EnergyPriority& x, const EnergyPriority& y) {
+    const auto a = x.point_states(), b = y.point_states();
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i)
+      if (a[i].position != b[i].position || a[i].distance_sq != b[i].distance_sq ||
+          a[i].face != b[i].face || a[i].parked != b[i].parked)
+        return false;
+    return true;
+  };
+  EXPECT_TRUE(same_points(direct_drifts, with_drifts));
+  EXPECT_TRUE(same_points(direct_bounds, with_bounds));
   std::vector<double> short_list(drifts.size() - 1, 0.0);
   EXPECT_THROW(with_drifts.set_drifts(short_list), Error);
   drifts[0] = -1;
