@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "util/fresh_pages.h"
+
 namespace parapm {
 
 FaceLists::FaceLists(const FaceLists& other) : slots_(other.slots_) {
@@ -32,6 +34,11 @@ FaceLists& FaceLists::operator=(FaceLists&& other) noexcept {
 void FaceLists::resize(size_t vertices) {
   if (vertices < slots_.size()) free_blocks(vertices);
   slots_.resize(vertices);
+}
+
+void FaceLists::resize(size_t vertices, ChunkedLoops& loops) {
+  if (vertices < slots_.size()) free_blocks(vertices);
+  resize_touched(slots_, vertices, loops);
 }
 
 void FaceLists::release(VertexId v) {

@@ -18,6 +18,8 @@
 
 namespace parapm {
 
+class ChunkedLoops;
+
 class FaceLists {
  public:
   static constexpr uint32_t kInline = 14;
@@ -31,6 +33,8 @@ class FaceLists {
 
   size_t size() const { return slots_.size(); }
   void resize(size_t vertices);  // new lists are empty
+  // The same, a new block's pages touched in `loops`' chunks first (fresh_pages.h).
+  void resize(size_t vertices, ChunkedLoops& loops);
   void reserve(size_t vertices) { slots_.reserve(vertices); }
   // Removes the last list, which must be empty.
   void pop_back() { resize(slots_.size() - 1); }

@@ -23,7 +23,7 @@ void CollapseMesh::build(const Mesh& mesh, ChunkedLoops& loops) {
   copy_touched(corner_wedges_, mesh.face_wedges, loops);
   assign_touched<uint8_t>(face_alive_, mesh.faces.size(), 1, loops);
   assign_touched<uint8_t>(vertex_alive_, vertices, 0, loops);
-  faces_of_.resize(vertices);
+  faces_of_.resize(vertices, loops);
   assign_touched<uint8_t>(boundary_, vertices, 0, loops);
   assign_touched<uint64_t>(imbalance_, vertices, 0, loops);
   assign_touched<uint32_t>(star_version_, vertices, 0, loops);

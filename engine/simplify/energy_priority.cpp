@@ -16,6 +16,7 @@
 #include "simplify/surface_samples.h"
 #include "simplify/vec_math.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 #include "util/thread_team.h"
 
 namespace parapm {
@@ -64,11 +65,11 @@ void EnergyPriority::initialize_curves(const CollapseMesh& mesh, ChunkedLoops& l
   }
 }
 
-void EnergyPriority::reset_point_lists(const CollapseMesh& mesh) {
-  face_points_.assign(mesh.face_capacity(), {});
+void EnergyPriority::reset_point_lists(const CollapseMesh& mesh, ChunkedLoops& loops) {
+  assign_touched(face_points_, mesh.face_capacity(), {}, loops);
   evaluator_.reset(mesh.face_capacity());
-  drift_.assign(mesh.face_capacity(), 0);
-  parked_point_.assign(mesh.vertex_capacity(), kNoPoint);
+  assign_touched(drift_, mesh.face_capacity(), 0.0, loops);
+  assign_touched(parked_point_, mesh.vertex_capacity(), kNoPoint, loops);
 }
 
 void EnergyPriority::initialize_points(const CollapseMesh& mesh, ChunkedLoops& loops) {
@@ -83,8 +84,8 @@ void EnergyPriority::initialize_points(const CollapseMesh& mesh, ChunkedLoops& l
   if (scalar_.enabled()) scalar_.add_points(mesh, samples, loops);
 
   point_id_.clear();
-  positions_.resize(samples.size());
-  reset_point_lists(mesh);
+  resize_touched(positions_, samples.size(), loops);
+  reset_point_lists(mesh, loops);
   // A point's id is its sample's index. The vertices' samples come first: each is parked at
   // its vertex; the others are listed on their faces, newest first, as collapsed() leaves
   // them (the order of the sums over a face's points is part of the build's arithmetic).

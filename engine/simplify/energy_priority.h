@@ -343,7 +343,7 @@ class EnergyPriority : public PriorityModule {
   void initialize_points(const CollapseMesh& mesh, ChunkedLoops& loops);  // everything else
   // Empty point lists, moments and drifts for every face, no parked sample: the start of
   // initialize_points and import_local.
-  void reset_point_lists(const CollapseMesh& mesh);
+  void reset_point_lists(const CollapseMesh& mesh, ChunkedLoops& loops);
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
                     EnergyState& out, ChunkedLoops& loops,

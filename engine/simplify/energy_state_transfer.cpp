@@ -178,7 +178,7 @@ void EnergyPriority::import_local(const CollapseMesh& mesh, const EnergyState& s
   const size_t n = points.size();
   resize_touched(positions_, n, loops);
   resize_touched(point_id_, n, loops);
-  reset_point_lists(mesh);
+  reset_point_lists(mesh, loops);
   // Each face's points come as one run (the state lists them grouped by face), which fills
   // its list in the written order; the runs side by side in `loops`' chunks, each chunk taking
   // the runs that start in its range. A face named by two runs, or a vertex parked at twice,
@@ -241,7 +241,7 @@ void EnergyPriority::import_from(const EnergyPriority& master, const CollapseMes
   for (const VertexId v : vertices) points += master.parked_point_[v] != kNoPoint ? 1 : 0;
   resize_touched(positions_, points, loops);
   resize_touched(point_id_, points, loops);
-  reset_point_lists(mesh);
+  reset_point_lists(mesh, loops);
   auto master_id = [&](uint32_t id) {
     return master.point_id_.empty() ? id : master.point_id_[id];
   };

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "simplify/vec_math.h"
+#include "util/fresh_pages.h"
 
 namespace parapm {
 
@@ -46,9 +47,13 @@ std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double sampl
 
 std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double samples_per_face,
                                           uint64_t seed, ChunkedLoops& loops) {
+  // Each new block's pages touched in `loops`' chunks before its serial fill (fresh_pages.h).
   std::vector<SurfaceSample> samples;
-  samples.reserve(mesh.live_vertices() + size_t(std::llround(std::max(0.0, samples_per_face) *
-                                                             double(mesh.live_faces()))));
+  const size_t expected =
+      mesh.live_vertices() +
+      size_t(std::llround(std::max(0.0, samples_per_face) * double(mesh.live_faces())));
+  samples.reserve(expected);
+  touch_pages(samples.data(), expected * sizeof(SurfaceSample), loops);
   // The vertices' samples: each range of vertices counts its own, then writes them after the
   // ranges before it.
   std::vector<size_t> first(loops.ranges(mesh.vertex_capacity()) + 1, 0);
@@ -66,7 +71,7 @@ std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double sampl
   });
   if (!(samples_per_face > 0)) return samples;
 
-  std::vector<double> area(mesh.face_capacity(), 0.0);
+  std::vector<double> area = filled_touched(mesh.face_capacity(), 0.0, loops);
   loops.run(mesh.face_capacity(), [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       if (!mesh.face_alive(FaceId(f))) continue;
@@ -77,6 +82,10 @@ std::vector<SurfaceSample> sample_surface(const CollapseMesh& mesh, double sampl
   });
   std::vector<FaceId> faces;
   std::vector<double> cumulative_area;
+  faces.reserve(mesh.face_capacity());
+  cumulative_area.reserve(mesh.face_capacity());
+  touch_pages(faces.data(), faces.capacity() * sizeof(FaceId), loops);
+  touch_pages(cumulative_area.data(), cumulative_area.capacity() * sizeof(double), loops);
   double total = 0;
   for (FaceId f = 0; f < mesh.face_capacity(); ++f) {
     if (!(area[f] > 0)) continue;

@@ -6,6 +6,8 @@
 #include <thread>
 #include <vector>
 
+#include "util/chunked_loops.h"
+
 namespace parapm {
 namespace {
 
@@ -29,6 +31,24 @@ TEST(FaceLists, ListsGrowPastTheirSlotInOrder) {
   EXPECT_EQ(list(lists, 1), count_up(0, many));
   EXPECT_EQ(list(lists, 0), std::vector<FaceId>{7});
   EXPECT_TRUE(lists.of(2).empty());
+}
+
+// Resized in chunks (pages touched first, for the builds' large meshes): the kept lists stay,
+// the new ones are empty, and a list cut off gives its block back (ASan would see a leak).
+TEST(FaceLists, ResizedInChunksKeepsTheListsBelow) {
+  ChunkedLoops loops(4, 2);
+  FaceLists lists;
+  lists.resize(3, loops);
+  const FaceId many = 2 * FaceLists::kInline + 1;
+  for (FaceId f = 0; f < many; ++f) lists.push(0, f), lists.push(2, f);
+  lists.resize(2, loops);
+  lists.resize(100000, loops);
+  EXPECT_EQ(list(lists, 0), count_up(0, many));
+  EXPECT_TRUE(lists.of(1).empty());
+  EXPECT_TRUE(lists.of(2).empty());
+  EXPECT_TRUE(lists.of(99999).empty());
+  lists.push(99999, 5);
+  EXPECT_EQ(list(lists, 99999), std::vector<FaceId>{5});
 }
 
 TEST(FaceLists, EditsInPlace) {
