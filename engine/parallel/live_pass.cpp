@@ -119,7 +119,7 @@ std::unique_ptr<PriorityModule> module_of_copy(const PriorityModule& master,
       make_priority_module(*inputs.options, copy.mesh, copy.locked, inputs.reference_diagonal);
   auto& module = dynamic_cast<EnergyPriority&>(*made);
   const IdMaps maps{&copy.global_vertex, &copy.global_face, &copy.global_wedge};
-  if (!energy.carries_attributes() && !copy.mesh.layout.any()) {
+  if (imports_from_master(master, copy)) {
     module.import_from(energy, mesh, maps, true, loops);
     return made;
   }

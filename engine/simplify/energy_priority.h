@@ -344,6 +344,10 @@ class EnergyPriority : public PriorityModule {
   // Empty point lists, moments and drifts for every face, no parked sample: the start of
   // initialize_points and import_local.
   void reset_point_lists(const CollapseMesh& mesh, ChunkedLoops& loops);
+  // Where each of `faces`' lists starts in a state listing them in that order (then the end of
+  // the last), and in `points` how many points they and `vertices`' parked samples hold.
+  std::vector<size_t> first_points(const std::vector<FaceId>& faces,
+                                   const std::vector<VertexId>& vertices, size_t& points) const;
   void export_state(const std::vector<FaceId>& faces, const std::vector<VertexId>& vertices,
                     const std::vector<WedgeId>& wedges, const IdMaps& maps, bool to_local,
                     EnergyState& out, ChunkedLoops& loops,

@@ -41,6 +41,20 @@ void for_each_run(ChunkedLoops& loops, const std::vector<EnergyState::Point>& po
 
 }  // namespace
 
+std::vector<size_t> EnergyPriority::first_points(const std::vector<FaceId>& faces,
+                                                 const std::vector<VertexId>& vertices,
+                                                 size_t& points) const {
+  std::vector<size_t> first(faces.size() + 1);
+  points = 0;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    first[i] = points;
+    points += face_points_[faces[i]].size();
+  }
+  first[faces.size()] = points;
+  for (const VertexId v : vertices) points += parked_point_[v] != kNoPoint ? 1 : 0;
+  return first;
+}
+
 void EnergyPriority::export_state(const std::vector<FaceId>& faces,
                                   const std::vector<VertexId>& vertices,
                                   const std::vector<WedgeId>& wedges, const IdMaps& maps,
@@ -67,16 +81,9 @@ void EnergyPriority::export_state(const std::vector<FaceId>& faces,
       std::copy_n(scalar_.point_values(id), floats,
                   out.point_values.begin() + ptrdiff_t(at * size_t(floats)));
   };
-  // Where each face's points go (its list's run starts there), so that the faces are written
-  // side by side; sized once, exactly.
-  std::vector<size_t> first_point(faces.size() + 1);
+  // (the faces written side by side; sized once, exactly)
   size_t points = 0;
-  for (size_t i = 0; i < faces.size(); ++i) {
-    first_point[i] = points;
-    points += face_points_[faces[i]].size();
-  }
-  first_point[faces.size()] = points;
-  for (const VertexId v : vertices) points += parked_point_[v] != kNoPoint ? 1 : 0;
+  const std::vector<size_t> first_point = first_points(faces, vertices, points);
   resize_touched(out.points, points, loops);
   if (values) resize_touched(out.point_values, points * size_t(floats), loops);
   resize_touched(out.faces, faces.size(), loops);
@@ -231,14 +238,8 @@ void EnergyPriority::import_from(const EnergyPriority& master, const CollapseMes
     curves_.initialize_empty(mesh);
   }
   // The points as export_local lists them: each face's in its order, then the parked ones.
-  std::vector<size_t> first_point(faces.size() + 1);
   size_t points = 0;
-  for (size_t i = 0; i < faces.size(); ++i) {
-    first_point[i] = points;
-    points += master.face_points_[faces[i]].size();
-  }
-  first_point[faces.size()] = points;
-  for (const VertexId v : vertices) points += master.parked_point_[v] != kNoPoint ? 1 : 0;
+  const std::vector<size_t> first_point = master.first_points(faces, vertices, points);
   resize_touched(positions_, points, loops);
   resize_touched(point_id_, points, loops);
   reset_point_lists(mesh, loops);
