@@ -1,6 +1,7 @@
 #include "parallel/parallel_builder.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -28,6 +29,7 @@
 #include "simplify/surface_samples.h"
 #include "util/clock.h"
 #include "util/error.h"
+#include "util/fresh_pages.h"
 #include "util/job_pool.h"
 #include "util/memory.h"
 #include "util/number_text.h"
@@ -47,9 +49,14 @@ struct LiveCopy {
 // vertex alive while a face holds it), for the first round's live copy before that build.
 class FreshMesh {
  public:
-  explicit FreshMesh(const Mesh& mesh) : mesh_(mesh), held_(mesh.positions.size(), 0) {
-    for (const Triangle& t : mesh.faces)
-      for (VertexId v : t) held_[v] = 1;
+  // In `loops`' chunks (relaxed stores: chunks mark shared vertices alike).
+  FreshMesh(const Mesh& mesh, ChunkedLoops& loops) : mesh_(mesh) {
+    resize_touched(held_, mesh.positions.size(), loops, uint8_t(0));
+    loops.run(mesh.faces.size(), [&](size_t begin, size_t end) {
+      for (size_t f = begin; f < end; ++f)
+        for (VertexId v : mesh.faces[f])
+          std::atomic_ref<uint8_t>(held_[v]).store(1, std::memory_order_relaxed);
+    });
   }
   size_t vertex_capacity() const { return mesh_.positions.size(); }
   size_t face_capacity() const { return mesh_.faces.size(); }
@@ -82,7 +89,7 @@ LiveCopy live_copy(const Source& mesh, const CopyGroups& groups, ChunkedLoops& l
   });
   LiveCopy out;
   out.compact = std::move(vertices.new_id);
-  out.mesh.positions.resize(vertices.old_id.size());
+  resize_touched(out.mesh.positions, vertices.old_id.size(), loops);
   loops.run(vertices.old_id.size(), [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) out.mesh.positions[i] = mesh.position(vertices.old_id[i]);
   });
@@ -92,12 +99,12 @@ LiveCopy live_copy(const Source& mesh, const CopyGroups& groups, ChunkedLoops& l
         if (out.compact[v] == kNoId && mesh.vertex_alive(VertexId(v)))
           out.compact[v] = out.compact[numbered_as(VertexId(v))];
     });
-  const KeptItems faces = number_kept(loops, mesh.face_capacity(),
-                                      [&](size_t f) { return mesh.face_alive(FaceId(f)); });
-  out.mesh.faces.resize(faces.old_id.size());
-  loops.run(faces.old_id.size(), [&](size_t begin, size_t end) {
+  const std::vector<uint32_t> faces =
+      kept_items(loops, mesh.face_capacity(), [&](size_t f) { return mesh.face_alive(FaceId(f)); });
+  resize_touched(out.mesh.faces, faces.size(), loops);
+  loops.run(faces.size(), [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
-      const Triangle& t = mesh.face(faces.old_id[i]);
+      const Triangle& t = mesh.face(faces[i]);
       out.mesh.faces[i] = {out.compact[t[0]], out.compact[t[1]], out.compact[t[2]]};
     }
   });
@@ -105,18 +112,24 @@ LiveCopy live_copy(const Source& mesh, const CopyGroups& groups, ChunkedLoops& l
 }
 
 // Per vertex of the mesh a live copy was made from, its subset in a partition of the copy (0
-// for vertices dead at the copy).
-std::vector<uint32_t> subsets_of_copied(const LiveCopy& live, const Partition& partition) {
-  std::vector<uint32_t> vertex_subset(live.compact.size(), 0);
-  for (VertexId v = 0; v < live.compact.size(); ++v)
-    if (live.compact[v] != kNoId) vertex_subset[v] = partition.vertex_subset[live.compact[v]];
+// for vertices dead at the copy), in `loops`' chunks.
+std::vector<uint32_t> subsets_of_copied(const LiveCopy& live, const Partition& partition,
+                                        ChunkedLoops& loops) {
+  std::vector<uint32_t> vertex_subset;
+  resize_touched(vertex_subset, live.compact.size(), loops);
+  loops.run(live.compact.size(), [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v)
+      vertex_subset[v] = live.compact[v] != kNoId ? partition.vertex_subset[live.compact[v]] : 0;
+  });
   return vertex_subset;
 }
 
-// Partitions a live copy into p subsets (subsets_of_copied).
+// Partitions a live copy into p subsets (subsets_of_copied), in options.loops' chunks.
 std::vector<uint32_t> partition_copy(const LiveCopy& live, uint32_t p,
                                      const PartitionOptions& options) {
-  return subsets_of_copied(live, partition_mesh(live.mesh, p, options));
+  ChunkedLoops one_thread;
+  return subsets_of_copied(live, partition_mesh(live.mesh, p, options),
+                           options.loops ? *options.loops : one_thread);
 }
 
 std::vector<uint32_t> partition_live(const CollapseMesh& mesh, const CopyGroups& groups, uint32_t p,
@@ -355,7 +368,9 @@ struct ParallelBuilder::LiveGraph {
       : live(live_copy(mesh, groups, loops)), graph(live.mesh, Balance::kFaces, &loops) {}
   // Per vertex of the mesh, its subset (subsets_of_copied).
   std::vector<uint32_t> draw(uint32_t p, const PartitionOptions& options) const {
-    return subsets_of_copied(live, graph.draw(p, options));
+    ChunkedLoops one_thread;
+    return subsets_of_copied(live, graph.draw(p, options),
+                             options.loops ? *options.loops : one_thread);
   }
   LiveCopy live;
   PartitionGraph graph;
@@ -425,7 +440,7 @@ void ParallelBuilder::set_up() {
   bool first_round = false;
   auto partition_first_round = [&] {
     const LoopClock clock(master_loops_);
-    const FreshMesh fresh(mesh_);
+    const FreshMesh fresh(mesh_, master_loops_);
     first_round = fresh.live_vertices() >= 4 * size_t(first_subsets);
     if (!first_round) return;
     auto source = std::make_shared<const LiveGraph>(fresh, copy_groups_, master_loops_);

@@ -19,7 +19,8 @@ namespace {
 // distance does not improve: O(p |V|) for the farthest-vertex scans plus the BFS work.
 std::vector<uint32_t> spread_seeds(const VertexGraph& graph, uint32_t count, uint64_t seed) {
   const uint32_t n = graph.vertex_count();
-  const std::vector<uint32_t> by_degree = vertices_by_degree(graph);
+  ChunkedLoops one_thread;
+  const std::vector<uint32_t> by_degree = vertices_by_degree(graph, one_thread);
   std::vector<uint32_t> distance(n, kNoId), queue;
   std::vector<char> chosen(n, 0);
   std::vector<uint32_t> seeds;

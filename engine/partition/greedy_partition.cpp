@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "partition/partition_internal.h"
+#include "util/fresh_pages.h"
 
 namespace parapm::partition_detail {
 namespace {
@@ -30,7 +31,8 @@ namespace {
 // counts it; the next subsets make up for it.)
 class SettledFaces {
  public:
-  explicit SettledFaces(const VertexGraph& graph) : graph_(graph), faces_(graph.face_count) {}
+  SettledFaces(const VertexGraph& graph, ChunkedLoops& loops)
+      : graph_(graph), faces_(filled_touched(graph.face_count, Face{}, loops)) {}
 
   // Corner units settled when v joins subset k.
   uint64_t join(uint32_t v, uint32_t k) {
@@ -96,13 +98,24 @@ class SettledFaces {
 // is changed at every fall, without unlinking anything at each one.
 class FallingDegrees {
  public:
-  explicit FallingDegrees(uint32_t max_degree)
-      : lists_(size_t(max_degree) + 1),
-        heads_(size_t(max_degree) + 1, 0),
-        min_key_(max_degree + 1) {}
+  // The lists lie in one block, each with room for every vertex whose degree exceeds its own
+  // (the vertices that can fall to it): 4 bytes per neighbour entry of the graph, no growth.
+  FallingDegrees(const VertexGraph& graph, uint32_t max_degree, ChunkedLoops& loops)
+      : heads_(size_t(max_degree) + 1, 0), min_key_(max_degree + 1) {
+    std::vector<size_t> of_degree(size_t(max_degree) + 1, 0);
+    for (uint32_t v = 0; v < graph.vertex_count(); ++v) ++of_degree[graph.degree(v)];
+    size_t above = graph.vertex_count(), room = 0;  // vertices whose degree exceeds d
+    for (uint32_t d = 0; d <= max_degree; ++d) {
+      heads_[d] = room;
+      above -= of_degree[d];
+      room += above;
+    }
+    resize_touched(entries_, room, loops);
+    ends_ = heads_;
+  }
 
   void push(uint32_t v, uint32_t degree) {
-    lists_[degree].push_back(v);
+    entries_[ends_[degree]++] = v;
     min_key_ = std::min(min_key_, degree);
   }
 
@@ -110,46 +123,48 @@ class FallingDegrees {
   // current(v, degree): whether v is unmarked and of that updated degree.
   template <class Current>
   uint32_t min(const Current& current) {
-    for (; min_key_ < lists_.size(); ++min_key_) {
-      const std::vector<uint32_t>& list = lists_[min_key_];
-      for (size_t& head = heads_[min_key_]; head < list.size(); ++head)
-        if (current(list[head], min_key_)) return list[head];
-    }
+    for (; min_key_ < ends_.size(); ++min_key_)
+      for (size_t& head = heads_[min_key_]; head < ends_[min_key_]; ++head)
+        if (current(entries_[head], min_key_)) return entries_[head];
     return kNoId;
   }
 
  private:
-  std::vector<std::vector<uint32_t>> lists_;  // per degree
-  std::vector<size_t> heads_;                 // per degree: the entries before it are stale
-  uint32_t min_key_;                          // no current entry has a lesser degree
+  std::vector<uint32_t> entries_;  // the lists, degree 0's first
+  std::vector<size_t> heads_;      // per degree: the entries before it are stale
+  std::vector<size_t> ends_;       // per degree: its list's end
+  uint32_t min_key_;               // no current entry has a lesser degree
 };
 
 }  // namespace
 
 Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
-                           uint64_t seed) {
+                           uint64_t seed, ChunkedLoops& loops) {
   const uint32_t n = graph.vertex_count(), p = uint32_t(targets.size());
   const uint32_t max_degree = graph.max_degree();
   Partition partition;
   partition.subsets = p;
   std::vector<uint32_t>& subset = partition.vertex_subset;
-  subset.assign(n, kNoId);
+  assign_touched(subset, n, kNoId, loops);
 
-  std::vector<uint32_t> updated_degree(n);
-  for (uint32_t v = 0; v < n; ++v) updated_degree[v] = graph.degree(v);
+  std::vector<uint32_t> updated_degree;
+  resize_touched(updated_degree, n, loops);
+  loops.run(n, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) updated_degree[v] = graph.degree(uint32_t(v));
+  });
   // Unmarked vertices with a marked neighbour, by updated degree: where a locked-in subset
   // continues. Kept up to date by mark(), so that finding a seed is O(1) amortised.
-  FallingDegrees touched(max_degree);
+  FallingDegrees touched(graph, max_degree, loops);
   auto current = [&](uint32_t v, uint32_t degree) {
     return subset[v] == kNoId && updated_degree[v] == degree;
   };
   // The front being taken in part when the last front overshoots the target.
   BucketQueue partial_front(n, max_degree);
-  const std::vector<uint32_t> by_degree = vertices_by_degree(graph);
+  const std::vector<uint32_t> by_degree = vertices_by_degree(graph, loops);
   size_t by_degree_next = 0;  // vertices before it in by_degree are all marked
 
   std::optional<SettledFaces> faces;
-  if (graph.has_faces()) faces.emplace(graph);
+  if (graph.has_faces()) faces.emplace(graph, loops);
   // Marks v as k's; returns what it adds to the subsets' count: its weight, or by faces the
   // faces it settles.
   auto mark = [&](uint32_t v, uint32_t k) -> uint64_t {
@@ -173,7 +188,8 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
 
   std::vector<uint32_t> members, previous_members;  // of the subset grown, the one before
   std::vector<uint32_t> front, next_front;
-  std::vector<uint32_t> queued(n, kNoId);  // the front number a vertex was queued for
+  // The front number a vertex was queued for.
+  std::vector<uint32_t> queued = filled_touched(n, kNoId, loops);
   uint32_t front_number = 0;
   bool first = true;
   // The last subset takes what remains; the others are grown, each until the subsets so far
@@ -267,9 +283,10 @@ Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>
     }
     std::swap(previous_members, members);
   }
-  for (uint32_t v = 0; v < n; ++v) {
-    if (subset[v] == kNoId) subset[v] = p - 1;
-  }
+  loops.run(n, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v)
+      if (subset[v] == kNoId) subset[v] = p - 1;
+  });
   return partition;
 }
 

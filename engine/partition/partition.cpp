@@ -128,15 +128,14 @@ VertexGraph build_vertex_graph(const Mesh& mesh, ChunkedLoops& loops, bool with_
 }
 
 BucketQueue::BucketQueue(uint32_t items, uint32_t max_key)
-    : head_(size_t(max_key) + 1, kNoId),
-      tail_(size_t(max_key) + 1, kNoId),
-      next_(items, kNoId),
-      prev_(items, kNoId),
-      key_(items, kNoId),
-      min_key_(max_key + 1) {}
+    : head_(size_t(max_key) + 1, kNoId), tail_(size_t(max_key) + 1, kNoId), min_key_(max_key + 1) {
+  next_.assign_zeroed(items);
+  prev_.assign_zeroed(items);
+  key_plus_one_.assign_zeroed(items);
+}
 
 void BucketQueue::insert(uint32_t item, uint32_t key) {
-  key_[item] = key;
+  key_plus_one_[item] = key + 1;
   next_[item] = kNoId;
   prev_[item] = tail_[key];
   if (tail_[key] != kNoId) {
@@ -150,7 +149,7 @@ void BucketQueue::insert(uint32_t item, uint32_t key) {
 }
 
 void BucketQueue::remove(uint32_t item) {
-  const uint32_t key = key_[item];
+  const uint32_t key = key_plus_one_[item] - 1;
   if (prev_[item] != kNoId) {
     next_[prev_[item]] = next_[item];
   } else {
@@ -161,7 +160,7 @@ void BucketQueue::remove(uint32_t item) {
   } else {
     tail_[key] = prev_[item];
   }
-  key_[item] = kNoId;
+  key_plus_one_[item] = 0;
   --size_;
 }
 
@@ -177,7 +176,7 @@ uint32_t BucketQueue::pop_min() {
   return item;
 }
 
-std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph) {
+std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph, ChunkedLoops& loops) {
   // Counting sort; degree 0 is given the key past the maximum so that it sorts last.
   const uint32_t n = graph.vertex_count(), max_degree = graph.max_degree();
   auto key = [&](uint32_t v) {
@@ -187,7 +186,8 @@ std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph) {
   std::vector<size_t> start(size_t(max_degree) + 3, 0);
   for (uint32_t v = 0; v < n; ++v) ++start[key(v) + 1];
   for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
-  std::vector<uint32_t> order(n);
+  std::vector<uint32_t> order;
+  resize_touched(order, n, loops);
   for (uint32_t v = 0; v < n; ++v) order[start[key(v)]++] = v;
   return order;
 }
@@ -214,7 +214,7 @@ void assign_faces(const Mesh& mesh, Partition& partition, ChunkedLoops& loops) {
   // the three vertices are in three subsets there is no majority: the smallest subset id
   // wins, which does not depend on which corner happens to be listed first.
   const auto& vs = partition.vertex_subset;
-  partition.face_subset.resize(mesh.faces.size());
+  resize_touched(partition.face_subset, mesh.faces.size(), loops);
   loops.run(mesh.faces.size(), [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       const uint32_t a = vs[mesh.faces[f][0]], b = vs[mesh.faces[f][1]], c = vs[mesh.faces[f][2]];
@@ -317,12 +317,14 @@ PartitionGraph::PartitionGraph(const Mesh& mesh, Balance balance, ChunkedLoops* 
   const uint32_t n = uint32_t(mesh.vertex_count());
   ChunkedLoops one_thread;
   const bool by_faces = balance == Balance::kFaces;
-  auto graph = std::make_unique<VertexGraph>(
-      build_vertex_graph(mesh, loops ? *loops : one_thread, by_faces));
-  graph->weight.assign(n, by_faces ? 0 : 1);
+  ChunkedLoops& chunks = loops ? *loops : one_thread;
+  auto graph = std::make_unique<VertexGraph>(build_vertex_graph(mesh, chunks, by_faces));
+  resize_touched(graph->weight, n, chunks, by_faces ? 0u : 1u);
   if (by_faces)  // a vertex counts its faces
-    for (VertexId v = 0; v < n; ++v)
-      graph->weight[v] = uint32_t(graph->face_offsets[v + 1] - graph->face_offsets[v]);
+    chunks.run(n, [&](size_t begin, size_t end) {
+      for (size_t v = begin; v < end; ++v)
+        graph->weight[v] = uint32_t(graph->face_offsets[v + 1] - graph->face_offsets[v]);
+    });
   graph_ = std::move(graph);
 }
 
@@ -336,12 +338,13 @@ Partition PartitionGraph::draw(uint32_t p, const PartitionOptions& options) cons
   uint64_t total = 0;
   for (uint32_t w : graph_->weight) total += w;
   const std::vector<uint64_t> targets = share_targets(total, p, options.weights);
+  ChunkedLoops one_thread;
+  ChunkedLoops& loops = options.loops ? *options.loops : one_thread;
   Partition partition = options.algorithm == "greedy"
-                            ? greedy_partition(*graph_, targets, options.seed)
+                            ? greedy_partition(*graph_, targets, options.seed, loops)
                             : bfs_partition(*graph_, targets, options.seed);
   if (options.refine) refine_partition(*graph_, targets, partition);
-  ChunkedLoops one_thread;
-  assign_faces(mesh_, partition, options.loops ? *options.loops : one_thread);
+  assign_faces(mesh_, partition, loops);
   return partition;
 }
 

@@ -46,8 +46,8 @@ struct PartitionOptions {
   // After the algorithm: move boundary vertices and stray components to cut fewer edges,
   // within the balance bound (refine_partition.cpp).
   bool refine = false;
-  // Where the graph's construction and the faces' assignment run in chunks side by side (the
-  // same partition); null: on the calling thread.
+  // Where the graph's construction, the faces' assignment and the first writes to the greedy's
+  // arrays run in chunks side by side (the same partition); null: on the calling thread.
   ChunkedLoops* loops = nullptr;
 };
 

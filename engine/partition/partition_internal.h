@@ -9,6 +9,7 @@
 
 #include "mesh/mesh.h"
 #include "partition/partition.h"
+#include "util/zeroed_array.h"
 
 namespace parapm::partition_detail {
 
@@ -59,11 +60,12 @@ CutShape cut_shape(const VertexGraph& graph, const std::vector<uint32_t>& vertex
 // Items 0..n-1 with integer keys 0..max_key, each in at most once. Insert, remove and changing
 // a key are O(1); pop_min scans up from the lowest key that may be occupied. Equal keys pop in
 // insertion order (a key change counts as a new insertion), so the order is deterministic.
+// The per-item arrays are zeroed pages: a queue costs the pages of the items it holds.
 class BucketQueue {
  public:
   BucketQueue(uint32_t items, uint32_t max_key);
   bool empty() const { return size_ == 0; }
-  bool contains(uint32_t item) const { return key_[item] != kNoId; }
+  bool contains(uint32_t item) const { return key_plus_one_[item] != 0; }
   void insert(uint32_t item, uint32_t key);
   void remove(uint32_t item);
   void set_key(uint32_t item, uint32_t key) {
@@ -74,15 +76,18 @@ class BucketQueue {
   uint32_t pop_min();
 
  private:
-  std::vector<uint32_t> head_, tail_;        // per key
-  std::vector<uint32_t> next_, prev_, key_;  // per item; key_ kNoId when absent
-  uint32_t min_key_ = 0;                     // no occupied key is below it
+  std::vector<uint32_t> head_, tail_;  // per key
+  // Per item: its neighbours in its key's list (kNoId at an end), valid while it is in the
+  // queue, and its key + 1 (0 when absent).
+  ZeroedArray<uint32_t> next_, prev_, key_plus_one_;
+  uint32_t min_key_ = 0;  // no occupied key is below it
   size_t size_ = 0;
 };
 
 // Vertices sorted by degree (stable: ties by id), vertices of degree 0 last: isolated vertices
-// are never chosen to start a subset while a vertex with edges is free.
-std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph);
+// are never chosen to start a subset while a vertex with edges is free. The result's pages are
+// touched in `loops`' chunks.
+std::vector<uint32_t> vertices_by_degree(const VertexGraph& graph, ChunkedLoops& loops);
 
 // The start vertex of the first subset: among the vertices of minimal (non-zero) degree, the
 // (seed mod count)-th in id order; where fewer than `candidates` have it, the vertices of the
@@ -101,8 +106,9 @@ std::vector<uint64_t> share_targets(uint64_t total, uint32_t p, const std::vecto
 
 // `targets` are in units of VertexGraph::weight: a subset is grown until its vertices' weights
 // reach its target (overshooting by less than one vertex's weight), the last takes the rest.
+// The greedy runs on the calling thread; its arrays' pages are touched in `loops`' chunks.
 Partition greedy_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
-                           uint64_t seed);
+                           uint64_t seed, ChunkedLoops& loops);
 Partition bfs_partition(const VertexGraph& graph, const std::vector<uint64_t>& targets,
                         uint64_t seed);
 // Moves boundary vertices and stray components to cut fewer edges while every subset stays

@@ -107,10 +107,12 @@ struct KeptItems {
   std::vector<uint32_t> new_id;
   std::vector<uint32_t> old_id;
 };
+namespace chunked_detail {
+// number_kept(), with the per-item numbers only `with_new_ids`.
 template <class Keep>
-KeptItems number_kept(ChunkedLoops& loops, size_t n, Keep keep) {
+KeptItems number_kept(ChunkedLoops& loops, size_t n, Keep keep, bool with_new_ids) {
   KeptItems out;
-  resize_touched(out.new_id, n, loops, kNoKey);
+  if (with_new_ids) resize_touched(out.new_id, n, loops, kNoKey);
   std::vector<size_t> first(loops.ranges(n) + 1, 0);  // per range, its first new number
   loops.run_indexed(n, [&](size_t range, size_t begin, size_t end) {
     size_t count = 0;
@@ -123,11 +125,21 @@ KeptItems number_kept(ChunkedLoops& loops, size_t n, Keep keep) {
     uint32_t next = uint32_t(first[range]);
     for (size_t i = begin; i < end; ++i)
       if (keep(i)) {
-        out.new_id[i] = next;
+        if (with_new_ids) out.new_id[i] = next;
         out.old_id[next++] = uint32_t(i);
       }
   });
   return out;
+}
+}  // namespace chunked_detail
+template <class Keep>
+KeptItems number_kept(ChunkedLoops& loops, size_t n, Keep keep) {
+  return chunked_detail::number_kept(loops, n, keep, true);
+}
+// The kept items alone, in order (number_kept's old_id).
+template <class Keep>
+std::vector<uint32_t> kept_items(ChunkedLoops& loops, size_t n, Keep keep) {
+  return std::move(chunked_detail::number_kept(loops, n, keep, false).old_id);
 }
 
 // A section's time with a core per chunk: the wall seconds since it was made, with the loops
