@@ -163,12 +163,15 @@ void EnergyPriority::take(FaceId f, int home, bool removed) {
 }
 
 void EnergyPriority::grow_moved_buffers() {
-  const size_t count = moved_.count;
-  for (auto* buffer : {&moved_.homes, &moved_.in_fan})
-    if (buffer->size() < count) buffer->resize(count);
-  if (moved_.points.size() < count) moved_.points.resize(count);
-  if (moved_.faces.size() < count) moved_.faces.resize(count);
-  if (moved_.bary.size() < count) moved_.bary.resize(count);
+  if (moved_.points.size() >= moved_.count) return;
+  // A point moves at most once per collapse: room for them all, the same for every buffer.
+  const size_t room = std::max(moved_.count, point_count());
+  moved_.points.assign_zeroed(room);
+  moved_.homes.assign_zeroed(room);
+  moved_.in_fan.assign_zeroed(room);
+  moved_.faces.assign_zeroed(room);
+  moved_.bary.assign_zeroed(room);
+  moved_.by_face.assign_zeroed(room);
 }
 
 void EnergyPriority::move_taken_points() {
@@ -180,8 +183,8 @@ void EnergyPriority::move_taken_points() {
       continue;
     }
     std::vector<FacePoint>& list = face_points_[source.face];
-    std::copy(list.begin(), list.end(), moved_.points.begin() + ptrdiff_t(source.at));
-    std::fill_n(moved_.homes.begin() + ptrdiff_t(source.at), list.size(), source.home);
+    std::copy(list.begin(), list.end(), &moved_.points[source.at]);
+    std::fill_n(&moved_.homes[source.at], list.size(), source.home);
     list.clear();
     if (source.removed) list.shrink_to_fit();
   }
@@ -236,7 +239,6 @@ double EnergyPriority::list_on_team(
     }
   }
   moved_.fan_start[fan] = at;
-  if (moved_.by_face.size() < moving) moved_.by_face.resize(moving);
   moved_.block_max_sq.assign(blocks, 0.0);
   each_block([&](size_t k) {
     size_t* next = &slots[k * fan];
@@ -265,8 +267,8 @@ double EnergyPriority::list_on_team(
     for (size_t j = begin; j < end; ++j) {
       std::vector<FacePoint>& list = face_points_[faces[j]];
       if (moved_.fan_taken[j]) list.clear();
-      const auto first = moved_.by_face.begin() + ptrdiff_t(moved_.fan_start[j]);
-      const auto last = moved_.by_face.begin() + ptrdiff_t(moved_.fan_start[j + 1]);
+      const FacePoint* first = &moved_.by_face[0] + moved_.fan_start[j];
+      const FacePoint* last = &moved_.by_face[0] + moved_.fan_start[j + 1];
       if (first == last) continue;
       list.insert(list.end(), first, last);
       evaluator_.extend(faces[j], size_t(last - first));

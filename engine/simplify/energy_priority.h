@@ -91,6 +91,7 @@
 #include "simplify/quadric.h"
 #include "simplify/scalar_attributes.h"
 #include "simplify/sharp_curves.h"
+#include "util/zeroed_array.h"
 
 namespace parapm {
 
@@ -393,22 +394,23 @@ class EnergyPriority : public PriorityModule {
       FacePoint sample;
     };
     std::vector<Source> sources;
-    // The points moving are the first `count` of each per-point buffer (buffers that only
-    // grow: filled on the team, not constructed again at each collapse).
+    // The points moving are the first `count` of each per-point buffer: zeroed pages with room
+    // for all of the module's points, given once (grow_moved_buffers), so that a page is
+    // written first where the point is (on the team), and never copied or cleared again.
     size_t count = 0;
-    std::vector<FacePoint> points;
+    ZeroedArray<FacePoint> points;
     // Per point: the index among vs's faces of its old face's image (-1: an unparked sample).
-    std::vector<int> homes;
+    ZeroedArray<int> homes;
     std::vector<PreparedTriangle> prepared;  // vs's faces
     std::vector<FanFace> fan;
-    std::vector<int> in_fan;                  // per point, its new face's index among vs's
-    std::vector<FaceId> faces;                // and the face
-    std::vector<std::array<double, 3>> bary;  // and its barycentric coordinates there
+    ZeroedArray<int> in_fan;                  // per point, its new face's index among vs's
+    ZeroedArray<FaceId> faces;                // and the face
+    ZeroedArray<std::array<double, 3>> bary;  // and its barycentric coordinates there
     // list_on_team's: per block and face of the fan, a count, then an index in by_face; the
     // moved points grouped by their new face, face j's from fan_start[j]; per block, its
     // points' largest distance.
     std::vector<size_t> slots;
-    std::vector<FacePoint> by_face;
+    ZeroedArray<FacePoint> by_face;  // (as the per-point buffers)
     std::vector<size_t> fan_start;
     std::vector<double> block_max_sq;
     std::vector<uint8_t> fan_taken;  // per face of the fan: its points were taken
