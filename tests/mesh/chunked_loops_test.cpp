@@ -71,5 +71,24 @@ TEST(ChunkedLoops, TheLowestRangesExceptionIsRethrown) {
   EXPECT_GE(calls, 2);
 }
 
+// Each range numbers its kept items from the count of the ranges before it: the same numbers as
+// one pass in order, whatever the chunks; kept_items gives the old ids alone.
+TEST(ChunkedLoops, KeptItemsAreNumberedInOrderAcrossRanges) {
+  auto keep = [](size_t i) { return i % 3 != 1 && i != 10; };
+  for (unsigned chunks : {1u, 3u, 7u}) {
+    ChunkedLoops loops(chunks, chunks, 1);
+    const KeptItems kept = number_kept(loops, 20, keep);
+    std::vector<uint32_t> old_id;
+    std::vector<uint32_t> new_id(20, kNoKey);
+    for (size_t i = 0; i < 20; ++i)
+      if (keep(i)) {
+        new_id[i] = uint32_t(old_id.size());
+        old_id.push_back(uint32_t(i));
+      }
+    EXPECT_EQ(kept.old_id, old_id) << chunks << " chunks";
+    EXPECT_EQ(kept.new_id, new_id) << chunks << " chunks";
+    EXPECT_EQ(kept_items(loops, 20, keep), old_id) << chunks << " chunks";
+  }
+}
 }  // namespace
 }  // namespace parapm
